@@ -1,0 +1,100 @@
+//! Smooth dielectric interface: Fresnel-weighted choice between reflection and refraction.
+
+use super::{ScatterSample, TransportMode, reflect};
+use glam::Vec3A;
+
+/// Unpolarized Fresnel reflectance for light arriving with |cos θ| = `cos_i` on the side
+/// with index `eta_i`, crossing into index `eta_t`. Returns 1 under total internal reflection.
+#[inline]
+pub fn fresnel_dielectric(cos_i: f32, eta_i: f32, eta_t: f32) -> f32 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin_i2 = (1.0 - cos_i * cos_i).max(0.0);
+    let sin_t2 = (eta_i / eta_t) * (eta_i / eta_t) * sin_i2;
+    if sin_t2 >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let r_parallel = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+    let r_perpendicular = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+    0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
+}
+
+/// Samples reflection with probability F and refraction with 1 − F, so the weight is the
+/// tint alone (times the radiance scaling (η_i/η_t)² on refraction in radiance mode).
+#[inline]
+pub(super) fn sample(
+    ior: f32,
+    color: Vec3A,
+    normal: Vec3A,
+    wo: Vec3A,
+    u_lobe: f32,
+    mode: TransportMode,
+) -> Option<ScatterSample> {
+    let cos_o = wo.dot(normal);
+    if cos_o == 0.0 {
+        return None;
+    }
+    // The front side is outside (index 1), the back side inside (index `ior`).
+    let (eta_i, eta_t, side_normal) = if cos_o > 0.0 {
+        (1.0, ior, normal)
+    } else {
+        (ior, 1.0, -normal)
+    };
+    let cos_i = cos_o.abs();
+    let fresnel = fresnel_dielectric(cos_i, eta_i, eta_t);
+    if u_lobe < fresnel {
+        return Some(ScatterSample {
+            wi: reflect(wo, side_normal),
+            weight: color,
+            pdf: fresnel,
+            specular: true,
+        });
+    }
+    let eta = eta_i / eta_t;
+    let sin_t2 = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    let cos_t = (1.0 - sin_t2).max(0.0).sqrt();
+    let wi = (-wo * eta + side_normal * (eta * cos_i - cos_t)).normalize();
+    let scale = match mode {
+        TransportMode::Radiance => eta * eta,
+        TransportMode::Importance => 1.0,
+    };
+    Some(ScatterSample {
+        wi,
+        weight: color * scale,
+        pdf: 1.0 - fresnel,
+        specular: true,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_known_values() {
+        // Normal incidence, glass: ((1.5-1)/(1.5+1))² = 0.04.
+        assert!((fresnel_dielectric(1.0, 1.0, 1.5) - 0.04).abs() < 1e-6);
+        // Symmetric from inside at normal incidence.
+        assert!((fresnel_dielectric(1.0, 1.5, 1.0) - 0.04).abs() < 1e-6);
+        // Total internal reflection beyond the critical angle (41.8° for 1.5).
+        assert_eq!(fresnel_dielectric(45f32.to_radians().cos(), 1.5, 1.0), 1.0);
+        // Grazing incidence reflects everything.
+        assert!((fresnel_dielectric(0.0, 1.0, 1.5) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn refraction_obeys_snell() {
+        let n = Vec3A::Y;
+        let wo = Vec3A::new(0.5, 0.8, 0.0).normalize();
+        // u_lobe = 0.999 picks refraction (F is small at this angle).
+        let s = sample(1.5, Vec3A::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
+        let sin_i = wo.cross(n).length();
+        let sin_t = s.wi.cross(n).length();
+        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
+        assert!(s.wi.y < 0.0);
+        assert!((s.weight.x - 1.0 / 2.25).abs() < 1e-6);
+        // The reversed path (arriving from inside along s.wi) leaves along wo.
+        let back = sample(1.5, Vec3A::ONE, n, s.wi, 0.999, TransportMode::Importance).unwrap();
+        assert!((back.wi - wo).length() < 1e-5);
+    }
+}

@@ -1,0 +1,838 @@
+//! The C ABI. Every export validates what the host passed, catches panics, and reports
+//! failures as an [`MltStatus`] plus a thread-local message. Conventions:
+//! - out-parameters are written only on success (renders also on cancel / time limit);
+//! - `*_release(NULL)` is a no-op;
+//! - enums coming from C are `int32_t` and range-checked (an invalid value in a Rust enum
+//!   would be undefined behaviour);
+//! - a null pointer is accepted only where a count of 0 makes it unused, or where the header
+//!   says it is optional.
+
+use crate::error::*;
+use crate::render::{self, Algorithm, RenderSettings, StopReason};
+use crate::scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc};
+use glam::Vec3A;
+use std::cell::RefCell;
+use std::ffi::{CString, c_char, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// Major version of the mlt library this header belongs to.
+pub const MLT_VERSION_MAJOR: u32 = 0;
+/// Minor version.
+pub const MLT_VERSION_MINOR: u32 = 1;
+/// Patch version.
+pub const MLT_VERSION_PATCH: u32 = 0;
+
+/// `MltMaterial.kind`: Lambertian diffuse with albedo `color` (two-sided).
+pub const MLT_MATERIAL_DIFFUSE: i32 = 0;
+/// `MltMaterial.kind`: perfect mirror reflecting `color` (two-sided).
+pub const MLT_MATERIAL_MIRROR: i32 = 1;
+/// `MltMaterial.kind`: smooth dielectric (glass) with index of refraction `ior`, tinted by `color`.
+pub const MLT_MATERIAL_DIELECTRIC: i32 = 2;
+
+/// `MltSceneDesc.backend`: obvhs compressed wide BVH, always available.
+pub const MLT_BACKEND_BVH: i32 = 0;
+/// `MltSceneDesc.backend`: Intel Embree 3, only when mlt was built with the `embree` feature.
+pub const MLT_BACKEND_EMBREE: i32 = 1;
+
+/// `MltRenderSettings.algorithm`: path tracing with next-event estimation and MIS.
+pub const MLT_ALGORITHM_PATH: i32 = 0;
+
+/// `MltHit.triangle_id` of a ray that hit nothing.
+pub const MLT_INVALID_ID: u32 = u32::MAX;
+
+/// A material. Initialize with `mlt_material_default`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltMaterial {
+    /// One of `MLT_MATERIAL_*`.
+    pub kind: i32,
+    /// Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+    pub color: [f32; 3],
+    /// Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
+    /// Any material may emit: its triangles become area lights.
+    pub emission: [f32; 3],
+    /// Index of refraction of a dielectric (> 0; the outside is vacuum). Ignored otherwise.
+    pub ior: f32,
+}
+
+/// Everything `mlt_scene_create` needs, as plain arrays the host keeps ownership of (they are
+/// copied; the host may free them once the call returns). Initialize with
+/// `mlt_scene_desc_default`.
+///
+/// Degenerate triangles (zero area, e.g. repeated or collinear vertices) are accepted: they
+/// keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltSceneDesc {
+    /// Vertex positions, x y z per vertex; all finite.
+    pub positions: *const f32,
+    /// Number of floats in `positions` (3 per vertex).
+    pub positions_len: usize,
+    /// Vertex indices, 3 per triangle, each < vertex count. Counter-clockwise is the front.
+    pub indices: *const u32,
+    /// Number of entries in `indices` (3 per triangle).
+    pub indices_len: usize,
+    /// One material index per triangle, each < `materials_len`. May be NULL (with length 0):
+    /// every triangle then uses material 0.
+    pub material_ids: *const u32,
+    /// Number of entries in `material_ids`: 0 or the triangle count.
+    pub material_ids_len: usize,
+    pub materials: *const MltMaterial,
+    pub materials_len: usize,
+    /// One of `MLT_BACKEND_*`.
+    pub backend: i32,
+}
+
+/// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with
+/// `mlt_camera_default` (the Cornell box's camera).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltCamera {
+    pub eye: [f32; 3],
+    /// Must differ from `eye`.
+    pub target: [f32; 3],
+    /// Must not be parallel to target - eye.
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+    /// Thin-lens aperture radius; 0 for a pinhole.
+    pub lens_radius: f32,
+    /// Distance of the plane in focus; 0 means |target - eye|.
+    pub focus_distance: f32,
+}
+
+/// How to render. Initialize with `mlt_render_settings_default`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltRenderSettings {
+    /// Image size in pixels, each in [1, 65536].
+    pub width: u32,
+    pub height: u32,
+    /// One of `MLT_ALGORITHM_*`.
+    pub algorithm: i32,
+    /// Samples per pixel, at most 2^24. 0 renders until `time_limit_seconds`.
+    pub samples_per_pixel: u32,
+    /// Most scattering vertices between camera and light (0: only directly visible
+    /// emitters), at most 1024.
+    pub max_depth: u32,
+    /// Worker threads; 0 uses every core. The image does not depend on it.
+    pub threads: u32,
+    /// Seed of every random number; equal seeds and settings give bitwise equal images.
+    pub seed: u64,
+    /// Stop after this many seconds (0: no limit). Finite, at most 1e7.
+    pub time_limit_seconds: f64,
+}
+
+/// What a render did (filled by `mlt_render_ex`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MltRenderStats {
+    /// Camera samples taken over the whole image.
+    pub samples: u64,
+    /// Rays traced, closest-hit and shadow.
+    pub rays: u64,
+    /// Samples with a non-finite value, dropped (they count as black samples).
+    pub invalid_samples: u64,
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// Worker threads used.
+    pub threads: u32,
+}
+
+/// Facts about a created scene.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MltSceneInfo {
+    pub triangle_count: u64,
+    /// Triangles with zero area: never hit, never emit.
+    pub degenerate_triangle_count: u64,
+    /// Emissive triangles (area lights).
+    pub emitter_count: u64,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    /// The `MLT_BACKEND_*` the scene was built with.
+    pub backend: i32,
+}
+
+/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax].
+/// `direction` need not be unit length; t is measured in multiples of it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltRay {
+    pub origin: [f32; 3],
+    /// Finite, >= 0.
+    pub tmin: f32,
+    /// Finite and non-zero.
+    pub direction: [f32; 3],
+    /// >= tmin; may be INFINITY.
+    pub tmax: f32,
+}
+
+/// A closest hit. The hit point is (1-u-v)·v0 + u·v1 + v·v2 of the triangle's vertices in
+/// the order the host gave them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltHit {
+    /// The host's triangle index, or `MLT_INVALID_ID` for a miss (then t = INFINITY).
+    pub triangle_id: u32,
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// An immutable scene: triangles, materials, lights and the acceleration structure. Thread
+/// safe: any number of threads may render and query one scene at the same time.
+pub struct MltScene {
+    scene: Scene,
+    backend: i32,
+}
+
+/// Progress callback: called on the thread that called `mlt_render` (never from a worker),
+/// about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
+/// Return `true` to continue and `false` to cancel.
+pub type MltProgressCallback =
+    Option<unsafe extern "C" fn(fraction: f32, user_data: *mut c_void) -> bool>;
+
+thread_local! {
+    static LAST_ERROR: RefCell<CString> = RefCell::new(CString::default());
+}
+
+fn set_last_error(message: &str) {
+    let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    LAST_ERROR.with(|e| *e.borrow_mut() = text);
+}
+
+/// Runs an export: converts errors and panics to a status and the thread's last message.
+fn guard(f: impl FnOnce() -> Result<MltStatus>) -> MltStatus {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(Ok(status)) => {
+            if status == MLT_STATUS_OK {
+                set_last_error("");
+            }
+            status
+        }
+        Ok(Err(error)) => {
+            set_last_error(&error.message);
+            error.status
+        }
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            set_last_error(&format!("internal error (please report): {what}"));
+            MLT_STATUS_INTERNAL_ERROR
+        }
+    }
+}
+
+fn check_pointer<T>(pointer: *const T, name: &str) -> Result<()> {
+    if pointer.is_null() {
+        return Err(Error::invalid(format!("{name} is NULL")));
+    }
+    if !pointer.is_aligned() {
+        return Err(Error::invalid(format!(
+            "{name} ({pointer:p}) is not aligned to {} bytes",
+            std::mem::align_of::<T>()
+        )));
+    }
+    Ok(())
+}
+
+/// A reference from a host pointer, after checking it is non-null and aligned.
+///
+/// # Safety
+/// If non-null, `pointer` must point to a valid `T` for the returned lifetime.
+unsafe fn host_ref<'a, T>(pointer: *const T, name: &str) -> Result<&'a T> {
+    check_pointer(pointer, name)?;
+    // SAFETY: non-null and aligned (checked above); validity is the caller's contract.
+    Ok(unsafe { &*pointer })
+}
+
+/// A slice from a host pointer and element count; NULL is allowed only with a count of 0.
+///
+/// # Safety
+/// If `len > 0`, `pointer` must point to `len` valid, initialized `T`s.
+unsafe fn host_slice<'a, T>(pointer: *const T, len: usize, name: &str) -> Result<&'a [T]> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    check_pointer(pointer, name)?;
+    if len
+        .checked_mul(std::mem::size_of::<T>())
+        .is_none_or(|b| b > isize::MAX as usize)
+    {
+        return Err(Error::invalid(format!(
+            "{name} claims {len} elements, more than the address space holds"
+        )));
+    }
+    // SAFETY: non-null, aligned, size within isize::MAX (checked); the host guarantees
+    // `len` initialized elements.
+    Ok(unsafe { std::slice::from_raw_parts(pointer, len) })
+}
+
+/// A mutable slice from a host pointer and element count.
+///
+/// # Safety
+/// `pointer` must point to `len` writable `T`s not aliased during the call.
+unsafe fn host_slice_mut<'a, T>(pointer: *mut T, len: usize, name: &str) -> Result<&'a mut [T]> {
+    check_pointer(pointer, name)?;
+    if len
+        .checked_mul(std::mem::size_of::<T>())
+        .is_none_or(|b| b > isize::MAX as usize)
+    {
+        return Err(Error::invalid(format!(
+            "{name} claims {len} elements, more than the address space holds"
+        )));
+    }
+    // SAFETY: as host_slice, and the host guarantees exclusive access for the call.
+    Ok(unsafe { std::slice::from_raw_parts_mut(pointer, len) })
+}
+
+/// Writes an out-parameter after checking it.
+///
+/// # Safety
+/// If non-null, `pointer` must be valid for a write of `T`.
+unsafe fn write_out<T>(pointer: *mut T, name: &str, value: T) -> Result<()> {
+    check_pointer(pointer, name)?;
+    // SAFETY: non-null and aligned; writable by the caller's contract.
+    unsafe { pointer.write(value) };
+    Ok(())
+}
+
+fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
+    match kind {
+        MLT_MATERIAL_DIFFUSE => Ok(MaterialKind::Diffuse),
+        MLT_MATERIAL_MIRROR => Ok(MaterialKind::Mirror),
+        MLT_MATERIAL_DIELECTRIC => Ok(MaterialKind::Dielectric),
+        other => Err(Error::invalid(format!(
+            "materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
+        ))),
+    }
+}
+
+fn backend(value: i32) -> Result<Backend> {
+    match value {
+        MLT_BACKEND_BVH => Ok(Backend::Bvh),
+        MLT_BACKEND_EMBREE => Ok(Backend::Embree),
+        other => Err(Error::invalid(format!(
+            "desc->backend is {other}; use MLT_BACKEND_BVH (0) or MLT_BACKEND_EMBREE (1)"
+        ))),
+    }
+}
+
+impl From<&MltCamera> for Camera {
+    fn from(c: &MltCamera) -> Self {
+        Camera {
+            eye: c.eye,
+            target: c.target,
+            up: c.up,
+            fov_y_deg: c.fov_y_deg,
+            lens_radius: c.lens_radius,
+            focus_distance: c.focus_distance,
+        }
+    }
+}
+
+fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
+    let algorithm = match s.algorithm {
+        MLT_ALGORITHM_PATH => Algorithm::Path,
+        other => {
+            return Err(Error::invalid(format!(
+                "settings->algorithm is {other}; use MLT_ALGORITHM_PATH (0)"
+            )));
+        }
+    };
+    Ok(RenderSettings {
+        width: s.width,
+        height: s.height,
+        algorithm,
+        samples_per_pixel: s.samples_per_pixel,
+        max_depth: s.max_depth,
+        seed: s.seed,
+        threads: s.threads,
+        time_limit_seconds: s.time_limit_seconds,
+    })
+}
+
+/// The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_version() -> u32 {
+    MLT_VERSION_MAJOR * 10000 + MLT_VERSION_MINOR * 100 + MLT_VERSION_PATCH
+}
+
+/// The library version as "MAJOR.MINOR.PATCH" (static storage).
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_version_string() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// A static description of a status (any integer is accepted).
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_status_string(status: i32) -> *const c_char {
+    let text: &'static std::ffi::CStr = match status {
+        0 => c"success",
+        1 => c"invalid argument",
+        2 => c"unsupported",
+        3 => c"out of memory",
+        4 => c"cancelled by the progress callback",
+        5 => c"time limit reached",
+        6 => c"internal error",
+        _ => c"unknown status",
+    };
+    text.as_ptr()
+}
+
+/// The message of the last failed mlt call on this thread ("" after a success). The pointer
+/// stays valid until the next mlt call on this thread.
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_last_error_message() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// Whether scenes can be built with this backend in this build (`MLT_BACKEND_*`).
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_backend_supported(backend: i32) -> bool {
+    backend == MLT_BACKEND_BVH
+}
+
+/// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltMaterial`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_material_default(out: *mut MltMaterial) -> MltStatus {
+    guard(|| {
+        let value = MltMaterial {
+            kind: MLT_MATERIAL_DIFFUSE,
+            color: [0.8; 3],
+            emission: [0.0; 3],
+            ior: 1.5,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with an empty description (no arrays, BVH backend).
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltSceneDesc`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_desc_default(out: *mut MltSceneDesc) -> MltStatus {
+    guard(|| {
+        let value = MltSceneDesc {
+            positions: std::ptr::null(),
+            positions_len: 0,
+            indices: std::ptr::null(),
+            indices_len: 0,
+            material_ids: std::ptr::null(),
+            material_ids_len: 0,
+            materials: std::ptr::null(),
+            materials_len: 0,
+            backend: MLT_BACKEND_BVH,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with the Cornell box's pinhole camera.
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltCamera`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
+    guard(|| {
+        let c = Camera::default();
+        let value = MltCamera {
+            eye: c.eye,
+            target: c.target,
+            up: c.up,
+            fov_y_deg: c.fov_y_deg,
+            lens_radius: c.lens_radius,
+            focus_distance: c.focus_distance,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with the default settings: 256 x 256, path tracing, 64 samples per pixel,
+/// max depth 5, seed 0, all cores, no time limit.
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings) -> MltStatus {
+    guard(|| {
+        let d = RenderSettings::default();
+        let value = MltRenderSettings {
+            width: d.width,
+            height: d.height,
+            algorithm: MLT_ALGORITHM_PATH,
+            samples_per_pixel: d.samples_per_pixel,
+            max_depth: d.max_depth,
+            threads: d.threads,
+            seed: d.seed,
+            time_limit_seconds: d.time_limit_seconds,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Validates `desc`, copies its arrays and builds the acceleration structure. On success
+/// `*out` receives a scene to release with `mlt_scene_release`; on failure `*out` is untouched.
+///
+/// # Safety
+/// `desc` must point to an `MltSceneDesc` whose pointers reference arrays of at least the
+/// given lengths; `out` must be writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_create(
+    desc: *const MltSceneDesc,
+    out: *mut *mut MltScene,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract for every pointer below.
+        let desc = unsafe { host_ref(desc, "desc") }?;
+        check_pointer(out, "out")?;
+        let positions =
+            unsafe { host_slice(desc.positions, desc.positions_len, "desc->positions") }?;
+        let indices = unsafe { host_slice(desc.indices, desc.indices_len, "desc->indices") }?;
+        let material_ids = unsafe {
+            host_slice(
+                desc.material_ids,
+                desc.material_ids_len,
+                "desc->material_ids",
+            )
+        }?;
+        let host_materials =
+            unsafe { host_slice(desc.materials, desc.materials_len, "desc->materials") }?;
+        let materials = host_materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                Ok(Material {
+                    kind: material_kind(m.kind, i)?,
+                    color: m.color,
+                    emission: m.emission,
+                    ior: m.ior,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let scene = Scene::new(&SceneDesc {
+            positions,
+            indices,
+            material_ids,
+            materials: &materials,
+            backend: backend(desc.backend)?,
+        })?;
+        let handle = Box::into_raw(Box::new(MltScene {
+            scene,
+            backend: desc.backend,
+        }));
+        // SAFETY: `out` checked non-null and aligned above.
+        unsafe { out.write(handle) };
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Releases a scene. NULL is a no-op. The scene must not be in use by another thread.
+///
+/// # Safety
+/// `scene` must be NULL or a pointer returned by `mlt_scene_create` not yet released.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_release(scene: *mut MltScene) {
+    if scene.is_null() {
+        return;
+    }
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: created by Box::into_raw in mlt_scene_create, released once (contract).
+        drop(unsafe { Box::from_raw(scene) });
+    }));
+}
+
+/// Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
+///
+/// # Safety
+/// `scene` must be a live scene; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_get_info(
+    scene: *const MltScene,
+    out: *mut MltSceneInfo,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let info = handle.scene.info();
+        let value = MltSceneInfo {
+            triangle_count: info.triangle_count as u64,
+            degenerate_triangle_count: info.degenerate_triangle_count as u64,
+            emitter_count: info.emitter_count as u64,
+            bounds_min: info.bounds_min,
+            bounds_max: info.bounds_max,
+            backend: handle.backend,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Renders `scene` seen by `camera` into `rgb_out`: width × height × 3 floats, linear RGB
+/// radiance, rows from top to bottom, left to right. `out_len` is the number of floats
+/// `rgb_out` holds (at least width·height·3). `progress` may be NULL.
+///
+/// Returns `MLT_STATUS_OK` when every sample was taken. `MLT_STATUS_CANCELLED` or
+/// `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
+/// normalized by the samples it actually received. On any other status `rgb_out` is untouched.
+///
+/// # Safety
+/// Pointers must be valid as described; `rgb_out` must not be accessed by the host until
+/// the call returns.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render(
+    scene: *const MltScene,
+    camera: *const MltCamera,
+    settings: *const MltRenderSettings,
+    rgb_out: *mut f32,
+    out_len: usize,
+    progress: MltProgressCallback,
+    user_data: *mut c_void,
+) -> MltStatus {
+    // SAFETY: forwarded contract; no stats requested.
+    unsafe {
+        mlt_render_ex(
+            scene,
+            camera,
+            settings,
+            rgb_out,
+            out_len,
+            progress,
+            user_data,
+            std::ptr::null_mut(),
+        )
+    }
+}
+
+/// `mlt_render` that also fills `stats_out` (may be NULL) whenever it writes the image.
+///
+/// # Safety
+/// As `mlt_render`; `stats_out` NULL or writable.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn mlt_render_ex(
+    scene: *const MltScene,
+    camera: *const MltCamera,
+    settings: *const MltRenderSettings,
+    rgb_out: *mut f32,
+    out_len: usize,
+    progress: MltProgressCallback,
+    user_data: *mut c_void,
+    stats_out: *mut MltRenderStats,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract for every pointer below.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let camera: Camera = unsafe { host_ref(camera, "camera") }?.into();
+        let settings = render_settings(unsafe { host_ref(settings, "settings") }?)?;
+        if !stats_out.is_null() {
+            check_pointer(stats_out, "stats_out")?;
+        }
+        settings.validate()?;
+        camera.validate()?;
+        let needed = settings.output_len()?;
+        if out_len < needed {
+            return Err(Error::invalid(format!(
+                "out_len is {out_len} floats but a {} x {} RGB image needs {needed}",
+                settings.width, settings.height
+            )));
+        }
+        let image = unsafe { host_slice_mut(rgb_out, needed, "rgb_out") }?;
+        let mut forward = |fraction: f32| match progress {
+            // SAFETY: the host's callback with the host's user data, on the host's thread.
+            Some(callback) => unsafe { callback(fraction, user_data) },
+            None => true,
+        };
+        let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
+        if !stats_out.is_null() {
+            let value = MltRenderStats {
+                samples: stats.samples,
+                rays: stats.rays,
+                invalid_samples: stats.invalid_samples,
+                seconds: stats.seconds,
+                threads: stats.threads,
+            };
+            // SAFETY: checked non-null and aligned above.
+            unsafe { stats_out.write(value) };
+        }
+        Ok(match stats.stop {
+            StopReason::Completed => MLT_STATUS_OK,
+            StopReason::Cancelled => {
+                set_last_error(&format!(
+                    "the progress callback cancelled the render after {} samples",
+                    stats.samples
+                ));
+                MLT_STATUS_CANCELLED
+            }
+            StopReason::TimeLimitReached => {
+                set_last_error(&format!(
+                    "the time limit of {} s was reached after {} samples",
+                    settings.time_limit_seconds, stats.samples
+                ));
+                MLT_STATUS_TIME_LIMIT_REACHED
+            }
+        })
+    })
+}
+
+/// Checks every ray of a batch query, naming the first bad one.
+fn checked_rays(rays: &[MltRay]) -> Result<()> {
+    for (i, ray) in rays.iter().enumerate() {
+        check_finite3(&format!("rays[{i}].origin"), ray.origin)?;
+        check_finite3(&format!("rays[{i}].direction"), ray.direction)?;
+        let length = Vec3A::from(ray.direction).length();
+        if !(length > 0.0 && length.is_finite()) {
+            return Err(Error::invalid(format!(
+                "rays[{i}].direction is {:?}; it must be non-zero",
+                ray.direction
+            )));
+        }
+        if !(ray.tmin.is_finite() && ray.tmin >= 0.0) {
+            return Err(Error::invalid(format!(
+                "rays[{i}].tmin is {}; it must be finite and >= 0",
+                ray.tmin
+            )));
+        }
+        if ray.tmax.is_nan() || ray.tmax < ray.tmin {
+            return Err(Error::invalid(format!(
+                "rays[{i}].tmax is {}; it must be >= tmin ({})",
+                ray.tmax, ray.tmin
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The ray with a unit direction and t scaled to match, plus the scale to map t back.
+fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f32) {
+    let direction = Vec3A::from(ray.direction);
+    let length = direction.length();
+    (
+        crate::accel::Ray::new(
+            Vec3A::from(ray.origin),
+            direction / length,
+            ray.tmin * length,
+            ray.tmax * length,
+        ),
+        length,
+    )
+}
+
+/// Closest hit for each of `count` rays, written to `hits_out[i]` (a miss has triangle_id
+/// `MLT_INVALID_ID` and t = INFINITY). Runs on the calling thread. Every ray is validated
+/// before any result is written.
+///
+/// # Safety
+/// `rays` and `hits_out` must hold `count` elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_intersect(
+    scene: *const MltScene,
+    rays: *const MltRay,
+    count: usize,
+    hits_out: *mut MltHit,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let rays = unsafe { host_slice(rays, count, "rays") }?;
+        if count == 0 {
+            return Ok(MLT_STATUS_OK);
+        }
+        let hits = unsafe { host_slice_mut(hits_out, count, "hits_out") }?;
+        checked_rays(rays)?;
+        for (ray, out) in rays.iter().zip(hits.iter_mut()) {
+            let (unit, length) = unit_ray(ray);
+            *out = match handle.scene.intersect(&unit) {
+                Some(hit) => MltHit {
+                    triangle_id: hit.triangle,
+                    t: hit.t / length,
+                    u: hit.u,
+                    v: hit.v,
+                },
+                None => MltHit {
+                    triangle_id: MLT_INVALID_ID,
+                    t: f32::INFINITY,
+                    u: 0.0,
+                    v: 0.0,
+                },
+            };
+        }
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// For each of `count` rays, `occluded_out[i]` = 1 if any triangle lies on it within
+/// [tmin, tmax], else 0. Runs on the calling thread.
+///
+/// # Safety
+/// `rays` and `occluded_out` must hold `count` elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_occluded(
+    scene: *const MltScene,
+    rays: *const MltRay,
+    count: usize,
+    occluded_out: *mut u8,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let rays = unsafe { host_slice(rays, count, "rays") }?;
+        if count == 0 {
+            return Ok(MLT_STATUS_OK);
+        }
+        let out = unsafe { host_slice_mut(occluded_out, count, "occluded_out") }?;
+        checked_rays(rays)?;
+        for (ray, o) in rays.iter().zip(out.iter_mut()) {
+            let (unit, _) = unit_ray(ray);
+            *o = handle.scene.occluded(&unit) as u8;
+        }
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn version_constants_match_the_crate() {
+        assert_eq!(
+            env!("CARGO_PKG_VERSION"),
+            format!("{MLT_VERSION_MAJOR}.{MLT_VERSION_MINOR}.{MLT_VERSION_PATCH}")
+        );
+    }
+
+    #[test]
+    fn status_strings_match_descriptions() {
+        for status in [
+            MLT_STATUS_OK,
+            MLT_STATUS_INVALID_ARGUMENT,
+            MLT_STATUS_UNSUPPORTED,
+            MLT_STATUS_OUT_OF_MEMORY,
+            MLT_STATUS_CANCELLED,
+            MLT_STATUS_TIME_LIMIT_REACHED,
+            MLT_STATUS_INTERNAL_ERROR,
+        ] {
+            // SAFETY: static NUL-terminated strings.
+            let s = unsafe { std::ffi::CStr::from_ptr(mlt_status_string(status as i32)) };
+            assert_eq!(s.to_str().unwrap(), status.description());
+        }
+    }
+}

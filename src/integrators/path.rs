@@ -1,0 +1,150 @@
+//! Unidirectional path tracing: BSDF importance sampling, next-event estimation to area
+//! lights, multiple importance sampling (power heuristic) and Russian roulette.
+
+use super::{shadow_ray, spawn_ray};
+use crate::bsdf::{self, TransportMode};
+use crate::sampling::{Rng, power_heuristic, uniform_triangle};
+use crate::scene::{MaterialKind, Scene};
+use glam::Vec3A;
+
+/// Bounces after which Russian roulette may end a path.
+const ROULETTE_START_DEPTH: u32 = 3;
+/// Highest survival probability: paths always carry some chance of ending.
+const ROULETTE_MAX_SURVIVAL: f32 = 0.95;
+
+pub struct PathTracer<'a> {
+    pub scene: &'a Scene,
+    /// At most this many scattering vertices between camera and light.
+    pub max_depth: u32,
+}
+
+impl PathTracer<'_> {
+    /// Radiance arriving at `origin` from `direction` (unit length). `rays` counts traced rays.
+    #[inline]
+    pub fn radiance(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        rng: &mut Rng,
+        rays: &mut u64,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let mut radiance = Vec3A::ZERO;
+        let mut throughput = Vec3A::ONE;
+        let mut ray = crate::accel::Ray::new(origin, direction, 0.0, f32::INFINITY);
+        // The previous vertex's scattering density, for MIS against light sampling.
+        let mut previous_pdf = 0.0f32;
+        let mut previous_specular = true;
+
+        // `depth` = scattering vertices before the surface this iteration hits.
+        let mut depth = 0;
+        loop {
+            *rays += 1;
+            let Some(hit) = scene.accel.intersect(&ray) else {
+                break;
+            };
+            let shading = &scene.shading[hit.triangle as usize];
+            let material = &scene.materials[shading.material as usize];
+            let normal = shading.normal;
+            let wo = -ray.direction;
+            let p = ray.origin + ray.direction * hit.t;
+            let cos_o = wo.dot(normal);
+
+            // Emission from the front side.
+            if shading.light_area_pdf > 0.0 && cos_o > 0.0 {
+                let emission = Vec3A::from(material.emission);
+                let weight = if previous_specular {
+                    1.0
+                } else {
+                    let light_pdf = shading.light_area_pdf * hit.t * hit.t / cos_o;
+                    power_heuristic(previous_pdf, light_pdf)
+                };
+                radiance += throughput * emission * weight;
+            }
+            if depth >= self.max_depth {
+                break;
+            }
+
+            if material.kind == MaterialKind::Diffuse {
+                radiance += throughput * self.sample_light(p, normal, wo, material, rng, rays);
+            }
+
+            let Some(sample) = bsdf::sample(
+                material,
+                normal,
+                wo,
+                rng.uniform2(),
+                rng.uniform(),
+                TransportMode::Radiance,
+            ) else {
+                break;
+            };
+            throughput *= sample.weight;
+            previous_pdf = sample.pdf;
+            previous_specular = sample.specular;
+            depth += 1;
+
+            if depth >= ROULETTE_START_DEPTH {
+                let survival = throughput.max_element().min(ROULETTE_MAX_SURVIVAL);
+                if rng.uniform() >= survival {
+                    break;
+                }
+                throughput /= survival;
+            }
+            if throughput.max_element() <= 0.0 {
+                break;
+            }
+            ray = spawn_ray(scene, p, normal, sample.wi);
+        }
+        radiance
+    }
+
+    /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
+    /// against BSDF sampling. Returns the contribution before the path throughput.
+    #[inline]
+    fn sample_light(
+        &self,
+        p: Vec3A,
+        normal: Vec3A,
+        wo: Vec3A,
+        material: &crate::scene::Material,
+        rng: &mut Rng,
+        rays: &mut u64,
+    ) -> Vec3A {
+        let scene = self.scene;
+        let u_select = rng.uniform();
+        let u_point = rng.uniform2();
+        if scene.lights.is_empty() {
+            return Vec3A::ZERO;
+        }
+        let (index, _, _) = scene.light_distribution.sample_discrete(u_select);
+        let light = &scene.lights[index];
+        let [b1, b2] = uniform_triangle(u_point);
+        let y = light.v0 + light.edge1 * b1 + light.edge2 * b2;
+        let to_light = y - p;
+        let distance2 = to_light.length_squared();
+        if distance2 <= 0.0 {
+            return Vec3A::ZERO;
+        }
+        let wi = to_light / distance2.sqrt();
+        let cos_light = -wi.dot(light.normal);
+        if cos_light <= 0.0 {
+            return Vec3A::ZERO;
+        }
+        let f = bsdf::eval(material, normal, wo, wi);
+        if f.max_element() <= 0.0 {
+            return Vec3A::ZERO;
+        }
+        let Some(ray) = shadow_ray(scene, p, normal, y, light.normal) else {
+            return Vec3A::ZERO;
+        };
+        *rays += 1;
+        if scene.accel.occluded(&ray) {
+            return Vec3A::ZERO;
+        }
+        let light_pdf = light.area_pdf * distance2 / cos_light;
+        let bsdf_pdf = bsdf::pdf(material, normal, wo, wi);
+        let weight = power_heuristic(light_pdf, bsdf_pdf);
+        f * light.emission * (wi.dot(normal).abs() * weight / light_pdf)
+    }
+}

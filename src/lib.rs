@@ -1,0 +1,43 @@
+//! # mlt — an embeddable Metropolis Light Transport kernel
+//!
+//! Hand it triangles, materials and a camera; get back a linear HDR image. The Rust API is
+//! [`Scene::new`] and [`render`]; C and C++ hosts use the same kernel through `include/mlt.h`
+//! (see [`capi`]).
+//!
+//! ```
+//! use mlt::{Camera, Material, RenderSettings, Scene, SceneDesc};
+//! // One emissive quad facing the camera.
+//! let positions = [-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, -1.0, 1.0, 0.0];
+//! let indices = [0, 2, 1, 0, 3, 2];
+//! let materials = [Material::diffuse([0.5; 3]).with_emission([1.0; 3])];
+//! let scene = Scene::new(&SceneDesc {
+//!     positions: &positions,
+//!     indices: &indices,
+//!     material_ids: &[],
+//!     materials: &materials,
+//!     backend: Default::default(),
+//! })
+//! .unwrap();
+//! let camera = Camera { eye: [0.0, 0.0, -3.0], target: [0.0; 3], ..Camera::default() };
+//! let settings = RenderSettings { width: 8, height: 8, samples_per_pixel: 4, ..Default::default() };
+//! let mut image = vec![0.0f32; 8 * 8 * 3];
+//! mlt::render(&scene, &camera, &settings, &mut image, None).unwrap();
+//! assert!((image[(4 * 8 + 4) * 3] - 1.0).abs() < 1e-6);
+//! ```
+
+pub mod accel;
+pub mod bsdf;
+pub mod capi;
+pub mod error;
+pub mod film;
+pub mod integrators;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+
+#[cfg(feature = "cli")]
+pub mod io;
+
+pub use error::{Error, MltStatus, Result};
+pub use render::{Algorithm, RenderSettings, RenderStats, StopReason, render};
+pub use scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};

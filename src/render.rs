@@ -1,0 +1,383 @@
+//! Render settings, their validation, and the driver that runs an integrator over the film in
+//! parallel with progress reporting, cancellation and a time limit.
+
+use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
+use crate::film::Film;
+use crate::integrators::path::PathTracer;
+use crate::sampling::Rng;
+use crate::scene::{Camera, CameraModel, Scene};
+use glam::Vec3A;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+/// The light-transport algorithm of a render.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Algorithm {
+    /// Unidirectional path tracing with next-event estimation and MIS.
+    #[default]
+    Path,
+}
+
+/// Largest accepted image side, samples per pixel, depth and thread count: beyond these a
+/// value is a mistake, not a request.
+pub const MLT_MAX_IMAGE_SIDE: u32 = 1 << 16;
+pub const MLT_MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
+pub const MLT_MAX_DEPTH_LIMIT: u32 = 1024;
+pub const MLT_MAX_THREADS: u32 = 4096;
+pub const MLT_MAX_TIME_LIMIT_SECONDS: f64 = 1.0e7;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub algorithm: Algorithm,
+    /// Samples per pixel; 0 means "until the time limit" (which must then be set).
+    pub samples_per_pixel: u32,
+    /// At most this many scattering vertices between camera and light (0: emitters only).
+    pub max_depth: u32,
+    pub seed: u64,
+    /// Worker threads; 0 uses every core.
+    pub threads: u32,
+    /// Stop after this many seconds; 0 means no limit.
+    pub time_limit_seconds: f64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 256,
+            height: 256,
+            algorithm: Algorithm::Path,
+            samples_per_pixel: 64,
+            max_depth: 5,
+            seed: 0,
+            threads: 0,
+            time_limit_seconds: 0.0,
+        }
+    }
+}
+
+impl RenderSettings {
+    pub fn validate(&self) -> Result<()> {
+        for (name, side) in [("width", self.width), ("height", self.height)] {
+            if side == 0 || side > MLT_MAX_IMAGE_SIDE {
+                return Err(Error::invalid(format!(
+                    "settings.{name} is {side}; it must be between 1 and {MLT_MAX_IMAGE_SIDE}"
+                )));
+            }
+        }
+        if self.samples_per_pixel > MLT_MAX_SAMPLES_PER_PIXEL {
+            return Err(Error::invalid(format!(
+                "settings.samples_per_pixel is {}; at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported",
+                self.samples_per_pixel
+            )));
+        }
+        if self.max_depth > MLT_MAX_DEPTH_LIMIT {
+            return Err(Error::invalid(format!(
+                "settings.max_depth is {}; at most {MLT_MAX_DEPTH_LIMIT} is supported",
+                self.max_depth
+            )));
+        }
+        if self.threads > MLT_MAX_THREADS {
+            return Err(Error::invalid(format!(
+                "settings.threads is {}; use 0 for all cores or at most {MLT_MAX_THREADS}",
+                self.threads
+            )));
+        }
+        let t = self.time_limit_seconds;
+        if !(t.is_finite() && (0.0..=MLT_MAX_TIME_LIMIT_SECONDS).contains(&t)) {
+            return Err(Error::invalid(format!(
+                "settings.time_limit_seconds is {t}; it must be 0 (no limit) or a positive number of seconds up to {MLT_MAX_TIME_LIMIT_SECONDS}"
+            )));
+        }
+        if self.samples_per_pixel == 0 && t == 0.0 {
+            return Err(Error::invalid(
+                "settings.samples_per_pixel is 0 and there is no time limit; the render would never end",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Floats the RGB output of this image holds, or an error if it overflows.
+    pub fn output_len(&self) -> Result<usize> {
+        (self.width as usize)
+            .checked_mul(self.height as usize)
+            .and_then(|p| p.checked_mul(3))
+            .ok_or_else(|| {
+                Error::invalid(format!(
+                    "an image of {} x {} pixels x 3 floats overflows the address space",
+                    self.width, self.height
+                ))
+            })
+    }
+}
+
+/// Why a render stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    Completed,
+    Cancelled,
+    TimeLimitReached,
+}
+
+/// What a render did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderStats {
+    pub stop: StopReason,
+    /// Camera samples taken over the whole image.
+    pub samples: u64,
+    /// Rays traced (closest-hit and shadow).
+    pub rays: u64,
+    /// Samples whose radiance was not finite and were dropped (counted in `samples`).
+    pub invalid_samples: u64,
+    pub seconds: f64,
+    pub threads: u32,
+}
+
+/// Called from the rendering call's own thread with the fraction done; return `false` to stop.
+pub type Progress<'a> = &'a mut dyn FnMut(f32) -> bool;
+
+/// How often the caller's thread wakes to report progress and check the time limit.
+const PROGRESS_INTERVAL: Duration = Duration::from_millis(50);
+/// Rows per unit of parallel work.
+const BAND_ROWS: u32 = 4;
+/// Target samples per pass over the whole image: passes bound how long a stop takes and how
+/// unevenly a partial image is sampled.
+const SAMPLES_PER_PASS: u64 = 1 << 18;
+
+/// Renders into `rgb_out` (width × height × 3 floats, rows top to bottom).
+pub fn render(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    settings.validate()?;
+    camera.validate()?;
+    let needed = settings.output_len()?;
+    if rgb_out.len() < needed {
+        return Err(Error::invalid(format!(
+            "the output buffer holds {} floats but a {} x {} RGB image needs {needed}",
+            rgb_out.len(),
+            settings.width,
+            settings.height
+        )));
+    }
+    let mut film = try_film(settings.width, settings.height)?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(settings.threads as usize)
+        .build()
+        .map_err(|e| {
+            Error::new(
+                MLT_STATUS_OUT_OF_MEMORY,
+                format!("could not start worker threads: {e}"),
+            )
+        })?;
+    let threads = pool.current_num_threads() as u32;
+
+    let start = Instant::now();
+    let deadline = (settings.time_limit_seconds > 0.0)
+        .then(|| start + Duration::from_secs_f64(settings.time_limit_seconds));
+    let control = Control {
+        stop: AtomicBool::new(false),
+        cancelled: AtomicBool::new(false),
+        deadline,
+        samples_done: AtomicU64::new(0),
+        rays: AtomicU64::new(0),
+        invalid: AtomicU64::new(0),
+    };
+    let model = camera.model(settings.width, settings.height);
+    let job = PathJob {
+        tracer: PathTracer {
+            scene,
+            max_depth: settings.max_depth,
+        },
+        camera: model,
+        seed: settings.seed,
+        samples_per_pixel: settings.samples_per_pixel,
+    };
+    let pixels = settings.width as u64 * settings.height as u64;
+    let planned = if settings.samples_per_pixel > 0 {
+        settings.samples_per_pixel as u64 * pixels
+    } else {
+        0
+    };
+
+    let mut progress = progress;
+    let outcome = std::thread::scope(|s| {
+        let (done_tx, done_rx) = mpsc::channel::<()>();
+        let control = &control;
+        let film = &mut film;
+        let job = &job;
+        let pool = &pool;
+        let worker = s.spawn(move || {
+            pool.install(|| job.run(film, control));
+            let _ = done_tx.send(());
+        });
+        loop {
+            match done_rx.recv_timeout(PROGRESS_INTERVAL) {
+                Ok(()) | Err(mpsc::RecvTimeoutError::Disconnected) => break,
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            if let Some(callback) = progress.as_mut() {
+                let fraction = control.fraction(planned, start);
+                if !callback(fraction) {
+                    control.cancelled.store(true, Ordering::Relaxed);
+                    control.stop.store(true, Ordering::Relaxed);
+                }
+            }
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                control.stop.store(true, Ordering::Relaxed);
+            }
+        }
+        worker.join()
+    });
+    if outcome.is_err() {
+        return Err(Error::new(
+            MLT_STATUS_INTERNAL_ERROR,
+            "a rendering thread panicked; this is a bug in mlt",
+        ));
+    }
+    film.write_rgb(&mut rgb_out[..needed]);
+    let samples = film.sample_count();
+    let stop = if control.cancelled.load(Ordering::Relaxed) {
+        StopReason::Cancelled
+    } else if planned == 0 || samples < planned {
+        StopReason::TimeLimitReached
+    } else {
+        StopReason::Completed
+    };
+    if let (StopReason::Completed, Some(callback)) = (stop, progress.as_mut()) {
+        // The last word is always 1.0 for a finished render; a cancel now changes nothing.
+        let _ = callback(1.0);
+    }
+    Ok(RenderStats {
+        stop,
+        samples,
+        rays: control.rays.load(Ordering::Relaxed),
+        invalid_samples: control.invalid.load(Ordering::Relaxed),
+        seconds: start.elapsed().as_secs_f64(),
+        threads,
+    })
+}
+
+/// Allocates the film, reporting failure as a status instead of aborting.
+fn try_film(width: u32, height: u32) -> Result<Film> {
+    let pixels = width as usize * height as usize;
+    // Probe the two large allocations first: `vec!` would abort the process on failure.
+    let mut probe: Vec<[f64; 3]> = Vec::new();
+    probe.try_reserve_exact(pixels).map_err(|_| {
+        Error::new(
+            MLT_STATUS_OUT_OF_MEMORY,
+            format!("could not allocate the film for {width} x {height} pixels"),
+        )
+    })?;
+    drop(probe);
+    Ok(Film::new(width, height))
+}
+
+/// Shared state between the workers and the calling thread.
+struct Control {
+    /// Set when workers should finish their current band and start no more.
+    stop: AtomicBool,
+    cancelled: AtomicBool,
+    deadline: Option<Instant>,
+    samples_done: AtomicU64,
+    rays: AtomicU64,
+    invalid: AtomicU64,
+}
+
+impl Control {
+    fn should_stop(&self) -> bool {
+        if self.stop.load(Ordering::Relaxed) {
+            return true;
+        }
+        if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            self.stop.store(true, Ordering::Relaxed);
+            return true;
+        }
+        false
+    }
+
+    /// Fraction done: by samples when a count was asked for, else by time.
+    fn fraction(&self, planned: u64, start: Instant) -> f32 {
+        let by_samples = if planned > 0 {
+            self.samples_done.load(Ordering::Relaxed) as f64 / planned as f64
+        } else {
+            0.0
+        };
+        let by_time = self.deadline.map_or(0.0, |d| {
+            let total = (d - start).as_secs_f64();
+            start.elapsed().as_secs_f64() / total
+        });
+        by_samples.max(by_time).clamp(0.0, 1.0) as f32
+    }
+}
+
+/// Path tracing over the film, pass by pass.
+struct PathJob<'a> {
+    tracer: PathTracer<'a>,
+    camera: CameraModel,
+    seed: u64,
+    /// 0 = until stopped.
+    samples_per_pixel: u32,
+}
+
+impl PathJob<'_> {
+    fn run(&self, film: &mut Film, control: &Control) {
+        let width = film.width;
+        let pixels = width as u64 * film.height as u64;
+        let batch = SAMPLES_PER_PASS.div_ceil(pixels).clamp(1, 64) as u32;
+        let total = if self.samples_per_pixel > 0 {
+            self.samples_per_pixel
+        } else {
+            u32::MAX
+        };
+        let mut first = 0u32;
+        while first < total && !control.should_stop() {
+            let end = first.saturating_add(batch).min(total);
+            film.par_bands(BAND_ROWS).for_each(|band| {
+                if control.should_stop() {
+                    return;
+                }
+                let mut rays = 0u64;
+                let mut invalid = 0u64;
+                for (i, (sum, count)) in
+                    band.sums.iter_mut().zip(band.counts.iter_mut()).enumerate()
+                {
+                    let x = i as u32 % width;
+                    let y = band.first_row + i as u32 / width;
+                    let pixel = y as u64 * width as u64 + x as u64;
+                    let mut pixel_sum = Vec3A::ZERO;
+                    for sample in first..end {
+                        let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
+                        let [jx, jy] = rng.uniform2();
+                        let lens = rng.uniform2();
+                        let (origin, direction) =
+                            self.camera.generate_ray(x as f32 + jx, y as f32 + jy, lens);
+                        let l = self.tracer.radiance(origin, direction, &mut rng, &mut rays);
+                        if l.is_finite() {
+                            pixel_sum += l;
+                        } else {
+                            invalid += 1;
+                        }
+                    }
+                    for c in 0..3 {
+                        sum[c] += pixel_sum[c] as f64;
+                    }
+                    *count += end - first;
+                }
+                let band_pixels = band.counts.len() as u64;
+                control
+                    .samples_done
+                    .fetch_add(band_pixels * (end - first) as u64, Ordering::Relaxed);
+                control.rays.fetch_add(rays, Ordering::Relaxed);
+                control.invalid.fetch_add(invalid, Ordering::Relaxed);
+            });
+            first = end;
+        }
+    }
+}

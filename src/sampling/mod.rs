@@ -1,0 +1,12 @@
+//! Random numbers, distributions and warps used by every integrator.
+
+mod distribution;
+mod rng;
+mod warp;
+
+pub use distribution::{Distribution1D, Distribution2D};
+pub use rng::Rng;
+pub use warp::{
+    OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic, uniform_disk,
+    uniform_triangle,
+};

@@ -1,0 +1,148 @@
+//! The camera: a pinhole (or thin lens) perspective projection.
+
+use crate::error::{Error, Result, check_finite, check_finite3};
+use glam::Vec3A;
+
+/// A perspective camera looking from `eye` towards `target`. Image right is
+/// `normalize(cross(target - eye, up))`, image up is perpendicular to it and the view direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: [f32; 3],
+    pub target: [f32; 3],
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+    /// Thin-lens aperture radius; 0 is a pinhole.
+    pub lens_radius: f32,
+    /// Distance of the plane in focus; 0 means the distance from eye to target.
+    pub focus_distance: f32,
+}
+
+impl Default for Camera {
+    /// The Cornell box's camera.
+    fn default() -> Self {
+        Camera {
+            eye: [278.0, 273.0, -800.0],
+            target: [278.0, 273.0, -799.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 39.307_648,
+            lens_radius: 0.0,
+            focus_distance: 0.0,
+        }
+    }
+}
+
+/// A validated camera with its frame, ready to generate rays for a given image size.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraModel {
+    pub eye: Vec3A,
+    pub forward: Vec3A,
+    pub right: Vec3A,
+    pub up: Vec3A,
+    /// Half extent of the image plane at distance 1: (tan(fov/2)·aspect, tan(fov/2)).
+    pub half_width: f32,
+    pub half_height: f32,
+    pub lens_radius: f32,
+    pub focus_distance: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Camera {
+    pub fn validate(&self) -> Result<()> {
+        check_finite3("camera.eye", self.eye)?;
+        check_finite3("camera.target", self.target)?;
+        check_finite3("camera.up", self.up)?;
+        check_finite(&"camera.fov_y_deg", self.fov_y_deg)?;
+        check_finite(&"camera.lens_radius", self.lens_radius)?;
+        check_finite(&"camera.focus_distance", self.focus_distance)?;
+        let eye = Vec3A::from(self.eye);
+        let view = Vec3A::from(self.target) - eye;
+        let scale = eye.abs().max_element().max(1.0);
+        if view.length() <= 1e-6 * scale {
+            return Err(Error::invalid(format!(
+                "camera.eye {:?} and camera.target {:?} coincide; the view direction is undefined",
+                self.eye, self.target
+            )));
+        }
+        let up = Vec3A::from(self.up);
+        if up.length() == 0.0 {
+            return Err(Error::invalid("camera.up is the zero vector"));
+        }
+        let sin_angle = view.normalize().cross(up.normalize()).length();
+        if sin_angle < 1e-4 {
+            return Err(Error::invalid(format!(
+                "camera.up {:?} is parallel to the view direction {:?}; the image orientation is undefined",
+                self.up,
+                view.normalize().to_array()
+            )));
+        }
+        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
+            return Err(Error::invalid(format!(
+                "camera.fov_y_deg is {}; the vertical field of view must be in (0, 180) degrees",
+                self.fov_y_deg
+            )));
+        }
+        if self.lens_radius < 0.0 {
+            return Err(Error::invalid(format!(
+                "camera.lens_radius is {}; it must be 0 (pinhole) or positive",
+                self.lens_radius
+            )));
+        }
+        if self.focus_distance < 0.0 {
+            return Err(Error::invalid(format!(
+                "camera.focus_distance is {}; it must be 0 (focus on the target) or positive",
+                self.focus_distance
+            )));
+        }
+        Ok(())
+    }
+
+    /// The frame for an image of `width` × `height` pixels. Call `validate` first.
+    pub fn model(&self, width: u32, height: u32) -> CameraModel {
+        let eye = Vec3A::from(self.eye);
+        let view = Vec3A::from(self.target) - eye;
+        let forward = view.normalize();
+        let right = forward.cross(Vec3A::from(self.up)).normalize();
+        let up = right.cross(forward);
+        let half_height = (self.fov_y_deg.to_radians() * 0.5).tan();
+        let half_width = half_height * width as f32 / height as f32;
+        CameraModel {
+            eye,
+            forward,
+            right,
+            up,
+            half_width,
+            half_height,
+            lens_radius: self.lens_radius,
+            focus_distance: if self.focus_distance > 0.0 {
+                self.focus_distance
+            } else {
+                view.length()
+            },
+            width,
+            height,
+        }
+    }
+}
+
+impl CameraModel {
+    /// The primary ray through film position (x, y) in pixels, (0, 0) the top-left corner.
+    /// `lens` is a point in the unit square used only by a thin lens. Returns (origin, unit direction).
+    #[inline]
+    pub fn generate_ray(&self, x: f32, y: f32, lens: [f32; 2]) -> (Vec3A, Vec3A) {
+        let sx = (2.0 * x / self.width as f32 - 1.0) * self.half_width;
+        let sy = (1.0 - 2.0 * y / self.height as f32) * self.half_height;
+        let dir = self.forward + self.right * sx + self.up * sy;
+        if self.lens_radius > 0.0 {
+            let [lx, ly] = crate::sampling::uniform_disk(lens);
+            let offset = (self.right * lx + self.up * ly) * self.lens_radius;
+            // The point in focus lies where the pinhole ray crosses the focal plane.
+            let focus = self.eye + dir * self.focus_distance;
+            let origin = self.eye + offset;
+            (origin, (focus - origin).normalize())
+        } else {
+            (self.eye, dir.normalize())
+        }
+    }
+}

@@ -1,0 +1,286 @@
+//! The validated, immutable scene: geometry in the backend's order, materials, area lights.
+
+mod camera;
+mod material;
+
+pub use camera::{Camera, CameraModel};
+pub use material::{Material, MaterialKind};
+
+use crate::accel::{Accel, BvhAccel, Hit, Ray};
+use crate::error::{Error, MLT_STATUS_UNSUPPORTED, Result};
+use crate::sampling::Distribution1D;
+use glam::Vec3A;
+
+/// Which ray-intersection backend a scene is built with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Backend {
+    /// obvhs compressed wide BVH (always available).
+    #[default]
+    Bvh,
+    /// Intel Embree 3 (only with the `embree` cargo feature).
+    Embree,
+}
+
+/// Host-side description of a scene: plain arrays, as the C ABI passes them.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneDesc<'a> {
+    /// x, y, z per vertex.
+    pub positions: &'a [f32],
+    /// Three vertex indices per triangle; counter-clockwise is the front side.
+    pub indices: &'a [u32],
+    /// One material index per triangle; empty means material 0 for every triangle.
+    pub material_ids: &'a [u32],
+    pub materials: &'a [Material],
+    pub backend: Backend,
+}
+
+/// Facts about a built scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneInfo {
+    pub triangle_count: usize,
+    /// Triangles with zero area (or a non-finite normal): kept in the id space, never hit,
+    /// never emit.
+    pub degenerate_triangle_count: usize,
+    /// Non-degenerate triangles with emission: the area lights.
+    pub emitter_count: usize,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+}
+
+/// Per-triangle data the integrators read after a hit, in the backend's internal order.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleShading {
+    /// Unit geometric normal of the front (counter-clockwise) side.
+    pub normal: Vec3A,
+    pub material: u32,
+    /// Probability density per unit area of picking a point on this triangle by light
+    /// sampling (selection probability / area); 0 for non-emitters.
+    pub light_area_pdf: f32,
+}
+
+/// What light sampling needs about one area light.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaLight {
+    pub v0: Vec3A,
+    pub edge1: Vec3A,
+    pub edge2: Vec3A,
+    pub normal: Vec3A,
+    pub emission: Vec3A,
+    /// Selection probability / area: the area density of light sampling on this light.
+    pub area_pdf: f32,
+}
+
+pub struct Scene {
+    pub(crate) accel: Accel,
+    pub(crate) shading: Vec<TriangleShading>,
+    pub(crate) materials: Vec<Material>,
+    pub(crate) lights: Vec<AreaLight>,
+    pub(crate) light_distribution: Distribution1D,
+    /// Internal triangle index → the host's triangle id.
+    internal_to_input: Vec<u32>,
+    /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
+    pub(crate) ray_epsilon: f32,
+    info: SceneInfo,
+}
+
+impl Scene {
+    /// Validates the description and builds the acceleration structure.
+    pub fn new(desc: &SceneDesc) -> Result<Scene> {
+        validate_arrays(desc)?;
+        if desc.backend == Backend::Embree {
+            return Err(Error::new(
+                MLT_STATUS_UNSUPPORTED,
+                "backend Embree was requested but this build of mlt was compiled without the `embree` feature",
+            ));
+        }
+        let vertex = |i: u32| {
+            let i = i as usize * 3;
+            Vec3A::new(
+                desc.positions[i],
+                desc.positions[i + 1],
+                desc.positions[i + 2],
+            )
+        };
+        let triangle_count = desc.indices.len() / 3;
+        let mut kept_vertices = Vec::with_capacity(triangle_count);
+        let mut kept_ids = Vec::with_capacity(triangle_count);
+        let mut bounds_min = Vec3A::splat(f32::INFINITY);
+        let mut bounds_max = Vec3A::splat(f32::NEG_INFINITY);
+        for (id, tri) in desc.indices.chunks_exact(3).enumerate() {
+            let v = [vertex(tri[0]), vertex(tri[1]), vertex(tri[2])];
+            let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+            let length = normal.length();
+            if !(length > 0.0 && length.is_finite()) {
+                continue;
+            }
+            for p in v {
+                bounds_min = bounds_min.min(p);
+                bounds_max = bounds_max.max(p);
+            }
+            kept_vertices.push(v);
+            kept_ids.push(id as u32);
+        }
+        if kept_vertices.is_empty() {
+            bounds_min = Vec3A::ZERO;
+            bounds_max = Vec3A::ZERO;
+        }
+
+        let accel = Accel::Bvh(BvhAccel::build(&kept_vertices));
+        let order = accel.internal_to_build_order();
+
+        let material_of = |id: u32| {
+            if desc.material_ids.is_empty() {
+                0
+            } else {
+                desc.material_ids[id as usize]
+            }
+        };
+        let mut shading = Vec::with_capacity(order.len());
+        let mut internal_to_input = Vec::with_capacity(order.len());
+        let mut lights = Vec::new();
+        let mut light_power = Vec::new();
+        let mut light_of_internal = Vec::new();
+        for (internal, &build) in order.iter().enumerate() {
+            let [v0, v1, v2] = kept_vertices[build as usize];
+            let id = kept_ids[build as usize];
+            let material = material_of(id);
+            let cross = (v1 - v0).cross(v2 - v0);
+            let normal = cross.normalize();
+            let emission = Vec3A::from(desc.materials[material as usize].emission);
+            if emission.max_element() > 0.0 {
+                let area = 0.5 * cross.length();
+                light_of_internal.push((internal, area));
+                light_power.push(luminance(emission) * area);
+                lights.push(AreaLight {
+                    v0,
+                    edge1: v1 - v0,
+                    edge2: v2 - v0,
+                    normal,
+                    emission,
+                    area_pdf: 0.0,
+                });
+            }
+            shading.push(TriangleShading {
+                normal,
+                material,
+                light_area_pdf: 0.0,
+            });
+            internal_to_input.push(id);
+        }
+        // Lights are picked in proportion to their emitted power.
+        let light_distribution = Distribution1D::new(&light_power);
+        for (light, &(internal, area)) in light_of_internal.iter().enumerate() {
+            let area_pdf = light_distribution.discrete_pdf(light) / area;
+            shading[internal].light_area_pdf = area_pdf;
+            lights[light].area_pdf = area_pdf;
+        }
+        let magnitude = bounds_min
+            .abs()
+            .max(bounds_max.abs())
+            .max_element()
+            .max(1e-3);
+        let info = SceneInfo {
+            triangle_count,
+            degenerate_triangle_count: triangle_count - order.len(),
+            emitter_count: lights.len(),
+            bounds_min: bounds_min.to_array(),
+            bounds_max: bounds_max.to_array(),
+        };
+        Ok(Scene {
+            accel,
+            shading,
+            materials: desc.materials.to_vec(),
+            lights,
+            light_distribution,
+            internal_to_input,
+            ray_epsilon: magnitude * 2e-5,
+            info,
+        })
+    }
+
+    pub fn info(&self) -> SceneInfo {
+        self.info
+    }
+
+    /// Closest hit in the host's triangle ids; `None` on a miss.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.accel.intersect(ray).map(|hit| Hit {
+            triangle: self.internal_to_input[hit.triangle as usize],
+            ..hit
+        })
+    }
+
+    /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax].
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.accel.occluded(ray)
+    }
+}
+
+/// Rec. 709 luminance of linear RGB: the scalar used for light selection and (later) for
+/// Metropolis acceptance.
+#[inline]
+pub fn luminance(rgb: Vec3A) -> f32 {
+    rgb.dot(Vec3A::new(0.2126, 0.7152, 0.0722))
+}
+
+fn validate_arrays(desc: &SceneDesc) -> Result<()> {
+    if !desc.positions.len().is_multiple_of(3) {
+        return Err(Error::invalid(format!(
+            "positions has {} floats; it must hold 3 per vertex (a multiple of 3)",
+            desc.positions.len()
+        )));
+    }
+    if !desc.indices.len().is_multiple_of(3) {
+        return Err(Error::invalid(format!(
+            "indices has {} entries; it must hold 3 per triangle (a multiple of 3)",
+            desc.indices.len()
+        )));
+    }
+    let vertex_count = desc.positions.len() / 3;
+    let triangle_count = desc.indices.len() / 3;
+    if vertex_count > u32::MAX as usize || triangle_count > (u32::MAX - 1) as usize {
+        return Err(Error::invalid(format!(
+            "the scene has {vertex_count} vertices and {triangle_count} triangles; at most 2^32 - 2 of each are supported"
+        )));
+    }
+    if !desc.material_ids.is_empty() && desc.material_ids.len() != triangle_count {
+        return Err(Error::invalid(format!(
+            "material_ids has {} entries but there are {triangle_count} triangles; give one per triangle (or none for material 0 everywhere)",
+            desc.material_ids.len()
+        )));
+    }
+    if desc.materials.is_empty() && triangle_count > 0 {
+        return Err(Error::invalid(
+            "materials is empty; a scene with triangles needs at least one material",
+        ));
+    }
+    for (i, &p) in desc.positions.iter().enumerate() {
+        if !p.is_finite() {
+            return Err(Error::invalid(format!(
+                "positions[{i}] (vertex {}, {}) is {p}; vertex coordinates must be finite",
+                i / 3,
+                ["x", "y", "z"][i % 3]
+            )));
+        }
+    }
+    for (i, &v) in desc.indices.iter().enumerate() {
+        if v as usize >= vertex_count {
+            return Err(Error::invalid(format!(
+                "indices[{i}] (triangle {}) is {v}, but there are only {vertex_count} vertices",
+                i / 3
+            )));
+        }
+    }
+    for (i, &m) in desc.material_ids.iter().enumerate() {
+        if m as usize >= desc.materials.len() {
+            return Err(Error::invalid(format!(
+                "material_ids[{i}] is {m}, but there are only {} materials",
+                desc.materials.len()
+            )));
+        }
+    }
+    for (i, material) in desc.materials.iter().enumerate() {
+        material.validate(i)?;
+    }
+    Ok(())
+}
