@@ -1,0 +1,150 @@
+//! Shared helpers of the integration tests: test scenes built in code and image statistics.
+#![allow(dead_code)]
+
+use mlt::{Backend, Camera, Material, Scene, SceneDesc};
+
+/// An icosphere of `radius` around the origin, subdivided `levels` times, with every
+/// triangle's front (counter-clockwise) side facing the centre.
+pub fn inward_icosphere(levels: u32, radius: f32) -> (Vec<f32>, Vec<u32>) {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let mut vertices: Vec<[f32; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut midpoint = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        let mut mid = |a: u32, b: u32, vertices: &mut Vec<[f32; 3]>| -> u32 {
+            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (vertices[a as usize], vertices[b as usize]);
+                vertices.push([
+                    (p[0] + q[0]) / 2.0,
+                    (p[1] + q[1]) / 2.0,
+                    (p[2] + q[2]) / 2.0,
+                ]);
+                vertices.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in faces {
+            let ab = mid(a, b, &mut vertices);
+            let bc = mid(b, c, &mut vertices);
+            let ca = mid(c, a, &mut vertices);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    let positions = vertices
+        .iter()
+        .flat_map(|v| {
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|c| c / l * radius)
+        })
+        .collect();
+    // The icosahedron above winds outward; reverse each face to face inward.
+    let indices = faces.iter().flat_map(|&[a, b, c]| [a, c, b]).collect();
+    (positions, indices)
+}
+
+/// The white furnace: a closed sphere whose inside is diffuse with `albedo` and emits `emission`.
+pub fn furnace_scene(albedo: [f32; 3], emission: [f32; 3]) -> Scene {
+    let (positions, indices) = inward_icosphere(2, 1.0);
+    let materials = [Material::diffuse(albedo).with_emission(emission)];
+    Scene::new(&SceneDesc {
+        positions: &positions,
+        indices: &indices,
+        material_ids: &[],
+        materials: &materials,
+        backend: Backend::Bvh,
+    })
+    .unwrap()
+}
+
+/// A camera at the furnace's centre.
+pub fn furnace_camera() -> Camera {
+    Camera {
+        eye: [0.0, 0.0, 0.0],
+        target: [0.3, 0.2, 1.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 90.0,
+        ..Camera::default()
+    }
+}
+
+/// Per-channel mean of the pixels of an RGB image and the standard error of that mean,
+/// treating pixels as independent samples (they are: each has its own random streams).
+pub fn mean_and_standard_error(rgb: &[f32]) -> ([f64; 3], [f64; 3]) {
+    let n = (rgb.len() / 3) as f64;
+    let mut mean = [0.0; 3];
+    let mut error = [0.0; 3];
+    for c in 0..3 {
+        let values = rgb.iter().skip(c).step_by(3).map(|&v| v as f64);
+        let m = values.clone().sum::<f64>() / n;
+        let var = values.map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
+        mean[c] = m;
+        error[c] = (var / n).sqrt();
+    }
+    (mean, error)
+}
+
+/// Root-mean-square difference between two images of equal size.
+pub fn rmse(a: &[f32], b: &[f32]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+        .sum();
+    (sum / a.len() as f64).sqrt()
+}
+
+/// Mean RGB of each cell of a `grid` × `grid` partition of the image, row-major.
+pub fn region_means(rgb: &[f32], width: usize, height: usize, grid: usize) -> Vec<[f64; 3]> {
+    let mut sums = vec![[0.0f64; 3]; grid * grid];
+    let mut counts = vec![0usize; grid * grid];
+    for y in 0..height {
+        for x in 0..width {
+            let cell = (y * grid / height) * grid + x * grid / width;
+            let p = &rgb[(y * width + x) * 3..][..3];
+            for c in 0..3 {
+                sums[cell][c] += p[c] as f64;
+            }
+            counts[cell] += 1;
+        }
+    }
+    sums.iter()
+        .zip(&counts)
+        .map(|(s, &n)| s.map(|v| v / n as f64))
+        .collect()
+}

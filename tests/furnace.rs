@@ -1,0 +1,112 @@
+//! White furnace: inside a closed diffuse sphere of albedo a that emits Le everywhere, the
+//! radiance along every ray is exactly Le·Σ_{k=0..d} aᵏ at max depth d. The tolerances come
+//! from the estimator's own variance (4 standard errors of the image mean), and each test
+//! also checks that a 2% brightness error would be outside them.
+
+mod common;
+
+use common::*;
+use mlt::{RenderSettings, render};
+
+const ALBEDO: [f32; 3] = [0.5, 0.7, 0.9];
+const EMISSION: [f32; 3] = [1.0, 0.5, 2.0];
+
+fn expected(depth: u32) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        let a = ALBEDO[c] as f64;
+        EMISSION[c] as f64 * (0..=depth).map(|k| a.powi(k as i32)).sum::<f64>()
+    })
+}
+
+fn render_furnace(depth: u32, spp: u32, seed: u64, size: u32) -> Vec<f32> {
+    let scene = furnace_scene(ALBEDO, EMISSION);
+    let settings = RenderSettings {
+        width: size,
+        height: size,
+        samples_per_pixel: spp,
+        max_depth: depth,
+        seed,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; (size * size * 3) as usize];
+    let stats = render(&scene, &furnace_camera(), &settings, &mut image, None).unwrap();
+    assert_eq!(stats.samples, (size * size * spp) as u64);
+    assert_eq!(stats.invalid_samples, 0);
+    image
+}
+
+#[test]
+fn depth_zero_sees_only_the_emission_exactly() {
+    let image = render_furnace(0, 2, 1, 16);
+    for pixel in image.chunks_exact(3) {
+        assert_eq!(pixel, EMISSION);
+    }
+}
+
+#[test]
+fn furnace_matches_the_geometric_series() {
+    for depth in [1, 2, 5, 12] {
+        let image = render_furnace(depth, 16, 7 + depth as u64, 64);
+        let (mean, error) = mean_and_standard_error(&image);
+        let truth = expected(depth);
+        for c in 0..3 {
+            let tolerance = 4.0 * error[c];
+            assert!(
+                (mean[c] - truth[c]).abs() <= tolerance,
+                "depth {depth} channel {c}: mean {} vs {} (tolerance {tolerance})",
+                mean[c],
+                truth[c]
+            );
+            // The test must be able to see a 2% bias in either direction.
+            for biased in [truth[c] * 1.02, truth[c] * 0.98] {
+                assert!(
+                    (mean[c] - biased).abs() > tolerance,
+                    "depth {depth} channel {c}: a 2% bias ({biased}) would pass (tolerance {tolerance})"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn error_falls_like_one_over_square_root_of_samples() {
+    let truth = expected(5);
+    let reference: Vec<f32> = (0..32 * 32).flat_map(|_| truth.map(|v| v as f32)).collect();
+    let coarse = rmse(&render_furnace(5, 4, 100, 32), &reference);
+    let fine = rmse(&render_furnace(5, 64, 200, 32), &reference);
+    // 16× the samples: the error must shrink by √16 = 4. The spread of an RMSE over 3072
+    // values is a few percent, so [3.4, 4.6] is generous for a correct estimator and
+    // still rejects a biased one (whose error stops shrinking) or a wrong rate.
+    let ratio = coarse / fine;
+    assert!(
+        (3.4..=4.6).contains(&ratio),
+        "ratio {ratio} ({coarse} / {fine})"
+    );
+}
+
+#[test]
+fn image_is_identical_for_any_thread_count() {
+    let scene = furnace_scene(ALBEDO, EMISSION);
+    let images: Vec<Vec<f32>> = [1, 2, 3]
+        .iter()
+        .map(|&threads| {
+            let settings = RenderSettings {
+                width: 48,
+                height: 40,
+                samples_per_pixel: 3,
+                threads,
+                seed: 42,
+                ..Default::default()
+            };
+            let mut image = vec![0.0; 48 * 40 * 3];
+            render(&scene, &furnace_camera(), &settings, &mut image, None).unwrap();
+            image
+        })
+        .collect();
+    let bits = |image: &[f32]| image.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&images[0]), bits(&images[1]));
+    assert_eq!(bits(&images[0]), bits(&images[2]));
+    // And the seed matters.
+    let other = render_furnace(5, 3, 43, 16);
+    assert_ne!(bits(&other), bits(&render_furnace(5, 3, 42, 16)));
+}
