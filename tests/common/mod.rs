@@ -148,3 +148,114 @@ pub fn region_means(rgb: &[f32], width: usize, height: usize, grid: usize) -> Ve
         .map(|(s, &n)| s.map(|v| v / n as f64))
         .collect()
 }
+
+/// An image estimated from several independent renders (different seeds), with the variance
+/// of each float of the averaged image. Independent renders make the variance estimate valid
+/// for any estimator, including ones whose pixels are correlated (Metropolis chains).
+pub struct Estimate {
+    pub width: usize,
+    pub height: usize,
+    pub image: Vec<f32>,
+    /// Variance of each float of `image` (the variance of a mean over the renders).
+    pub variance: Vec<f64>,
+}
+
+impl Estimate {
+    /// Averages `renders` (each a width × height RGB image from its own seed).
+    pub fn from_renders(width: usize, height: usize, renders: &[Vec<f32>]) -> Self {
+        let k = renders.len();
+        assert!(k >= 2, "need at least two independent renders for a variance");
+        let n = width * height * 3;
+        let mut image = vec![0.0f32; n];
+        let mut variance = vec![0.0f64; n];
+        for i in 0..n {
+            let mean = renders.iter().map(|r| r[i] as f64).sum::<f64>() / k as f64;
+            let var = renders
+                .iter()
+                .map(|r| (r[i] as f64 - mean).powi(2))
+                .sum::<f64>()
+                / (k - 1) as f64;
+            image[i] = mean as f32;
+            variance[i] = var / k as f64;
+        }
+        Estimate {
+            width,
+            height,
+            image,
+            variance,
+        }
+    }
+
+    /// Mean RGB over the pixels of a rectangle and the variance of that mean.
+    pub fn region(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> ([f64; 3], [f64; 3]) {
+        let mut mean = [0.0; 3];
+        let mut variance = [0.0; 3];
+        let count = ((x1 - x0) * (y1 - y0)) as f64;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                for c in 0..3 {
+                    let i = (y * self.width + x) * 3 + c;
+                    mean[c] += self.image[i] as f64;
+                    variance[c] += self.variance[i];
+                }
+            }
+        }
+        (mean.map(|m| m / count), variance.map(|v| v / (count * count)))
+    }
+
+    /// Whole-image mean and its variance.
+    pub fn mean(&self) -> ([f64; 3], [f64; 3]) {
+        self.region(0, 0, self.width, self.height)
+    }
+}
+
+/// Asserts that two independent estimates of the same image agree: the image mean and the
+/// mean of every cell of a `grid` × `grid` partition within `sigmas` combined standard
+/// errors. Also asserts the comparison is sharp enough that a 2% brightness error of the
+/// whole image would fail it. `label` names the comparison in failure messages.
+pub fn assert_estimates_agree(
+    label: &str,
+    test: &Estimate,
+    reference: &Estimate,
+    grid: usize,
+    sigmas: f64,
+) {
+    assert_eq!((test.width, test.height), (reference.width, reference.height));
+    let (tm, tv) = test.mean();
+    let (rm, rv) = reference.mean();
+    for c in 0..3 {
+        let tolerance = sigmas * (tv[c] + rv[c]).sqrt();
+        assert!(
+            (tm[c] - rm[c]).abs() <= tolerance,
+            "{label}: image mean channel {c} is {} but the reference is {} (tolerance {tolerance})",
+            tm[c],
+            rm[c]
+        );
+        for factor in [1.02, 0.98] {
+            assert!(
+                (tm[c] * factor - rm[c]).abs() > tolerance,
+                "{label}: channel {c}: a {:+.0}% bias would pass (tolerance {tolerance} of {})",
+                (factor - 1.0) * 100.0,
+                rm[c]
+            );
+        }
+    }
+    let (w, h) = (test.width, test.height);
+    for gy in 0..grid {
+        for gx in 0..grid {
+            let (x0, x1) = (gx * w / grid, (gx + 1) * w / grid);
+            let (y0, y1) = (gy * h / grid, (gy + 1) * h / grid);
+            let (tm, tv) = test.region(x0, y0, x1, y1);
+            let (rm, rv) = reference.region(x0, y0, x1, y1);
+            for c in 0..3 {
+                let tolerance = sigmas * (tv[c] + rv[c]).sqrt();
+                assert!(
+                    (tm[c] - rm[c]).abs() <= tolerance,
+                    "{label}: region ({gx}, {gy}) channel {c} is {} but the reference is {} (tolerance {tolerance})",
+                    tm[c],
+                    rm[c]
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,68 @@
+//! The Cornell box against a long render of the same code with other seeds: image mean and
+//! per-region means within 4.5 combined standard errors (the errors estimated from
+//! independent renders), and the error falling like 1/√spp. cornell-glass exercises the
+//! dielectric, including caustics reached only through specular chains.
+
+mod common;
+
+use common::*;
+use mlt::{Camera, RenderSettings, Scene, render};
+use std::path::Path;
+
+const SIZE: u32 = 64;
+
+fn load(name: &str) -> (Scene, Camera) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/scenes")
+        .join(format!("{name}.obj"));
+    let data = mlt::io::load_scene(&path).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    (scene, data.camera.unwrap().camera)
+}
+
+fn render_image(scene: &Scene, camera: &Camera, spp: u32, seed: u64) -> Vec<f32> {
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        samples_per_pixel: spp,
+        max_depth: 5,
+        seed,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; (SIZE * SIZE * 3) as usize];
+    render(scene, camera, &settings, &mut image, None).unwrap();
+    image
+}
+
+fn estimate(scene: &Scene, camera: &Camera, spp: u32, seeds: std::ops::Range<u64>) -> Estimate {
+    let renders: Vec<Vec<f32>> = seeds.map(|s| render_image(scene, camera, spp, s)).collect();
+    Estimate::from_renders(SIZE as usize, SIZE as usize, &renders)
+}
+
+#[test]
+fn cornell_box_agrees_with_a_long_render() {
+    let (scene, camera) = load("cornell-box");
+    let reference = estimate(&scene, &camera, 256, 1000..1004);
+    let test = estimate(&scene, &camera, 32, 0..4);
+    assert_estimates_agree("cornell-box", &test, &reference, 4, 4.5);
+}
+
+#[test]
+fn cornell_glass_agrees_with_a_long_render() {
+    let (scene, camera) = load("cornell-glass");
+    let reference = estimate(&scene, &camera, 256, 1000..1004);
+    let test = estimate(&scene, &camera, 32, 0..4);
+    assert_estimates_agree("cornell-glass", &test, &reference, 4, 4.5);
+}
+
+#[test]
+fn cornell_error_falls_like_one_over_square_root_of_samples() {
+    let (scene, camera) = load("cornell-box");
+    let reference = estimate(&scene, &camera, 256, 2000..2004).image;
+    let coarse = rmse(&render_image(&scene, &camera, 4, 1), &reference);
+    let fine = rmse(&render_image(&scene, &camera, 64, 2), &reference);
+    // The reference's own noise (1024 spp) adds to both: expected ratio
+    // sqrt((1/4 + 1/1024) / (1/64 + 1/1024)) = 3.89.
+    let ratio = coarse / fine;
+    assert!((3.3..=4.5).contains(&ratio), "ratio {ratio} ({coarse} / {fine})");
+}
