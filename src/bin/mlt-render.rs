@@ -1,1 +1,266 @@
-fn main() {}
+//! `mlt-render`: render an OBJ or glTF scene to PFM, OpenEXR or PNG.
+//!
+//! Errors print one line, `mlt-render: <message>`, to stderr and exit with status 1.
+
+use clap::{Parser, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mlt::io::{CameraFile, ImageFormat, SceneData};
+use mlt::{RenderSettings, RenderStats, Scene, StopReason};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum AlgorithmArg {
+    /// Path tracing with next-event estimation and MIS.
+    Path,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum BackendArg {
+    /// The built-in BVH.
+    Bvh,
+    /// Intel Embree (only in builds with the `embree` feature).
+    Embree,
+}
+
+/// Render a scene with mlt.
+///
+/// SCENE is a Wavefront OBJ (with its MTL; the camera from NAME.camera.json beside it) or a
+/// glTF 2.0 file (.gltf/.glb; the camera from its first perspective camera). The image is
+/// linear RGB; .png output is clamped to [0, 1] and sRGB-encoded.
+#[derive(Debug, Parser)]
+#[command(name = "mlt-render", version)]
+struct Args {
+    /// Scene file: .obj, .gltf or .glb.
+    scene: PathBuf,
+    /// Camera JSON (eye, target, up, fov_y_deg, width, height); overrides the scene's camera.
+    #[arg(long, value_name = "FILE.json")]
+    camera: Option<PathBuf>,
+    /// Light-transport algorithm.
+    #[arg(long, value_enum, default_value = "path")]
+    algorithm: AlgorithmArg,
+    /// Samples per pixel (0: until the time limit).
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().samples_per_pixel)]
+    spp: u32,
+    /// Stop after this many seconds (0: no limit).
+    #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
+    time_limit: f64,
+    /// Maximum number of scattering vertices on a path.
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().max_depth)]
+    max_depth: u32,
+    /// Random seed.
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().seed)]
+    seed: u64,
+    /// Worker threads (0: all cores).
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().threads)]
+    threads: u32,
+    /// Image width in pixels; overrides the camera file's.
+    #[arg(long, value_name = "W")]
+    width: Option<u32>,
+    /// Image height in pixels; overrides the camera file's.
+    #[arg(long, value_name = "H")]
+    height: Option<u32>,
+    /// Ray-intersection backend.
+    #[arg(long, value_enum, default_value = "bvh")]
+    backend: BackendArg,
+    /// Output image: .pfm, .exr or .png.
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+}
+
+fn main() -> ExitCode {
+    let args = match Args::try_parse() {
+        Ok(args) => args,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // clap's message is several paragraphs (problem, usage, hint): keep the first,
+            // on one line, without "error: ".
+            let text = e.render().to_string();
+            let first: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|line| !line.is_empty())
+                .collect();
+            let first = first.join(" ");
+            let first = first.strip_prefix("error: ").unwrap_or(&first);
+            eprintln!("mlt-render: {first} (see mlt-render --help)");
+            return ExitCode::FAILURE;
+        }
+    };
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            // One line, whatever the message contains.
+            let line = message.replace('\n', " ");
+            eprintln!("mlt-render: {line}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<(), String> {
+    // Reject an unusable output path before spending time on loading and rendering.
+    ImageFormat::from_path(&args.out).map_err(|e| e.to_string())?;
+    check_output_directory(&args.out)?;
+
+    let load_start = Instant::now();
+    let data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let camera_file = match &args.camera {
+        Some(path) => mlt::io::load_camera_json(path).map_err(|e| e.to_string())?,
+        None => data.camera.ok_or_else(|| {
+            format!(
+                "{} has no camera (for an OBJ, put one in {}); pass --camera FILE.json",
+                args.scene.display(),
+                args.scene.with_extension("camera.json").display()
+            )
+        })?,
+    };
+    let backend = match args.backend {
+        BackendArg::Bvh => mlt::Backend::Bvh,
+        BackendArg::Embree => mlt::Backend::Embree,
+    };
+    let scene = Scene::new(&data.desc(backend)).map_err(|e| {
+        format!(
+            "cannot build the scene from {}: {}: {}",
+            args.scene.display(),
+            e.status.description(),
+            describe_scene_error(&e, &data)
+        )
+    })?;
+    let load_seconds = load_start.elapsed().as_secs_f64();
+
+    let settings = settings(args, &camera_file);
+    let mut rgb = vec![0.0f32; settings.output_len().map_err(|e| e.message)?];
+    let bar = progress_bar();
+    let mut on_progress = |fraction: f32| {
+        bar.set_position((fraction.clamp(0.0, 1.0) * 1000.0) as u64);
+        true
+    };
+    let result = mlt::render(
+        &scene,
+        &camera_file.camera,
+        &settings,
+        &mut rgb,
+        Some(&mut on_progress),
+    );
+    bar.finish_and_clear();
+    let stats = result.map_err(|e| format!("cannot render {}: {e}", args.scene.display()))?;
+
+    mlt::io::write_image(&args.out, settings.width, settings.height, &rgb)
+        .map_err(|e| e.to_string())?;
+    print_summary(args, &scene, &settings, &stats, load_seconds);
+    Ok(())
+}
+
+fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
+    RenderSettings {
+        width: args.width.unwrap_or(camera.width),
+        height: args.height.unwrap_or(camera.height),
+        algorithm: match args.algorithm {
+            AlgorithmArg::Path => mlt::Algorithm::Path,
+        },
+        samples_per_pixel: args.spp,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        threads: args.threads,
+        time_limit_seconds: args.time_limit,
+    }
+}
+
+/// The kernel names a material by index; add its name from the file.
+fn describe_scene_error(error: &mlt::Error, data: &SceneData) -> String {
+    let message = &error.message;
+    let named = message
+        .strip_prefix("materials[")
+        .and_then(|rest| rest.split(']').next())
+        .and_then(|index| index.parse::<usize>().ok())
+        .and_then(|index| data.material_names.get(index));
+    match named {
+        Some(name) => format!("{message} (material '{name}')"),
+        None => message.clone(),
+    }
+}
+
+fn check_output_directory(out: &Path) -> Result<(), String> {
+    let directory = match out.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => return Ok(()),
+    };
+    if directory.is_dir() {
+        Ok(())
+    } else {
+        Err(format!(
+            "cannot write image {}: directory {} does not exist",
+            out.display(),
+            directory.display()
+        ))
+    }
+}
+
+fn progress_bar() -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent:>3}% eta {eta}")
+            .expect("the progress template is valid")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+fn print_summary(
+    args: &Args,
+    scene: &Scene,
+    settings: &RenderSettings,
+    stats: &RenderStats,
+    load_seconds: f64,
+) {
+    let info = scene.info();
+    let pixels = settings.width as f64 * settings.height as f64;
+    let seconds = stats.seconds.max(1e-9);
+    let stop = match stats.stop {
+        StopReason::Completed => "completed".to_owned(),
+        StopReason::Cancelled => "stopped early: cancelled".to_owned(),
+        StopReason::TimeLimitReached => format!(
+            "stopped early: time limit of {} s reached",
+            settings.time_limit_seconds
+        ),
+    };
+    println!(
+        "mlt-render: {} -> {} ({} x {}, {:?}, max depth {})",
+        args.scene.display(),
+        args.out.display(),
+        settings.width,
+        settings.height,
+        settings.algorithm,
+        settings.max_depth
+    );
+    println!(
+        "  scene      {} triangles, {} emitters, loaded in {:.3} s",
+        info.triangle_count, info.emitter_count, load_seconds
+    );
+    println!("  wall time  {:.3} s", stats.seconds);
+    println!(
+        "  samples    {} ({:.2} per pixel)",
+        stats.samples,
+        stats.samples as f64 / pixels
+    );
+    println!("  samples/s  {:.3} M", stats.samples as f64 / seconds / 1e6);
+    println!(
+        "  rays       {} ({:.3} Mrays/s)",
+        stats.rays,
+        stats.rays as f64 / seconds / 1e6
+    );
+    println!("  threads    {}", stats.threads);
+    if stats.invalid_samples > 0 {
+        println!(
+            "  invalid    {} samples with non-finite radiance dropped",
+            stats.invalid_samples
+        );
+    }
+    println!("  status     {stop}");
+}

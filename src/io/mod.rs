@@ -1,1 +1,165 @@
-pub fn placeholder() {}
+//! Scene files in, images out: what the `mlt-render` front end (and tests) need around the
+//! kernel. Compiled only with the `cli` feature (on by default); the kernel itself never
+//! touches files.
+//!
+//! - [`load_scene`] reads Wavefront OBJ (+ MTL, + `NAME.camera.json` beside it) or glTF 2.0
+//!   (`.gltf` / `.glb`) into flat arrays ([`SceneData`]) ready for [`crate::Scene::new`].
+//! - [`load_camera_json`] reads a camera sidecar file.
+//! - [`write_image`] writes the renderer's linear RGB buffer as PFM, OpenEXR or PNG.
+//!
+//! Every failure is an [`IoError`] whose message is one sentence naming the file and what is
+//! wrong with it.
+//!
+//! ## OBJ / MTL mapping
+//! Faces are triangulated; all objects and groups go into one set of arrays, each triangle
+//! keeping its face's material:
+//! - `illum 7`, or a non-zero `Tf` together with `Ni`: a smooth dielectric with index of
+//!   refraction `Ni` (1.5 if absent), tinted by `Tf` (white if absent);
+//! - `illum 3` or `illum 5`: a perfect mirror reflecting `Ks` (white if absent);
+//! - anything else: Lambertian with albedo `Kd` (0.8 grey if absent);
+//! - `Ke` on any material makes its triangles area lights.
+//!
+//! Colors are passed through unchanged: the kernel validates them and names the material
+//! index in its error. Faces without a material (no `usemtl`) get an extra white diffuse
+//! material (albedo 0.8) appended after the file's materials. A `usemtl` naming a
+//! material no library defines, or a material library that cannot be read, is an error.
+//! Normals and texture coordinates are ignored.
+//!
+//! ## glTF mapping
+//! See [`load_scene`]: meshes of the default scene (or the first scene) with node transforms
+//! applied, the first perspective camera, and materials reduced to the kernel's three kinds.
+//! Textures are ignored.
+
+mod camera_file;
+mod gltf_file;
+mod image_file;
+mod obj;
+
+use crate::{Backend, Camera, Material, SceneDesc};
+use std::fmt;
+use std::path::Path;
+
+pub use camera_file::load_camera_json;
+pub use image_file::{ImageFormat, read_pfm, write_exr, write_image, write_pfm, write_png};
+
+/// Albedo of the diffuse material given to OBJ faces without a material, and of
+/// materials without `Kd`.
+pub(crate) const DEFAULT_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
+
+/// Size of the image when a glTF camera gives no aspect ratio (square), and its height
+/// otherwise.
+pub(crate) const GLTF_DEFAULT_HEIGHT: u32 = 512;
+
+/// An error reading or writing a file: a sentence naming the file and what is wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct IoError {
+    pub message: String,
+}
+
+impl IoError {
+    pub fn new(message: impl Into<String>) -> Self {
+        IoError {
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for IoError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for IoError {}
+
+/// A camera and the image size it was set up for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraFile {
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A loaded scene: the flat arrays [`crate::SceneDesc`] borrows, plus the camera the file
+/// came with, if any.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneData {
+    /// x, y, z per vertex.
+    pub positions: Vec<f32>,
+    /// Three vertex indices per triangle, counter-clockwise front.
+    pub indices: Vec<u32>,
+    /// One index into `materials` per triangle.
+    pub material_ids: Vec<u32>,
+    pub materials: Vec<Material>,
+    /// The name of each material in `materials` (same length), for error messages.
+    pub material_names: Vec<String>,
+    /// The OBJ's `NAME.camera.json` sidecar or the glTF's first camera.
+    pub camera: Option<CameraFile>,
+}
+
+impl SceneData {
+    /// Borrows the arrays as a scene description for [`crate::Scene::new`].
+    pub fn desc(&self, backend: Backend) -> SceneDesc<'_> {
+        SceneDesc {
+            positions: &self.positions,
+            indices: &self.indices,
+            material_ids: &self.material_ids,
+            materials: &self.materials,
+            backend,
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Adds `material` (named `name`) and returns its index.
+    fn push_material(&mut self, name: String, material: Material) -> u32 {
+        self.materials.push(material);
+        self.material_names.push(name);
+        (self.materials.len() - 1) as u32
+    }
+}
+
+/// Loads a scene by its file extension (case-insensitive):
+///
+/// - `.obj`: Wavefront OBJ with its MTL libraries (see the [module docs](self)); if
+///   `NAME.camera.json` exists beside `NAME.obj` it is loaded into [`SceneData::camera`].
+/// - `.gltf` / `.glb`: glTF 2.0. All `TRIANGLES` primitives reachable from the default
+///   scene's nodes (the first scene if none is marked default), with world transforms applied
+///   (winding flipped under mirroring transforms so front faces stay front). The camera is the
+///   first perspective camera met walking the nodes depth-first: eye at the node's world
+///   position, looking down its -Z with +Y up, `yfov` converted to degrees; the image is
+///   512 pixels high and `round(height × aspectRatio)` wide, or square
+///   when no aspect ratio is given. Materials: emission = `emissiveFactor` ×
+///   `KHR_materials_emissive_strength`; `KHR_materials_transmission` factor > 0 → dielectric
+///   with `KHR_materials_ior` (1.5 if absent); metallic 1 and roughness 0 → mirror with the
+///   base color; else diffuse with the base color. Primitives without a material get the glTF
+///   default material (white diffuse). Textures, normals and other attributes are ignored.
+///
+/// A file without any triangle is an error.
+pub fn load_scene(path: &Path) -> Result<SceneData, IoError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    let data = match extension.as_deref() {
+        Some("obj") => obj::load_obj(path)?,
+        Some("gltf") | Some("glb") => gltf_file::load_gltf(path)?,
+        _ => {
+            return Err(IoError::new(format!(
+                "cannot load scene {}: unsupported file extension (expected .obj, .gltf or .glb)",
+                path.display()
+            )));
+        }
+    };
+    if data.indices.is_empty() {
+        return Err(IoError::new(format!(
+            "scene file {} contains no triangles",
+            path.display()
+        )));
+    }
+    debug_assert_eq!(data.material_ids.len(), data.triangle_count());
+    debug_assert_eq!(data.materials.len(), data.material_names.len());
+    Ok(data)
+}

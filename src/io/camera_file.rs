@@ -1,0 +1,65 @@
+//! Camera sidecar JSON: `eye`, `target`, `up` (3 numbers each), `fov_y_deg` (vertical field of
+//! view, degrees), `width`, `height` (pixels), optional `lens_radius` and `focus_distance`
+//! (0 by default: a pinhole focused on the target). Unknown keys are rejected, so a typo
+//! does not silently fall back to a default.
+
+use super::{CameraFile, IoError};
+use crate::Camera;
+use crate::render::MLT_MAX_IMAGE_SIDE;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraJson {
+    eye: [f32; 3],
+    target: [f32; 3],
+    up: [f32; 3],
+    fov_y_deg: f32,
+    width: u32,
+    height: u32,
+    #[serde(default)]
+    lens_radius: f32,
+    #[serde(default)]
+    focus_distance: f32,
+}
+
+/// Reads and validates a camera sidecar file.
+pub fn load_camera_json(path: &Path) -> Result<CameraFile, IoError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| IoError::new(format!("cannot read camera file {}: {e}", path.display())))?;
+    let json: CameraJson = serde_json::from_str(&text).map_err(|e| {
+        IoError::new(format!(
+            "camera file {} is not a valid camera description: {e}",
+            path.display()
+        ))
+    })?;
+    let camera = Camera {
+        eye: json.eye,
+        target: json.target,
+        up: json.up,
+        fov_y_deg: json.fov_y_deg,
+        lens_radius: json.lens_radius,
+        focus_distance: json.focus_distance,
+    };
+    camera.validate().map_err(|e| {
+        IoError::new(format!(
+            "camera file {} is invalid: {}",
+            path.display(),
+            e.message
+        ))
+    })?;
+    for (name, side) in [("width", json.width), ("height", json.height)] {
+        if side == 0 || side > MLT_MAX_IMAGE_SIDE {
+            return Err(IoError::new(format!(
+                "camera file {} is invalid: {name} is {side}; it must be between 1 and {MLT_MAX_IMAGE_SIDE} pixels",
+                path.display()
+            )));
+        }
+    }
+    Ok(CameraFile {
+        camera,
+        width: json.width,
+        height: json.height,
+    })
+}

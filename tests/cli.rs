@@ -1,0 +1,199 @@
+//! The `mlt-render` command line: a small render end to end, and one-line errors.
+#![cfg(feature = "cli")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+fn scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/scenes")
+        .join(name)
+}
+
+fn temp_path(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("mlt-cli-test-{}-{n}-{name}", std::process::id()))
+}
+
+fn mlt_render(args: &[&dyn AsRef<std::ffi::OsStr>]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mlt-render"))
+        .args(args.iter().map(|a| a.as_ref()))
+        .output()
+        .expect("mlt-render runs")
+}
+
+/// Exit status 1 and exactly one stderr line `mlt-render: ...` without a panic; returns it.
+fn assert_one_line_error(output: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(output.status.code(), Some(1), "stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!stderr.contains("RUST_BACKTRACE"), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(lines[0].starts_with("mlt-render: "), "{stderr}");
+    lines[0].to_owned()
+}
+
+#[test]
+fn renders_the_cornell_box_to_pfm_and_prints_a_summary() {
+    let out = temp_path("cornell.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--spp",
+        &"2",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--threads",
+        &"2",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        output.status.success(),
+        "stdout: {stdout}\nstderr: {stderr}"
+    );
+    for needle in [
+        "wall time",
+        "samples    2048 (2.00 per pixel)",
+        "samples/s",
+        "Mrays/s",
+        "threads    2",
+        "completed",
+    ] {
+        assert!(stdout.contains(needle), "missing {needle:?} in:\n{stdout}");
+    }
+
+    let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
+    assert_eq!((w, h), (32, 32));
+    assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+    // Converged means of this view are about (0.19, 0.13, 0.036): the light is (17, 12, 4)
+    // and the red and green walls reflect little blue, so blue sits below 0.05. Bound each
+    // channel loosely, the sum tighter, and check the channels are not swapped.
+    let means: Vec<f32> = (0..3)
+        .map(|c| rgb.iter().skip(c).step_by(3).sum::<f32>() / (w * h) as f32)
+        .collect();
+    for (c, mean) in means.iter().enumerate() {
+        assert!((0.01..5.0).contains(mean), "channel {c} mean {mean}");
+    }
+    let total: f32 = means.iter().sum();
+    assert!((0.15..5.0).contains(&total), "means {means:?}");
+    assert!(
+        means[0] > means[1] && means[1] > means[2],
+        "means {means:?}"
+    );
+    std::fs::remove_file(&out).unwrap();
+}
+
+#[test]
+fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
+    let out = temp_path("timed.png");
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--spp",
+        &"0",
+        &"--time-limit",
+        &"0.3",
+        &"--width",
+        &"16",
+        &"--height",
+        &"16",
+        &"--threads",
+        &"1",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    assert!(stdout.contains("time limit"), "{stdout}");
+    let image = image::open(&out).unwrap();
+    assert_eq!((image.width(), image.height()), (16, 16));
+    std::fs::remove_file(&out).unwrap();
+}
+
+#[test]
+fn missing_scene_file_is_a_one_line_error() {
+    let missing = temp_path("missing.obj");
+    let output = mlt_render(&[&missing, &"--out", &temp_path("never.pfm")]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains(&*missing.to_string_lossy()), "{line}");
+}
+
+#[test]
+fn malformed_obj_is_a_one_line_error() {
+    let obj = temp_path("malformed.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n").unwrap();
+    let output = mlt_render(&[&obj, &"--out", &temp_path("never.pfm")]);
+    let line = assert_one_line_error(&output);
+    assert!(
+        line.contains("malformed.obj") && line.contains("line 5"),
+        "{line}"
+    );
+    std::fs::remove_file(&obj).unwrap();
+}
+
+#[test]
+fn invalid_camera_json_is_a_one_line_error_naming_fov() {
+    let camera = temp_path("camera.json");
+    std::fs::write(
+        &camera,
+        r#"{"eye":[278,273,-800],"target":[278,273,-799],"up":[0,1,0],"fov_y_deg":0,"width":8,"height":8}"#,
+    )
+    .unwrap();
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--camera",
+        &camera,
+        &"--out",
+        &temp_path("never.pfm"),
+    ]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains("fov"), "{line}");
+    std::fs::remove_file(&camera).unwrap();
+}
+
+#[test]
+fn unsupported_output_extension_is_a_one_line_error() {
+    let output = mlt_render(&[&scene("cornell-box.obj"), &"--out", &"x.bmp"]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains("x.bmp"), "{line}");
+    assert!(!Path::new("x.bmp").exists());
+}
+
+#[test]
+fn invalid_settings_and_arguments_are_one_line_errors() {
+    // The kernel rejects the settings: its message comes through.
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--width",
+        &"0",
+        &"--out",
+        &temp_path("never.pfm"),
+    ]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains("width"), "{line}");
+
+    // A scene without any camera.
+    let obj = temp_path("nocamera.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let output = mlt_render(&[&obj, &"--out", &temp_path("never.pfm")]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains("camera"), "{line}");
+    std::fs::remove_file(&obj).unwrap();
+
+    // clap's own errors are folded into one line too.
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--spp",
+        &"many",
+        &"--out",
+        &"x.pfm",
+    ]);
+    let line = assert_one_line_error(&output);
+    assert!(line.contains("--spp"), "{line}");
+}

@@ -1,0 +1,593 @@
+//! Scene loaders and image writers of `mlt::io`.
+#![cfg(feature = "cli")]
+
+use mlt::io::{self, IoError, SceneData};
+use mlt::{Material, MaterialKind, Scene};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes")
+}
+
+/// A fresh path in the temp directory, unique per process and call.
+fn temp_path(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("mlt-io-test-{}-{n}-{name}", std::process::id()))
+}
+
+/// A temp directory holding the given files.
+fn temp_dir_with(files: &[(&str, &[u8])]) -> PathBuf {
+    let dir = temp_path("dir");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, contents) in files {
+        std::fs::write(dir.join(name), contents).unwrap();
+    }
+    dir
+}
+
+fn face_count(obj: &Path) -> usize {
+    std::fs::read_to_string(obj)
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .count()
+}
+
+fn material_named<'a>(data: &'a SceneData, name: &str) -> (u32, &'a Material) {
+    let i = data
+        .material_names
+        .iter()
+        .position(|n| n == name)
+        .unwrap_or_else(|| panic!("no material {name} in {:?}", data.material_names));
+    (i as u32, &data.materials[i])
+}
+
+fn vertex(data: &SceneData, i: u32) -> glam::Vec3 {
+    let i = i as usize * 3;
+    glam::Vec3::from_slice(&data.positions[i..i + 3])
+}
+
+/// Unit normal of triangle `t` by its counter-clockwise winding.
+fn normal(data: &SceneData, t: usize) -> glam::Vec3 {
+    let tri = &data.indices[t * 3..t * 3 + 3];
+    let (a, b, c) = (
+        vertex(data, tri[0]),
+        vertex(data, tri[1]),
+        vertex(data, tri[2]),
+    );
+    (b - a).cross(c - a).normalize()
+}
+
+#[test]
+fn cornell_box_obj_loads_triangles_materials_and_camera() {
+    let path = scenes().join("cornell-box.obj");
+    let data = io::load_scene(&path).unwrap();
+    assert_eq!(face_count(&path), 32);
+    assert_eq!(data.triangle_count(), 32);
+    assert_eq!(data.material_ids.len(), 32);
+    assert_eq!(data.positions.len() % 3, 0);
+    assert!(
+        data.indices
+            .iter()
+            .all(|&i| (i as usize) < data.positions.len() / 3)
+    );
+
+    // Exactly the four MTL materials: no default material was needed.
+    assert_eq!(data.materials.len(), 4);
+    let expect = [
+        ("white", [0.725, 0.71, 0.68], [0.0; 3]),
+        ("red", [0.63, 0.065, 0.05], [0.0; 3]),
+        ("green", [0.14, 0.45, 0.091], [0.0; 3]),
+        ("light", [0.0; 3], [17.0, 12.0, 4.0]),
+    ];
+    for (name, kd, ke) in expect {
+        let (_, m) = material_named(&data, name);
+        assert_eq!(m.kind, MaterialKind::Diffuse, "{name}");
+        assert_eq!(m.color, kd, "{name}");
+        assert_eq!(m.emission, ke, "{name}");
+    }
+
+    // The two light triangles emit (17, 12, 4) and face -y (winding kept).
+    let (light, _) = material_named(&data, "light");
+    let lights: Vec<usize> = (0..32).filter(|&t| data.material_ids[t] == light).collect();
+    assert_eq!(lights.len(), 2);
+    for &t in &lights {
+        assert_eq!(
+            data.materials[data.material_ids[t] as usize].emission,
+            [17.0, 12.0, 4.0]
+        );
+        assert!((normal(&data, t) - glam::Vec3::NEG_Y).length() < 1e-4);
+        assert!((vertex(&data, data.indices[t * 3]).y - 548.7).abs() < 0.2);
+    }
+    // Emission appears on the light triangles only.
+    let emitting = (0..32)
+        .filter(|&t| data.materials[data.material_ids[t] as usize].is_emissive())
+        .count();
+    assert_eq!(emitting, 2);
+
+    // The camera sidecar beside the OBJ.
+    let camera = data.camera.expect("cornell-box.camera.json is loaded");
+    assert_eq!(camera.width, 256);
+    assert_eq!(camera.height, 256);
+    assert_eq!(camera.camera.eye, [278.0, 273.0, -800.0]);
+
+    // And the kernel accepts it.
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    assert_eq!(scene.info().triangle_count, 32);
+    assert_eq!(scene.info().emitter_count, 2);
+}
+
+#[test]
+fn cornell_glass_has_a_dielectric_with_ior_1_5() {
+    let path = scenes().join("cornell-glass.obj");
+    let data = io::load_scene(&path).unwrap();
+    assert_eq!(data.triangle_count(), face_count(&path));
+    let (glass, m) = material_named(&data, "glass");
+    assert_eq!(m.kind, MaterialKind::Dielectric);
+    assert_eq!(m.ior, 1.5);
+    assert_eq!(m.color, [1.0; 3]);
+    assert_eq!(m.emission, [0.0; 3]);
+    let glass_triangles = data.material_ids.iter().filter(|&&id| id == glass).count();
+    assert!(glass_triangles > 1000, "{glass_triangles}");
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
+#[test]
+fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
+    let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\
+        newmtl tf\nTf 0.5 0.6 0.7\nNi 1.33\nillum 2\n\
+        newmtl glass7\nillum 7\n\
+        newmtl emissive_mirror\nillum 3\nKe 1 2 3\n\
+        newmtl bare\n";
+    let obj = b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+        f 1 2 3\nusemtl m\nf 2 4 3\nusemtl tf\nf 1 2 3\nusemtl glass7\nf 1 2 3\n\
+        usemtl emissive_mirror\nf 1 2 3\nusemtl bare\nf 1 2 4 3\n";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    // The quad is triangulated.
+    assert_eq!(data.triangle_count(), 7);
+    let m = material_named(&data, "m").1;
+    assert_eq!((m.kind, m.color), (MaterialKind::Mirror, [0.9, 0.8, 0.7]));
+    let tf = material_named(&data, "tf").1;
+    assert_eq!(
+        (tf.kind, tf.color, tf.ior),
+        (MaterialKind::Dielectric, [0.5, 0.6, 0.7], 1.33)
+    );
+    let g = material_named(&data, "glass7").1;
+    assert_eq!(
+        (g.kind, g.color, g.ior),
+        (MaterialKind::Dielectric, [1.0; 3], 1.5)
+    );
+    let em = material_named(&data, "emissive_mirror").1;
+    assert_eq!(
+        (em.kind, em.emission),
+        (MaterialKind::Mirror, [1.0, 2.0, 3.0])
+    );
+    let bare = material_named(&data, "bare").1;
+    assert_eq!(*bare, Material::diffuse([0.8; 3]));
+    // The first face has no material: it gets the appended default white diffuse.
+    assert_eq!(data.materials.len(), 6);
+    let default = data.material_ids[0] as usize;
+    assert_eq!(default, 5);
+    assert_eq!(data.materials[default], Material::diffuse([0.8; 3]));
+    assert_eq!(data.material_ids[1], material_named(&data, "m").0);
+    // No sidecar camera here.
+    assert!(data.camera.is_none());
+}
+
+fn load_error(path: &Path) -> IoError {
+    match io::load_scene(path) {
+        Ok(_) => panic!("{} loaded", path.display()),
+        Err(e) => {
+            assert!(!e.to_string().contains('\n'), "{e}");
+            e
+        }
+    }
+}
+
+#[test]
+fn obj_errors_name_the_file_and_the_problem() {
+    let missing = temp_path("missing.obj");
+    let e = load_error(&missing);
+    assert!(e.message.contains(&*missing.to_string_lossy()), "{e}");
+
+    let dir = temp_dir_with(&[
+        (
+            "range.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n",
+        ),
+        (
+            "nomtl.obj",
+            b"mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ),
+        (
+            "unknown.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl nothere\nf 1 2 3\n",
+        ),
+        ("empty.obj", b"v 0 0 0\n"),
+        (
+            "badtf.obj",
+            b"mtllib badtf.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ),
+        ("badtf.mtl", b"newmtl x\nTf spectral a.spd\n"),
+        ("scene.xyz", b""),
+    ]);
+    let e = load_error(&dir.join("range.obj"));
+    assert!(e.message.contains("range.obj"), "{e}");
+    assert!(e.message.contains("line 5"), "{e}");
+    assert!(e.message.contains("out of bounds"), "{e}");
+
+    let e = load_error(&dir.join("nomtl.obj"));
+    assert!(e.message.contains("absent.mtl"), "{e}");
+
+    let e = load_error(&dir.join("unknown.obj"));
+    assert!(e.message.contains("'nothere'"), "{e}");
+    assert!(e.message.contains("line 4"), "{e}");
+
+    let e = load_error(&dir.join("empty.obj"));
+    assert!(e.message.contains("no triangles"), "{e}");
+
+    let e = load_error(&dir.join("badtf.obj"));
+    assert!(e.message.contains("Tf"), "{e}");
+
+    let e = load_error(&dir.join("scene.xyz"));
+    assert!(e.message.contains("unsupported file extension"), "{e}");
+}
+
+#[test]
+fn camera_json_fields_are_read_exactly() {
+    let path = scenes().join("cornell-box.camera.json");
+    let c = io::load_camera_json(&path).unwrap();
+    assert_eq!(c.camera.eye, [278.0, 273.0, -800.0]);
+    assert_eq!(c.camera.target, [278.0, 273.0, -799.0]);
+    assert_eq!(c.camera.up, [0.0, 1.0, 0.0]);
+    assert_eq!(c.camera.fov_y_deg, 39.307648);
+    assert_eq!((c.width, c.height), (256, 256));
+    assert_eq!((c.camera.lens_radius, c.camera.focus_distance), (0.0, 0.0));
+
+    let dir = temp_dir_with(&[(
+        "lens.json",
+        br#"{"eye":[1,2,3],"target":[1,2,4],"up":[0,1,0],"fov_y_deg":45.5,
+            "width":640,"height":480,"lens_radius":0.25,"focus_distance":7}"#,
+    )]);
+    let c = io::load_camera_json(&dir.join("lens.json")).unwrap();
+    assert_eq!(c.camera.eye, [1.0, 2.0, 3.0]);
+    assert_eq!(c.camera.fov_y_deg, 45.5);
+    assert_eq!((c.width, c.height), (640, 480));
+    assert_eq!(c.camera.lens_radius, 0.25);
+    assert_eq!(c.camera.focus_distance, 7.0);
+}
+
+#[test]
+fn camera_json_errors() {
+    let good = r#""eye":[0,0,0],"target":[0,0,1],"up":[0,1,0],"width":8,"height":8"#;
+    let cases = [
+        (format!(r#"{{{good},"fov_y_deg":0}}"#), "fov_y_deg"),
+        (format!(r#"{{{good},"fov_y_deg":180}}"#), "fov_y_deg"),
+        (format!(r#"{{{good}}}"#), "fov_y_deg"),
+        (format!(r#"{{{good},"fov_y_deg":40,"fov":3}}"#), "fov"),
+        (
+            r#"{"eye":[0,0,0],"target":[0,0,1],"up":[0,1,0],"width":0,"height":8,"fov_y_deg":40}"#
+                .to_owned(),
+            "width",
+        ),
+        (
+            r#"{"eye":[0,0,0],"target":[0,0,0],"up":[0,1,0],"width":8,"height":8,"fov_y_deg":40}"#
+                .to_owned(),
+            "coincide",
+        ),
+        ("{ not json".to_owned(), "line 1"),
+    ];
+    for (text, needle) in cases {
+        let path = temp_path("camera.json");
+        std::fs::write(&path, &text).unwrap();
+        let e = io::load_camera_json(&path).expect_err(&text);
+        assert!(e.message.contains(needle), "{text}: {e}");
+        assert!(e.message.contains(&*path.to_string_lossy()), "{e}");
+        std::fs::remove_file(&path).unwrap();
+    }
+}
+
+/// A 3 x 2 image whose every float differs.
+fn test_image() -> (u32, u32, Vec<f32>) {
+    let rgb = (0..18).map(|i| i as f32 * 0.25 - 1.0).collect();
+    (3, 2, rgb)
+}
+
+#[test]
+fn pfm_round_trip_is_exact_and_stores_the_bottom_row_first() {
+    let (w, h, rgb) = test_image();
+    let path = temp_path("image.pfm");
+    io::write_image(&path, w, h, &rgb).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let header = b"PF\n3 2\n-1.0\n";
+    assert_eq!(&bytes[..header.len()], header);
+    assert_eq!(bytes.len(), header.len() + 18 * 4);
+    let data: Vec<f32> = bytes[header.len()..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    // The file's first row is the image's bottom row (rgb rows are top to bottom).
+    assert_eq!(&data[..9], &rgb[9..]);
+    assert_eq!(&data[9..], &rgb[..9]);
+
+    let (rw, rh, back) = io::read_pfm(&path).unwrap();
+    assert_eq!((rw, rh), (w, h));
+    assert_eq!(back, rgb);
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn read_pfm_accepts_big_endian_and_greyscale() {
+    let path = temp_path("grey.pfm");
+    let mut bytes = b"Pf\n2 2\n1.0\n".to_vec();
+    for v in [1.0f32, 2.0, 3.0, 4.0] {
+        bytes.extend_from_slice(&v.to_be_bytes());
+    }
+    std::fs::write(&path, &bytes).unwrap();
+    let (w, h, rgb) = io::read_pfm(&path).unwrap();
+    assert_eq!((w, h), (2, 2));
+    assert_eq!(
+        rgb,
+        [3.0, 3.0, 3.0, 4.0, 4.0, 4.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0]
+    );
+    std::fs::write(&path, &bytes[..bytes.len() - 1]).unwrap();
+    assert!(io::read_pfm(&path).is_err());
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn exr_is_written_and_readable() {
+    let (w, h, rgb) = test_image();
+    let path = temp_path("image.exr");
+    io::write_image(&path, w, h, &rgb).unwrap();
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &path,
+        |resolution, _| vec![[0.0f32; 3]; resolution.width() * resolution.height()],
+        |pixels: &mut Vec<[f32; 3]>, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels[position.y() * 3 + position.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let size = image.layer_data.size;
+    assert_eq!((size.width(), size.height()), (3, 2));
+    let back: Vec<f32> = image.layer_data.channel_data.pixels.concat();
+    assert_eq!(back, rgb);
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn png_is_srgb_encoded_and_readable() {
+    // Top row: black, 18% grey, white; bottom row: over-range, negative, 0.5.
+    let rgb = [
+        0.0, 0.0, 0.0, 0.18, 0.18, 0.18, 1.0, 1.0, 1.0, //
+        5.0, 5.0, 5.0, -1.0, -1.0, -1.0, 0.5, 0.25, 0.0,
+    ];
+    let path = temp_path("image.png");
+    io::write_image(&path, 3, 2, &rgb).unwrap();
+    let image = image::open(&path).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (3, 2));
+    assert_eq!(image.get_pixel(0, 0).0, [0, 0, 0]);
+    assert_eq!(image.get_pixel(1, 0).0, [118, 118, 118]);
+    assert_eq!(image.get_pixel(2, 0).0, [255, 255, 255]);
+    assert_eq!(image.get_pixel(0, 1).0, [255, 255, 255]);
+    assert_eq!(image.get_pixel(1, 1).0, [0, 0, 0]);
+    assert_eq!(image.get_pixel(2, 1).0, [188, 137, 0]);
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn image_writer_errors() {
+    let (w, h, rgb) = test_image();
+    let e = io::write_image(&temp_path("x.bmp"), w, h, &rgb).unwrap_err();
+    assert!(
+        e.message.contains("x.bmp") && e.message.contains("extension"),
+        "{e}"
+    );
+    let e = io::write_image(&temp_path("short.pfm"), w, h, &rgb[..17]).unwrap_err();
+    assert!(e.message.contains("17 floats"), "{e}");
+    let unwritable = temp_path("no-such-dir").join("x.png");
+    let e = io::write_image(&unwritable, w, h, &rgb).unwrap_err();
+    assert!(e.message.contains(&*unwritable.to_string_lossy()), "{e}");
+}
+
+// ---------------------------------------------------------------------------------------
+// glTF
+
+fn base64(bytes: &[u8]) -> String {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for chunk in bytes.chunks(3) {
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
+        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+        for k in 0..4 {
+            if k <= chunk.len() {
+                out.push(ALPHABET[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A unit quad in the x = 0 plane facing +x (4 f32x3 positions, 6 u16 indices, padded).
+fn quad_buffer() -> Vec<u8> {
+    let positions: [[f32; 3]; 4] = [
+        [0.0, -1.0, -1.0],
+        [0.0, -1.0, 1.0],
+        [0.0, 1.0, 1.0],
+        [0.0, 1.0, -1.0],
+    ];
+    let indices: [u16; 6] = [0, 2, 1, 0, 3, 2];
+    let mut buffer = Vec::new();
+    for p in positions {
+        for c in p {
+            buffer.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for i in indices {
+        buffer.extend_from_slice(&i.to_le_bytes());
+    }
+    buffer
+}
+
+/// Two instances of the quad (one mirrored, under a translated parent), an emissive material
+/// with strength 4, a glass material and a camera at (5, 0, 0) turned to look down -x.
+fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
+    let uri = buffer_uri.map_or(String::new(), |u| format!(r#""uri": "{u}", "#));
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior"],
+  "scene": 0,
+  "scenes": [{{ "nodes": [0, 3] }}],
+  "nodes": [
+    {{ "name": "group", "translation": [1, 0, 0], "children": [1, 2] }},
+    {{ "name": "quad", "mesh": 0 }},
+    {{ "name": "mirrored", "mesh": 1, "translation": [0, 3, 0], "scale": [1, 1, -1] }},
+    {{ "name": "camera", "camera": 0, "translation": [5, 0, 0], "rotation": [0, {s}, 0, {s}] }}
+  ],
+  "cameras": [{{ "type": "perspective", "perspective": {{ "yfov": 0.5, "aspectRatio": 1.5, "znear": 0.01 }} }}],
+  "meshes": [
+    {{ "primitives": [{{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0 }}] }},
+    {{ "primitives": [{{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 1 }}] }}
+  ],
+  "materials": [
+    {{ "name": "lamp", "emissiveFactor": [1, 0.5, 0.25],
+       "extensions": {{ "KHR_materials_emissive_strength": {{ "emissiveStrength": 4 }} }},
+       "pbrMetallicRoughness": {{ "baseColorFactor": [0.2, 0.3, 0.4, 1] }} }},
+    {{ "name": "glass",
+       "extensions": {{ "KHR_materials_transmission": {{ "transmissionFactor": 1 }},
+                        "KHR_materials_ior": {{ "ior": 1.33 }} }} }}
+  ],
+  "buffers": [{{ {uri}"byteLength": {buffer_len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 12 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+       "min": [0, -1, -1], "max": [0, 1, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#
+    )
+}
+
+fn check_gltf_scene(data: &SceneData) {
+    assert_eq!(data.triangle_count(), 4);
+    assert_eq!(data.materials.len(), 2);
+    let (lamp_id, lamp) = material_named(data, "lamp");
+    assert_eq!(lamp.kind, MaterialKind::Diffuse);
+    assert_eq!(lamp.color, [0.2, 0.3, 0.4]);
+    assert_eq!(lamp.emission, [4.0, 2.0, 1.0]);
+    let (glass_id, glass) = material_named(data, "glass");
+    assert_eq!((glass.kind, glass.ior), (MaterialKind::Dielectric, 1.33));
+    assert_eq!(glass.emission, [0.0; 3]);
+    assert_eq!(data.material_ids, [lamp_id, lamp_id, glass_id, glass_id]);
+
+    // The parent's translation moves both quads to x = 1; the mirrored one is also moved up.
+    for t in 0..4 {
+        for k in 0..3 {
+            let p = vertex(data, data.indices[t * 3 + k]);
+            assert!((p.x - 1.0).abs() < 1e-6, "{p}");
+            let up = if t >= 2 { 3.0 } else { 0.0 };
+            assert!((p.y - up).abs() <= 1.0 + 1e-6, "{p}");
+        }
+        // Both face +x: the mirrored instance had its winding flipped.
+        assert!(
+            (normal(data, t) - glam::Vec3::X).length() < 1e-5,
+            "triangle {t}"
+        );
+    }
+
+    let camera = data.camera.expect("the glTF camera");
+    assert_eq!((camera.width, camera.height), (768, 512));
+    assert!((camera.camera.fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-4);
+    let close =
+        |a: [f32; 3], b: [f32; 3]| (glam::Vec3::from(a) - glam::Vec3::from(b)).length() < 1e-5;
+    assert!(
+        close(camera.camera.eye, [5.0, 0.0, 0.0]),
+        "{:?}",
+        camera.camera
+    );
+    assert!(
+        close(camera.camera.target, [4.0, 0.0, 0.0]),
+        "{:?}",
+        camera.camera
+    );
+    assert!(
+        close(camera.camera.up, [0.0, 1.0, 0.0]),
+        "{:?}",
+        camera.camera
+    );
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
+#[test]
+fn gltf_with_data_uri_buffer_loads_meshes_materials_and_camera() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = gltf_json(Some(&uri), buffer.len());
+    let path = temp_path("quad.gltf");
+    std::fs::write(&path, json).unwrap();
+    let data = io::load_scene(&path).unwrap();
+    check_gltf_scene(&data);
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn glb_loads_the_same_scene() {
+    let buffer = quad_buffer();
+    let mut json = gltf_json(None, buffer.len()).into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let mut bin = buffer.clone();
+    while !bin.len().is_multiple_of(4) {
+        bin.push(0);
+    }
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin);
+    let path = temp_path("quad.glb");
+    std::fs::write(&path, glb).unwrap();
+    let data = io::load_scene(&path).unwrap();
+    check_gltf_scene(&data);
+    std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn gltf_errors_name_the_file() {
+    let path = temp_path("broken.gltf");
+    std::fs::write(&path, "{ \"asset\": ").unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(e.message.contains(&*path.to_string_lossy()), "{e}");
+
+    // An index beyond the primitive's vertices.
+    let mut buffer = quad_buffer();
+    buffer[48..50].copy_from_slice(&7u16.to_le_bytes());
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    std::fs::write(&path, gltf_json(Some(&uri), buffer.len())).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(
+        e.message.contains("is 7") && e.message.contains("4 vertices"),
+        "{e}"
+    );
+    std::fs::remove_file(&path).unwrap();
+}
