@@ -175,6 +175,7 @@ fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     assert_eq!(data.material_ids[1], material_named(&data, "m").0);
     // No sidecar camera here.
     assert!(data.camera.is_none());
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 fn load_error(path: &Path) -> IoError {
@@ -234,6 +235,7 @@ fn obj_errors_name_the_file_and_the_problem() {
 
     let e = load_error(&dir.join("scene.xyz"));
     assert!(e.message.contains("unsupported file extension"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -258,6 +260,7 @@ fn camera_json_fields_are_read_exactly() {
     assert_eq!((c.width, c.height), (640, 480));
     assert_eq!(c.camera.lens_radius, 0.25);
     assert_eq!(c.camera.focus_distance, 7.0);
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
