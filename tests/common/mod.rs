@@ -164,7 +164,10 @@ impl Estimate {
     /// Averages `renders` (each a width × height RGB image from its own seed).
     pub fn from_renders(width: usize, height: usize, renders: &[Vec<f32>]) -> Self {
         let k = renders.len();
-        assert!(k >= 2, "need at least two independent renders for a variance");
+        assert!(
+            k >= 2,
+            "need at least two independent renders for a variance"
+        );
         let n = width * height * 3;
         let mut image = vec![0.0f32; n];
         let mut variance = vec![0.0f64; n];
@@ -200,7 +203,10 @@ impl Estimate {
                 }
             }
         }
-        (mean.map(|m| m / count), variance.map(|v| v / (count * count)))
+        (
+            mean.map(|m| m / count),
+            variance.map(|v| v / (count * count)),
+        )
     }
 
     /// Whole-image mean and its variance.
@@ -220,7 +226,10 @@ pub fn assert_estimates_agree(
     grid: usize,
     sigmas: f64,
 ) {
-    assert_eq!((test.width, test.height), (reference.width, reference.height));
+    assert_eq!(
+        (test.width, test.height),
+        (reference.width, reference.height)
+    );
     let (tm, tv) = test.mean();
     let (rm, rv) = reference.mean();
     for c in 0..3 {
