@@ -41,3 +41,9 @@ pub mod io;
 pub use error::{Error, MltStatus, Result};
 pub use render::{Algorithm, RenderSettings, RenderStats, StopReason, render};
 pub use scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
+
+// One scene serves renders and queries from many threads at once.
+const _: () = {
+    const fn shareable<T: Send + Sync>() {}
+    shareable::<Scene>();
+};

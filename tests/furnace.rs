@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use mlt::{RenderSettings, render};
+use mlt::{Camera, RenderSettings, render};
 
 const ALBEDO: [f32; 3] = [0.5, 0.7, 0.9];
 const EMISSION: [f32; 3] = [1.0, 0.5, 2.0];
@@ -19,6 +19,10 @@ fn expected(depth: u32) -> [f64; 3] {
 }
 
 fn render_furnace(depth: u32, spp: u32, seed: u64, size: u32) -> Vec<f32> {
+    render_furnace_with(&furnace_camera(), depth, spp, seed, size)
+}
+
+fn render_furnace_with(camera: &Camera, depth: u32, spp: u32, seed: u64, size: u32) -> Vec<f32> {
     let scene = furnace_scene(ALBEDO, EMISSION);
     let settings = RenderSettings {
         width: size,
@@ -29,7 +33,7 @@ fn render_furnace(depth: u32, spp: u32, seed: u64, size: u32) -> Vec<f32> {
         ..Default::default()
     };
     let mut image = vec![0.0; (size * size * 3) as usize];
-    let stats = render(&scene, &furnace_camera(), &settings, &mut image, None).unwrap();
+    let stats = render(&scene, camera, &settings, &mut image, None).unwrap();
     assert_eq!(stats.samples, (size * size * spp) as u64);
     assert_eq!(stats.invalid_samples, 0);
     image
@@ -65,6 +69,27 @@ fn furnace_matches_the_geometric_series() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn thin_lens_camera_sees_the_same_furnace() {
+    // Every camera ray starts inside the sphere, so the lens must not change the radiance.
+    let camera = Camera {
+        lens_radius: 0.3,
+        focus_distance: 0.7,
+        ..furnace_camera()
+    };
+    let image = render_furnace_with(&camera, 2, 16, 11, 64);
+    let (mean, error) = mean_and_standard_error(&image);
+    let truth = expected(2);
+    for c in 0..3 {
+        assert!(
+            (mean[c] - truth[c]).abs() <= 4.0 * error[c],
+            "channel {c}: {} vs {}",
+            mean[c],
+            truth[c]
+        );
     }
 }
 
