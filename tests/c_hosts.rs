@@ -31,7 +31,9 @@ fn static_lib() -> &'static Path {
         let deps = exe.parent().expect("target/<profile>/deps");
         let candidates = [
             deps.join("libmlt.a"),
-            deps.parent().map(|p| p.join("libmlt.a")).unwrap_or_default(),
+            deps.parent()
+                .map(|p| p.join("libmlt.a"))
+                .unwrap_or_default(),
         ];
         for candidate in candidates {
             if candidate.is_file() {
@@ -214,8 +216,14 @@ fn reference() -> &'static [f32] {
             ..Default::default()
         };
         let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
-        let stats =
-            mlt::render(&scene, &common::cornell_camera(), &settings, &mut image, None).unwrap();
+        let stats = mlt::render(
+            &scene,
+            &common::cornell_camera(),
+            &settings,
+            &mut image,
+            None,
+        )
+        .unwrap();
         assert_eq!(stats.stop, mlt::StopReason::Completed);
         image
     })
@@ -237,7 +245,10 @@ fn run_and_check(exe: &Path, name: &str) -> String {
         String::from_utf8_lossy(&output.stderr)
     );
     let image = read_pfm(&pfm_path);
-    assert_eq!((image.width, image.height), (WIDTH as usize, HEIGHT as usize));
+    assert_eq!(
+        (image.width, image.height),
+        (WIDTH as usize, HEIGHT as usize)
+    );
     assert!(image.rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
     check_picture(&image, name);
 

@@ -107,7 +107,11 @@ pub fn cornell_box() -> Mesh {
             _ => {}
         }
     }
-    assert_eq!(mesh.indices.len(), 32 * 3, "the Cornell box has 32 triangles");
+    assert_eq!(
+        mesh.indices.len(),
+        32 * 3,
+        "the Cornell box has 32 triangles"
+    );
     mesh
 }
 
