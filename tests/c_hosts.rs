@@ -293,8 +293,8 @@ fn check_picture(image: &Pfm, name: &str) {
         let mut s = [0.0f64; 3];
         for y in 0..h {
             for x in x0..x1 {
-                for c in 0..3 {
-                    s[c] += pixel(x, y)[c] as f64;
+                for (sum, &value) in s.iter_mut().zip(pixel(x, y)) {
+                    *sum += value as f64;
                 }
             }
         }

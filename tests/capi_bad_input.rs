@@ -454,8 +454,9 @@ fn scene_create_null_material_ids_with_length() {
 #[test]
 fn scene_create_misaligned_arrays() {
     let host = HostScene::floor_and_light();
-    let bytes = vec![0u8; 64];
-    let odd = bytes.as_ptr().wrapping_add(1);
+    // u64 storage: one byte past its start is misaligned for every multi-byte type.
+    let storage = [0u64; 8];
+    let odd = storage.as_ptr().cast::<u8>().wrapping_add(1);
     let desc = MltSceneDesc {
         positions: odd.cast(),
         ..host.desc()
@@ -904,8 +905,12 @@ fn render_null_pointers() {
 #[test]
 fn render_misaligned_output() {
     let scene = HostScene::floor_and_light().create();
-    let mut bytes = vec![0u8; 4 * 48 + 8];
-    let odd = bytes.as_mut_ptr().wrapping_add(1).cast::<f32>();
+    let mut storage = vec![0u64; 32];
+    let odd = storage
+        .as_mut_ptr()
+        .cast::<u8>()
+        .wrapping_add(1)
+        .cast::<f32>();
     // SAFETY: a misaligned pointer must be rejected before any write.
     let s = unsafe {
         mlt_render(
@@ -919,7 +924,7 @@ fn render_misaligned_output() {
         )
     };
     assert_invalid(s, &["rgb_out", "aligned"]);
-    assert!(bytes.iter().all(|&b| b == 0));
+    assert!(storage.iter().all(|&b| b == 0));
 }
 
 #[test]
@@ -946,8 +951,12 @@ fn render_larger_buffer_is_fine_and_the_tail_untouched() {
 fn stats_out_misaligned() {
     let scene = HostScene::floor_and_light().create();
     let mut image = vec![SENTINEL_F32; 48];
-    let mut bytes = vec![0u8; std::mem::size_of::<MltRenderStats>() + 16];
-    let odd = bytes.as_mut_ptr().wrapping_add(1).cast::<MltRenderStats>();
+    let mut storage = [0u64; 16];
+    let odd = storage
+        .as_mut_ptr()
+        .cast::<u8>()
+        .wrapping_add(1)
+        .cast::<MltRenderStats>();
     // SAFETY: the misaligned stats pointer must be rejected before rendering.
     let s = unsafe {
         mlt_render_ex(

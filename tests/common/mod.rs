@@ -130,8 +130,8 @@ pub fn cornell_camera() -> mlt::Camera {
 pub fn mean(image: &[f32]) -> [f64; 3] {
     let mut sum = [0.0f64; 3];
     for pixel in image.chunks_exact(3) {
-        for c in 0..3 {
-            sum[c] += pixel[c] as f64;
+        for (s, &value) in sum.iter_mut().zip(pixel) {
+            *s += value as f64;
         }
     }
     let n = (image.len() / 3).max(1) as f64;
