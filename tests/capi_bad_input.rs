@@ -710,6 +710,25 @@ fn ior_not_positive() {
 }
 
 #[test]
+fn ior_is_ignored_for_non_dielectrics_but_must_be_finite() {
+    // The header: "Ignored otherwise". Zero or negative is accepted for diffuse and mirror...
+    for kind in [MLT_MATERIAL_DIFFUSE, MLT_MATERIAL_MIRROR] {
+        let mut host = HostScene::floor_and_light();
+        host.materials[0].kind = kind;
+        host.materials[0].ior = -1.0;
+        drop(host.create());
+    }
+    // ...but a NaN is still reported (every float the host passes must be finite).
+    let mut host = HostScene::floor_and_light();
+    host.materials[0].ior = f32::NAN;
+    host.create_fails(
+        &host.desc(),
+        MLT_STATUS_INVALID_ARGUMENT,
+        &["materials[0].ior", "NaN"],
+    );
+}
+
+#[test]
 fn unknown_material_kind() {
     for bad in [3, -1, i32::MAX] {
         let mut host = HostScene::floor_and_light();
