@@ -143,7 +143,8 @@ typedef struct MltMaterial {
    */
   float emission[3];
   /**
-   * Index of refraction of a dielectric (> 0; the outside is vacuum). Ignored otherwise.
+   * Index of refraction of a dielectric (> 0; the outside is vacuum). Must be finite for
+   * every kind; only dielectrics use it.
    */
   float ior;
 } MltMaterial;
@@ -438,7 +439,8 @@ enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct MltSceneI
  *
  * Returns `MLT_STATUS_OK` when every sample was taken. `MLT_STATUS_CANCELLED` or
  * `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
- * normalized by the samples it actually received. On any other status `rgb_out` is untouched.
+ * normalized by the samples it actually received. A cancel or time limit takes effect once
+ * every pixel has at least one sample (the first pass is never interrupted). On any other status `rgb_out` is untouched.
  *
  * # Safety
  * Pointers must be valid as described; `rgb_out` must not be accessed by the host until

@@ -51,7 +51,8 @@ pub struct MltMaterial {
     /// Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
     /// Any material may emit: its triangles become area lights.
     pub emission: [f32; 3],
-    /// Index of refraction of a dielectric (> 0; the outside is vacuum). Ignored otherwise.
+    /// Index of refraction of a dielectric (> 0; the outside is vacuum). Must be finite for
+    /// every kind; only dielectrics use it.
     pub ior: f32,
 }
 
@@ -307,7 +308,7 @@ fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
         MLT_MATERIAL_MIRROR => Ok(MaterialKind::Mirror),
         MLT_MATERIAL_DIELECTRIC => Ok(MaterialKind::Dielectric),
         other => Err(Error::invalid(format!(
-            "materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
+            "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
         ))),
     }
 }
@@ -317,7 +318,7 @@ fn backend(value: i32) -> Result<Backend> {
         MLT_BACKEND_BVH => Ok(Backend::Bvh),
         MLT_BACKEND_EMBREE => Ok(Backend::Embree),
         other => Err(Error::invalid(format!(
-            "desc->backend is {other}; use MLT_BACKEND_BVH (0) or MLT_BACKEND_EMBREE (1)"
+            "desc.backend is {other}; use MLT_BACKEND_BVH (0) or MLT_BACKEND_EMBREE (1)"
         ))),
     }
 }
@@ -340,7 +341,7 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         MLT_ALGORITHM_PATH => Algorithm::Path,
         other => {
             return Err(Error::invalid(format!(
-                "settings->algorithm is {other}; use MLT_ALGORITHM_PATH (0)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0)"
             )));
         }
     };
@@ -503,17 +504,17 @@ pub unsafe extern "C" fn mlt_scene_create(
         let desc = unsafe { host_ref(desc, "desc") }?;
         check_pointer(out, "out")?;
         let positions =
-            unsafe { host_slice(desc.positions, desc.positions_len, "desc->positions") }?;
-        let indices = unsafe { host_slice(desc.indices, desc.indices_len, "desc->indices") }?;
+            unsafe { host_slice(desc.positions, desc.positions_len, "desc.positions") }?;
+        let indices = unsafe { host_slice(desc.indices, desc.indices_len, "desc.indices") }?;
         let material_ids = unsafe {
             host_slice(
                 desc.material_ids,
                 desc.material_ids_len,
-                "desc->material_ids",
+                "desc.material_ids",
             )
         }?;
         let host_materials =
-            unsafe { host_slice(desc.materials, desc.materials_len, "desc->materials") }?;
+            unsafe { host_slice(desc.materials, desc.materials_len, "desc.materials") }?;
         let materials = host_materials
             .iter()
             .enumerate()
@@ -591,7 +592,8 @@ pub unsafe extern "C" fn mlt_scene_get_info(
 ///
 /// Returns `MLT_STATUS_OK` when every sample was taken. `MLT_STATUS_CANCELLED` or
 /// `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
-/// normalized by the samples it actually received. On any other status `rgb_out` is untouched.
+/// normalized by the samples it actually received. A cancel or time limit takes effect once
+/// every pixel has at least one sample (the first pass is never interrupted). On any other status `rgb_out` is untouched.
 ///
 /// # Safety
 /// Pointers must be valid as described; `rgb_out` must not be accessed by the host until
@@ -697,8 +699,8 @@ fn checked_rays(rays: &[MltRay]) -> Result<()> {
     for (i, ray) in rays.iter().enumerate() {
         check_finite3(&format!("rays[{i}].origin"), ray.origin)?;
         check_finite3(&format!("rays[{i}].direction"), ray.direction)?;
-        let length = Vec3A::from(ray.direction).length();
-        if !(length > 0.0 && length.is_finite()) {
+        let length = direction_length(ray.direction);
+        if length == 0.0 {
             return Err(Error::invalid(format!(
                 "rays[{i}].direction is {:?}; it must be non-zero",
                 ray.direction
@@ -720,16 +722,21 @@ fn checked_rays(rays: &[MltRay]) -> Result<()> {
     Ok(())
 }
 
+/// |direction| in f64: exact enough, and neither underflows nor overflows for finite floats.
+fn direction_length(direction: [f32; 3]) -> f64 {
+    glam::DVec3::from(direction.map(f64::from)).length()
+}
+
 /// The ray with a unit direction and t scaled to match, plus the scale to map t back.
-fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f32) {
-    let direction = Vec3A::from(ray.direction);
+fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f64) {
+    let direction = glam::DVec3::from(ray.direction.map(f64::from));
     let length = direction.length();
     (
         crate::accel::Ray::new(
             Vec3A::from(ray.origin),
-            direction / length,
-            ray.tmin * length,
-            ray.tmax * length,
+            (direction / length).as_vec3a(),
+            (ray.tmin as f64 * length) as f32,
+            (ray.tmax as f64 * length) as f32,
         ),
         length,
     )
@@ -762,7 +769,7 @@ pub unsafe extern "C" fn mlt_intersect(
             *out = match handle.scene.intersect(&unit) {
                 Some(hit) => MltHit {
                     triangle_id: hit.triangle,
-                    t: hit.t / length,
+                    t: (hit.t as f64 / length) as f32,
                     u: hit.u,
                     v: hit.v,
                 },

@@ -190,6 +190,7 @@ pub fn render(
         invalid: AtomicU64::new(0),
     };
     let model = camera.model(settings.width, settings.height);
+    model.validate()?;
     let job = PathJob {
         tracer: PathTracer {
             scene,
@@ -337,10 +338,16 @@ impl PathJob<'_> {
             u32::MAX
         };
         let mut first = 0u32;
-        while first < total && !control.should_stop() {
-            let end = first.saturating_add(batch).min(total);
+        // The first pass takes one sample per pixel and always completes, so a render
+        // stopped at any moment still has a sample in every pixel.
+        while first < total && (first == 0 || !control.should_stop()) {
+            let end = if first == 0 {
+                1
+            } else {
+                first.saturating_add(batch).min(total)
+            };
             film.par_bands(BAND_ROWS).for_each(|band| {
-                if control.should_stop() {
+                if first > 0 && control.should_stop() {
                     return;
                 }
                 let mut rays = 0u64;

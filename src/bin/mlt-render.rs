@@ -176,7 +176,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
 fn describe_scene_error(error: &mlt::Error, data: &SceneData) -> String {
     let message = &error.message;
     let named = message
-        .strip_prefix("materials[")
+        .strip_prefix("desc.materials[")
         .and_then(|rest| rest.split(']').next())
         .and_then(|index| index.parse::<usize>().ok())
         .and_then(|index| data.material_names.get(index));

@@ -58,6 +58,12 @@ impl Camera {
         check_finite(&"camera.focus_distance", self.focus_distance)?;
         let eye = Vec3A::from(self.eye);
         let view = Vec3A::from(self.target) - eye;
+        if !view.is_finite() {
+            return Err(Error::invalid(format!(
+                "camera.target {:?} - camera.eye {:?} overflows a float; the view direction is undefined",
+                self.target, self.eye
+            )));
+        }
         let scale = eye.abs().max_element().max(1.0);
         if view.length() <= 1e-6 * scale {
             return Err(Error::invalid(format!(
@@ -127,6 +133,40 @@ impl Camera {
 }
 
 impl CameraModel {
+    /// Checks that every primary ray is finite and unit length: the image corners with the
+    /// lens's extreme points bound all of them. Catches lens radii and focus distances that
+    /// overflow the float range together with the field of view and position.
+    pub fn validate(&self) -> Result<()> {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let lens_points = [
+            [0.5, 0.5],
+            [0.0, 0.5],
+            [1.0, 0.5],
+            [0.5, 0.0],
+            [0.5, 1.0],
+            [0.0, 0.0],
+            [1.0, 1.0],
+        ];
+        for (x, y) in [(0.0, 0.0), (w, 0.0), (0.0, h), (w, h)] {
+            for lens in lens_points {
+                let (origin, direction) = self.generate_ray(x, y, lens);
+                if !(origin.is_finite()
+                    && direction.is_finite()
+                    && (direction.length() - 1.0).abs() < 1e-3)
+                {
+                    return Err(Error::invalid(format!(
+                        "camera.lens_radius {} and camera.focus_distance {} with a vertical field of view of {} degrees from camera.eye {:?} give primary rays outside the float range",
+                        self.lens_radius,
+                        self.focus_distance,
+                        2.0 * self.half_height.atan().to_degrees(),
+                        self.eye.to_array()
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The primary ray through film position (x, y) in pixels, (0, 0) the top-left corner.
     /// `lens` is a point in the unit square used only by a thin lens. Returns (origin, unit direction).
     #[inline]

@@ -30,7 +30,7 @@ impl Material {
             kind: MaterialKind::Diffuse,
             color: albedo,
             emission: [0.0; 3],
-            ior: 1.0,
+            ior: 1.5,
         }
     }
 
@@ -62,7 +62,7 @@ impl Material {
 
     /// Checks every field, naming `materials[index]` in the message.
     pub fn validate(&self, index: usize) -> Result<()> {
-        let name = format!("materials[{index}]");
+        let name = format!("desc.materials[{index}]");
         check_finite3(&format!("{name}.color"), self.color)?;
         check_finite3(&format!("{name}.emission"), self.emission)?;
         check_finite(&format_args!("{name}.ior"), self.ior)?;

@@ -226,13 +226,13 @@ pub fn luminance(rgb: Vec3A) -> f32 {
 fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     if !desc.positions.len().is_multiple_of(3) {
         return Err(Error::invalid(format!(
-            "positions has {} floats; it must hold 3 per vertex (a multiple of 3)",
+            "desc.positions has {} floats; it must hold 3 per vertex (a multiple of 3)",
             desc.positions.len()
         )));
     }
     if !desc.indices.len().is_multiple_of(3) {
         return Err(Error::invalid(format!(
-            "indices has {} entries; it must hold 3 per triangle (a multiple of 3)",
+            "desc.indices has {} entries; it must hold 3 per triangle (a multiple of 3)",
             desc.indices.len()
         )));
     }
@@ -245,19 +245,19 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     }
     if !desc.material_ids.is_empty() && desc.material_ids.len() != triangle_count {
         return Err(Error::invalid(format!(
-            "material_ids has {} entries but there are {triangle_count} triangles; give one per triangle (or none for material 0 everywhere)",
+            "desc.material_ids has {} entries but there are {triangle_count} triangles; give one per triangle (or none for material 0 everywhere)",
             desc.material_ids.len()
         )));
     }
     if desc.materials.is_empty() && triangle_count > 0 {
         return Err(Error::invalid(
-            "materials is empty; a scene with triangles needs at least one material",
+            "desc.materials is empty; a scene with triangles needs at least one material",
         ));
     }
     for (i, &p) in desc.positions.iter().enumerate() {
         if !p.is_finite() {
             return Err(Error::invalid(format!(
-                "positions[{i}] (vertex {}, {}) is {p}; vertex coordinates must be finite",
+                "desc.positions[{i}] (vertex {}, {}) is {p}; vertex coordinates must be finite",
                 i / 3,
                 ["x", "y", "z"][i % 3]
             )));
@@ -266,7 +266,7 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     for (i, &v) in desc.indices.iter().enumerate() {
         if v as usize >= vertex_count {
             return Err(Error::invalid(format!(
-                "indices[{i}] (triangle {}) is {v}, but there are only {vertex_count} vertices",
+                "desc.indices[{i}] (triangle {}) is {v}, but there are only {vertex_count} vertices",
                 i / 3
             )));
         }
@@ -274,7 +274,7 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     for (i, &m) in desc.material_ids.iter().enumerate() {
         if m as usize >= desc.materials.len() {
             return Err(Error::invalid(format!(
-                "material_ids[{i}] is {m}, but there are only {} materials",
+                "desc.material_ids[{i}] is {m}, but there are only {} materials",
                 desc.materials.len()
             )));
         }

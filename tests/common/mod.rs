@@ -268,3 +268,78 @@ pub fn assert_estimates_agree(
         }
     }
 }
+
+/// A triangle scene as plain arrays, in file order, for tests that go through the C ABI.
+pub struct Mesh {
+    pub positions: Vec<f32>,
+    pub indices: Vec<u32>,
+    pub material_ids: Vec<u32>,
+    pub materials: Vec<Material>,
+}
+
+impl Mesh {
+    pub fn rust_materials(&self) -> Vec<Material> {
+        self.materials.clone()
+    }
+
+    pub fn c_materials(&self) -> Vec<mlt::capi::MltMaterial> {
+        self.materials
+            .iter()
+            .map(|m| mlt::capi::MltMaterial {
+                kind: match m.kind {
+                    mlt::MaterialKind::Diffuse => mlt::capi::MLT_MATERIAL_DIFFUSE,
+                    mlt::MaterialKind::Mirror => mlt::capi::MLT_MATERIAL_MIRROR,
+                    mlt::MaterialKind::Dielectric => mlt::capi::MLT_MATERIAL_DIELECTRIC,
+                },
+                color: m.color,
+                emission: m.emission,
+                ior: m.ior,
+            })
+            .collect()
+    }
+
+    pub fn scene(&self) -> Scene {
+        Scene::new(&SceneDesc {
+            positions: &self.positions,
+            indices: &self.indices,
+            material_ids: &self.material_ids,
+            materials: &self.materials,
+            backend: Backend::Bvh,
+        })
+        .expect("a valid scene")
+    }
+}
+
+pub fn scenes_dir() -> std::path::PathBuf {
+    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes")
+}
+
+/// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
+pub fn cornell_box() -> Mesh {
+    let data = mlt::io::load_scene(&scenes_dir().join("cornell-box.obj")).expect("loads");
+    Mesh {
+        positions: data.positions,
+        indices: data.indices,
+        material_ids: data.material_ids,
+        materials: data.materials,
+    }
+}
+
+/// The Cornell box's camera (tests/scenes/cornell-box.camera.json).
+pub fn cornell_camera() -> Camera {
+    mlt::io::load_camera_json(&scenes_dir().join("cornell-box.camera.json"))
+        .expect("loads")
+        .camera
+}
+
+/// Per-channel mean of an RGB image.
+pub fn mean(image: &[f32]) -> [f64; 3] {
+    let mut sum = [0.0f64; 3];
+    for pixel in image.chunks_exact(3) {
+        for (s, &value) in sum.iter_mut().zip(pixel) {
+            *s += value as f64;
+        }
+    }
+    let n = (image.len() / 3).max(1) as f64;
+    sum.map(|s| s / n)
+}

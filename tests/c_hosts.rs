@@ -1,0 +1,349 @@
+//! Compiles the C and C++ examples in c_examples/ against include/mlt.h and the static library
+//! cargo built, runs them on a small image and checks their PFM output against the same
+//! render through the Rust API (rendering is deterministic given the seed, so they must agree
+//! bit for bit).
+//!
+//! Finding the library: `cargo test` builds the `mlt` lib target once with all its crate types
+//! (rlib, staticlib, cdylib), so `libmlt.a` sits next to this test's executable in
+//! `target/<profile>/deps/`, from the very compilation that is linked into this test. After a
+//! plain `cargo build` it is in `target/<profile>/`. If neither exists (an unusual runner), the
+//! test runs `cargo build --lib` and takes the path cargo reports.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+const WIDTH: u32 = 64;
+const HEIGHT: u32 = 64;
+const SPP: u32 = 8;
+
+fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The static library, located once per test process.
+fn static_lib() -> &'static Path {
+    static LIB: OnceLock<PathBuf> = OnceLock::new();
+    LIB.get_or_init(|| {
+        let exe = std::env::current_exe().expect("the test executable's path");
+        let deps = exe.parent().expect("target/<profile>/deps");
+        let candidates = [
+            deps.join("libmlt.a"),
+            deps.parent()
+                .map(|p| p.join("libmlt.a"))
+                .unwrap_or_default(),
+        ];
+        for candidate in candidates {
+            if candidate.is_file() {
+                return candidate;
+            }
+        }
+        build_static_lib()
+    })
+}
+
+/// Fallback: asks cargo to build the library and report where the staticlib went.
+fn build_static_lib() -> PathBuf {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let output = Command::new(cargo)
+        .args(["build", "--lib", "--message-format=json"])
+        .current_dir(crate_dir())
+        .output()
+        .expect("running cargo build --lib");
+    assert!(
+        output.status.success(),
+        "cargo build --lib failed:\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    for line in stdout.lines() {
+        // Each artifact line lists "filenames":[...]; pick the one ending in libmlt.a.
+        if !line.contains("\"compiler-artifact\"") {
+            continue;
+        }
+        for piece in line.split('"') {
+            if piece.ends_with("/libmlt.a") || piece.ends_with("\\libmlt.a") {
+                return PathBuf::from(piece);
+            }
+        }
+    }
+    panic!("cargo build --lib did not report a libmlt.a; output:\n{stdout}");
+}
+
+/// The C (or C++) compiler the `cc` crate would use for this platform: honours CC / CXX and
+/// friends. `cc` normally reads TARGET, HOST and OPT_LEVEL from a build script's environment;
+/// here they are set explicitly. If cc cannot decide, fall back to `cc` / `c++` on PATH.
+fn compiler(cpp: bool) -> Command {
+    let triple = host_triple();
+    let tool = triple.and_then(|t| {
+        cc::Build::new()
+            .cargo_metadata(false)
+            .cargo_warnings(false)
+            .emit_rerun_if_env_changed(false)
+            .opt_level(0)
+            .debug(false)
+            .target(t)
+            .host(t)
+            .cpp(cpp)
+            .try_get_compiler()
+            .ok()
+    });
+    match tool {
+        Some(tool) => tool.to_command(),
+        None => Command::new(if cpp { "c++" } else { "cc" }),
+    }
+}
+
+/// The target triple this test was compiled for, for the common platforms.
+fn host_triple() -> Option<&'static str> {
+    use std::env::consts::{ARCH, OS};
+    let env_gnu = cfg!(target_env = "gnu");
+    Some(match (ARCH, OS) {
+        ("x86_64", "linux") if env_gnu => "x86_64-unknown-linux-gnu",
+        ("aarch64", "linux") if env_gnu => "aarch64-unknown-linux-gnu",
+        ("x86_64", "linux") => "x86_64-unknown-linux-musl",
+        ("aarch64", "linux") => "aarch64-unknown-linux-musl",
+        ("x86_64", "macos") => "x86_64-apple-darwin",
+        ("aarch64", "macos") => "aarch64-apple-darwin",
+        ("x86_64", "freebsd") => "x86_64-unknown-freebsd",
+        _ => return None,
+    })
+}
+
+fn scratch_dir() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .unwrap_or(Path::new("."))
+        .join("c_hosts");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Compiles `source` (C unless `as_cpp`, with `std`), links the static library, and returns
+/// the executable.
+fn build(source: &str, exe_name: &str, as_cpp: bool, extra: &[&str]) -> PathBuf {
+    let out = scratch_dir().join(exe_name);
+    let _ = std::fs::remove_file(&out);
+    let mut cmd = compiler(as_cpp);
+    cmd.args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
+        .arg("-I")
+        .arg(crate_dir().join("include"))
+        .args(extra)
+        .arg(crate_dir().join("c_examples").join(source))
+        // Whatever follows is a library, not source in the language given by `-x`.
+        .arg("-x")
+        .arg("none")
+        .arg(static_lib())
+        .args(["-lpthread", "-ldl", "-lm"])
+        .arg("-o")
+        .arg(&out);
+    if cfg!(target_os = "macos") {
+        cmd.args(["-framework", "Security", "-framework", "CoreFoundation"]);
+    }
+    let output = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("could not run the compiler {cmd:?}: {e}"));
+    assert!(
+        output.status.success(),
+        "compiling {source} failed: {cmd:?}\n{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    // Warnings are errors, but make sure nothing slipped through on stderr either.
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        !stderr.contains("warning"),
+        "{source} compiled with warnings:\n{stderr}"
+    );
+    out
+}
+
+struct Pfm {
+    width: usize,
+    height: usize,
+    /// RGB rows from the TOP of the image down (flipped from the file's bottom-up order).
+    rgb: Vec<f32>,
+}
+
+fn read_pfm(path: &Path) -> Pfm {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("reading {path:?}: {e}"));
+    // Three whitespace-terminated header tokens: "PF", "<w> <h>", "-1.0".
+    let mut tokens = Vec::new();
+    let mut at = 0;
+    while tokens.len() < 4 {
+        while bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        let start = at;
+        while !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        tokens.push(std::str::from_utf8(&bytes[start..at]).unwrap().to_string());
+    }
+    assert_eq!(bytes[at], b'\n', "a single newline ends the PFM header");
+    at += 1;
+    assert_eq!(tokens[0], "PF", "an RGB PFM");
+    let width: usize = tokens[1].parse().unwrap();
+    let height: usize = tokens[2].parse().unwrap();
+    let scale: f32 = tokens[3].parse().unwrap();
+    assert!(scale < 0.0, "little-endian PFM (negative scale)");
+    let data = &bytes[at..];
+    assert_eq!(data.len(), width * height * 3 * 4, "PFM payload size");
+    let floats: Vec<f32> = data
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let mut rgb = Vec::with_capacity(floats.len());
+    for row in floats.chunks_exact(width * 3).rev() {
+        rgb.extend_from_slice(row);
+    }
+    Pfm { width, height, rgb }
+}
+
+/// The same render through the Rust API, from the canonical OBJ file.
+fn reference() -> &'static [f32] {
+    static IMAGE: OnceLock<Vec<f32>> = OnceLock::new();
+    IMAGE.get_or_init(|| {
+        let scene = common::cornell_box().scene();
+        let settings = mlt::RenderSettings {
+            width: WIDTH,
+            height: HEIGHT,
+            samples_per_pixel: SPP,
+            ..Default::default()
+        };
+        let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
+        let stats = mlt::render(
+            &scene,
+            &common::cornell_camera(),
+            &settings,
+            &mut image,
+            None,
+        )
+        .unwrap();
+        assert_eq!(stats.stop, mlt::StopReason::Completed);
+        image
+    })
+}
+
+fn run_and_check(exe: &Path, name: &str) -> String {
+    let pfm_path = scratch_dir().join(format!("{name}.pfm"));
+    let _ = std::fs::remove_file(&pfm_path);
+    let output = Command::new(exe)
+        .arg(&pfm_path)
+        .args([WIDTH, HEIGHT, SPP].map(|v| v.to_string()))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).to_string();
+    assert!(
+        output.status.success(),
+        "{name} failed ({}):\n{stdout}\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let image = read_pfm(&pfm_path);
+    assert_eq!(
+        (image.width, image.height),
+        (WIDTH as usize, HEIGHT as usize)
+    );
+    assert!(image.rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+    check_picture(&image, name);
+
+    let expected = reference();
+    let mut mismatches = 0;
+    for (i, (a, b)) in image.rgb.iter().zip(expected).enumerate() {
+        if a.to_bits() != b.to_bits() {
+            if mismatches < 5 {
+                eprintln!("{name}: float {i} is {a}, the Rust API gives {b}");
+            }
+            mismatches += 1;
+        }
+    }
+    assert_eq!(
+        mismatches, 0,
+        "{name}'s image differs from the Rust API's render"
+    );
+    stdout
+}
+
+/// Plausibility checks that catch flipped or mirrored images and broken lighting.
+fn check_picture(image: &Pfm, name: &str) {
+    let (w, h) = (image.width, image.height);
+    let pixel = |x: usize, y: usize| &image.rgb[(y * w + x) * 3..(y * w + x) * 3 + 3];
+    let mean = common::mean(&image.rgb);
+    // The Cornell box at the light's (17, 12, 4): the mean is roughly (0.19, 0.12, 0.036).
+    assert!(
+        (0.05..2.0).contains(&mean[0]) && mean[0] > mean[2],
+        "{name}: implausible mean {mean:?}"
+    );
+    // The light (radiance 17, 12, 4 seen directly) is in the top rows, not the bottom ones.
+    let light_rows: Vec<usize> = (0..h)
+        .filter(|&y| (0..w).any(|x| pixel(x, y)[0] > 10.0))
+        .collect();
+    assert!(!light_rows.is_empty(), "{name}: the light is not visible");
+    assert!(
+        light_rows.iter().all(|&y| y < h / 4),
+        "{name}: the light should be near the top, found in rows {light_rows:?} (image upside down?)"
+    );
+    // The red wall is on the left, the green one on the right.
+    let column_mean = |x0: usize, x1: usize| {
+        let mut s = [0.0f64; 3];
+        for y in 0..h {
+            for x in x0..x1 {
+                for (sum, &value) in s.iter_mut().zip(pixel(x, y)) {
+                    *sum += value as f64;
+                }
+            }
+        }
+        s
+    };
+    let left = column_mean(0, w / 10);
+    let right = column_mean(w - w / 10, w);
+    assert!(left[0] > left[1], "{name}: the left wall is not red");
+    assert!(right[1] > right[0], "{name}: the right wall is not green");
+}
+
+#[test]
+fn minimal_c_compiles_as_c99_and_matches_the_rust_api() {
+    let exe = build("minimal.c", "minimal_c99", false, &["-std=c99"]);
+    let stdout = run_and_check(&exe, "minimal_c99");
+    assert!(stdout.contains("32 triangles"), "{stdout}");
+}
+
+#[test]
+fn minimal_c_compiles_as_cpp_and_matches_the_rust_api() {
+    let exe = build("minimal.c", "minimal_cpp", true, &["-x", "c++"]);
+    run_and_check(&exe, "minimal_cpp");
+}
+
+#[test]
+fn cornell_cpp_renders_and_answers_ray_queries() {
+    let exe = build("cornell.cpp", "cornell_cpp", true, &["-std=c++17"]);
+    let stdout = run_and_check(&exe, "cornell_cpp");
+    assert!(stdout.contains("ray 0 hits the back wall"), "{stdout}");
+    assert!(stdout.contains("ray 1: miss"), "{stdout}");
+    assert!(
+        stdout.contains("floor point 0 is lit, floor point 1 is in shadow"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn minimal_c_reports_a_bad_size_through_the_status_helper() {
+    let exe = build("minimal.c", "minimal_bad_size", false, &["-std=c99"]);
+    let pfm = scratch_dir().join("minimal_bad_size.pfm");
+    let output = Command::new(exe)
+        .arg(&pfm)
+        .args(["0", "64", "8"])
+        .output()
+        .unwrap();
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("mlt_render failed: invalid argument") && stderr.contains("width is 0"),
+        "{stderr}"
+    );
+}
