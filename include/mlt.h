@@ -64,6 +64,12 @@
 #define MLT_ALGORITHM_PATH 0
 
 /**
+ * `MltRenderSettings.algorithm`: bidirectional path tracing, all strategies combined by MIS
+ * (including light tracing onto the film).
+ */
+#define MLT_ALGORITHM_BDPT 1
+
+/**
  * `MltHit.triangle_id` of a ray that hit nothing.
  */
 #define MLT_INVALID_ID UINT32_MAX

@@ -36,6 +36,9 @@ pub const MLT_BACKEND_EMBREE: i32 = 1;
 
 /// `MltRenderSettings.algorithm`: path tracing with next-event estimation and MIS.
 pub const MLT_ALGORITHM_PATH: i32 = 0;
+/// `MltRenderSettings.algorithm`: bidirectional path tracing, all strategies combined by MIS
+/// (including light tracing onto the film).
+pub const MLT_ALGORITHM_BDPT: i32 = 1;
 
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
@@ -339,9 +342,10 @@ impl From<&MltCamera> for Camera {
 fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
     let algorithm = match s.algorithm {
         MLT_ALGORITHM_PATH => Algorithm::Path,
+        MLT_ALGORITHM_BDPT => Algorithm::Bdpt,
         other => {
             return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0) or MLT_ALGORITHM_BDPT (1)"
             )));
         }
     };

@@ -10,6 +10,10 @@ pub struct Film {
     sums: Vec<[f64; 3]>,
     /// Samples taken per pixel.
     counts: Vec<u32>,
+    /// Sum of splats (light tracing) per pixel; empty when the estimator does not splat.
+    splats: Vec<[f64; 3]>,
+    /// Light paths traced in all, the normalization of the splats.
+    light_paths: u64,
 }
 
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
@@ -21,13 +25,30 @@ pub struct FilmBand<'a> {
 }
 
 impl Film {
-    pub fn new(width: u32, height: u32) -> Self {
+    pub fn new(width: u32, height: u32, with_splats: bool) -> Self {
         let pixels = width as usize * height as usize;
         Film {
             width,
             height,
             sums: vec![[0.0; 3]; pixels],
             counts: vec![0; pixels],
+            splats: if with_splats {
+                vec![[0.0; 3]; pixels]
+            } else {
+                Vec::new()
+            },
+            light_paths: 0,
+        }
+    }
+
+    /// Adds the splats of a work unit (in the unit's order) and the light paths it traced.
+    pub fn add_splats(&mut self, splats: &[crate::integrators::Splat], light_paths: u64) {
+        self.light_paths += light_paths;
+        for splat in splats {
+            let sum = &mut self.splats[splat.pixel as usize];
+            for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
+                *s += v as f64;
+            }
         }
     }
 
@@ -52,13 +73,26 @@ impl Film {
         self.counts.iter().map(|&c| c as u64).sum()
     }
 
-    /// Writes mean radiance per pixel as RGB floats, rows top to bottom. Pixels without a
-    /// sample (only possible after an early stop) are black.
+    /// Writes the estimate per pixel as RGB floats, rows top to bottom: the mean of the
+    /// pixel's own samples plus the splats, which are normalized by the light paths per
+    /// pixel (each light path's splats estimate the whole film once).
     pub fn write_rgb(&self, out: &mut [f32]) {
-        for ((pixel, sum), &count) in out.chunks_exact_mut(3).zip(&self.sums).zip(&self.counts) {
+        let pixels = self.counts.len() as f64;
+        let splat_scale = if self.light_paths > 0 {
+            pixels / self.light_paths as f64
+        } else {
+            0.0
+        };
+        for (i, ((pixel, sum), &count)) in out
+            .chunks_exact_mut(3)
+            .zip(&self.sums)
+            .zip(&self.counts)
+            .enumerate()
+        {
             let scale = if count > 0 { 1.0 / count as f64 } else { 0.0 };
+            let splat = self.splats.get(i).copied().unwrap_or([0.0; 3]);
             for c in 0..3 {
-                pixel[c] = (sum[c] * scale) as f32;
+                pixel[c] = (sum[c] * scale + splat[c] * splat_scale) as f32;
             }
         }
     }

@@ -3,7 +3,9 @@
 
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::Film;
+use crate::integrators::bdpt::Bdpt;
 use crate::integrators::path::PathTracer;
+use crate::integrators::{PixelEstimator, SampleCounters, Splat};
 use crate::sampling::Rng;
 use crate::scene::{Camera, CameraModel, Scene};
 use glam::Vec3A;
@@ -18,6 +20,41 @@ pub enum Algorithm {
     /// Unidirectional path tracing with next-event estimation and MIS.
     #[default]
     Path,
+    /// Bidirectional path tracing: every connection strategy, combined by MIS.
+    Bdpt,
+}
+
+/// The estimator a render runs, chosen from the settings.
+enum Estimator<'a> {
+    Path(&'a PathTracer<'a>),
+    Bdpt(&'a Bdpt<'a>),
+}
+
+impl Estimator<'_> {
+    fn run(
+        &self,
+        camera: &CameraModel,
+        settings: &RenderSettings,
+        film: &mut Film,
+        control: &Control,
+    ) {
+        match *self {
+            Estimator::Path(estimator) => CameraSampleJob {
+                estimator,
+                camera: *camera,
+                seed: settings.seed,
+                samples_per_pixel: settings.samples_per_pixel,
+            }
+            .run(film, control),
+            Estimator::Bdpt(estimator) => CameraSampleJob {
+                estimator,
+                camera: *camera,
+                seed: settings.seed,
+                samples_per_pixel: settings.samples_per_pixel,
+            }
+            .run(film, control),
+        }
+    }
 }
 
 /// Largest accepted image side, samples per pixel, depth and thread count: beyond these a
@@ -166,7 +203,11 @@ pub fn render(
             settings.height
         )));
     }
-    let mut film = try_film(settings.width, settings.height)?;
+    let mut film = try_film(
+        settings.width,
+        settings.height,
+        settings.algorithm == Algorithm::Bdpt,
+    )?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads as usize)
         .build()
@@ -191,14 +232,23 @@ pub fn render(
     };
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
-    let job = PathJob {
-        tracer: PathTracer {
-            scene,
-            max_depth: settings.max_depth,
-        },
-        camera: model,
-        seed: settings.seed,
-        samples_per_pixel: settings.samples_per_pixel,
+    let path_tracer;
+    let bdpt;
+    let estimator: Estimator = match settings.algorithm {
+        Algorithm::Path => {
+            path_tracer = PathTracer {
+                scene,
+                max_depth: settings.max_depth,
+            };
+            Estimator::Path(&path_tracer)
+        }
+        Algorithm::Bdpt => {
+            bdpt = Bdpt {
+                scene,
+                max_depth: settings.max_depth,
+            };
+            Estimator::Bdpt(&bdpt)
+        }
     };
     let pixels = settings.width as u64 * settings.height as u64;
     let planned = if settings.samples_per_pixel > 0 {
@@ -212,10 +262,11 @@ pub fn render(
         let (done_tx, done_rx) = mpsc::channel::<()>();
         let control = &control;
         let film = &mut film;
-        let job = &job;
+        let estimator = &estimator;
+        let model = &model;
         let pool = &pool;
         let worker = s.spawn(move || {
-            pool.install(|| job.run(film, control));
+            pool.install(|| estimator.run(model, settings, film, control));
             let _ = done_tx.send(());
         });
         loop {
@@ -266,7 +317,7 @@ pub fn render(
 }
 
 /// Allocates the film, reporting failure as a status instead of aborting.
-fn try_film(width: u32, height: u32) -> Result<Film> {
+fn try_film(width: u32, height: u32, with_splats: bool) -> Result<Film> {
     let pixels = width as usize * height as usize;
     // Probe the two large allocations first: `vec!` would abort the process on failure.
     let mut probe: Vec<[f64; 3]> = Vec::new();
@@ -277,7 +328,7 @@ fn try_film(width: u32, height: u32) -> Result<Film> {
         )
     })?;
     drop(probe);
-    Ok(Film::new(width, height))
+    Ok(Film::new(width, height, with_splats))
 }
 
 /// Shared state between the workers and the calling thread.
@@ -318,16 +369,24 @@ impl Control {
     }
 }
 
-/// Path tracing over the film, pass by pass.
-struct PathJob<'a> {
-    tracer: PathTracer<'a>,
+/// Per-work-unit state of a render: the estimator's scratch memory and the splats of the
+/// current pass. Created once per render so sampling never allocates.
+struct BandState<S> {
+    scratch: S,
+    splats: Vec<Splat>,
+    light_paths: u64,
+}
+
+/// Runs a pixel estimator over the film, pass by pass.
+struct CameraSampleJob<'a, E> {
+    estimator: &'a E,
     camera: CameraModel,
     seed: u64,
     /// 0 = until stopped.
     samples_per_pixel: u32,
 }
 
-impl PathJob<'_> {
+impl<E: PixelEstimator> CameraSampleJob<'_, E> {
     fn run(&self, film: &mut Film, control: &Control) {
         let width = film.width;
         let pixels = width as u64 * film.height as u64;
@@ -337,6 +396,19 @@ impl PathJob<'_> {
         } else {
             u32::MAX
         };
+        let bands = film.height.div_ceil(BAND_ROWS) as usize;
+        let splat_capacity = if self.estimator.splats() {
+            (BAND_ROWS * width * batch * 2) as usize
+        } else {
+            0
+        };
+        let mut states: Vec<BandState<E::Scratch>> = (0..bands)
+            .map(|_| BandState {
+                scratch: self.estimator.scratch(),
+                splats: Vec::with_capacity(splat_capacity),
+                light_paths: 0,
+            })
+            .collect();
         let mut first = 0u32;
         // The first pass takes one sample per pixel and always completes, so a render
         // stopped at any moment still has a sample in every pixel.
@@ -346,44 +418,64 @@ impl PathJob<'_> {
             } else {
                 first.saturating_add(batch).min(total)
             };
-            film.par_bands(BAND_ROWS).for_each(|band| {
-                if first > 0 && control.should_stop() {
-                    return;
-                }
-                let mut rays = 0u64;
-                let mut invalid = 0u64;
-                for (i, (sum, count)) in
-                    band.sums.iter_mut().zip(band.counts.iter_mut()).enumerate()
-                {
-                    let x = i as u32 % width;
-                    let y = band.first_row + i as u32 / width;
-                    let pixel = y as u64 * width as u64 + x as u64;
-                    let mut pixel_sum = Vec3A::ZERO;
-                    for sample in first..end {
-                        let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
-                        let [jx, jy] = rng.uniform2();
-                        let lens = rng.uniform2();
-                        let (origin, direction) =
-                            self.camera.generate_ray(x as f32 + jx, y as f32 + jy, lens);
-                        let l = self.tracer.radiance(origin, direction, &mut rng, &mut rays);
-                        if l.is_finite() {
-                            pixel_sum += l;
-                        } else {
-                            invalid += 1;
+            film.par_bands(BAND_ROWS)
+                .zip(states.par_iter_mut())
+                .for_each(|(band, state)| {
+                    state.splats.clear();
+                    state.light_paths = 0;
+                    if first > 0 && control.should_stop() {
+                        return;
+                    }
+                    let mut counters = SampleCounters::default();
+                    let mut invalid = 0u64;
+                    for (i, (sum, count)) in
+                        band.sums.iter_mut().zip(band.counts.iter_mut()).enumerate()
+                    {
+                        let x = i as u32 % width;
+                        let y = band.first_row + i as u32 / width;
+                        let pixel = y as u64 * width as u64 + x as u64;
+                        let mut pixel_sum = Vec3A::ZERO;
+                        for sample in first..end {
+                            let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
+                            let [jx, jy] = rng.uniform2();
+                            let splats_before = state.splats.len();
+                            let l = self.estimator.sample(
+                                &self.camera,
+                                x as f32 + jx,
+                                y as f32 + jy,
+                                &mut rng,
+                                &mut counters,
+                                &mut state.scratch,
+                                &mut state.splats,
+                            );
+                            let splats_valid = state.splats[splats_before..]
+                                .iter()
+                                .all(|s| s.value.is_finite());
+                            if l.is_finite() && splats_valid {
+                                pixel_sum += l;
+                            } else {
+                                state.splats.truncate(splats_before);
+                                invalid += 1;
+                            }
                         }
+                        for c in 0..3 {
+                            sum[c] += pixel_sum[c] as f64;
+                        }
+                        *count += end - first;
                     }
-                    for c in 0..3 {
-                        sum[c] += pixel_sum[c] as f64;
-                    }
-                    *count += end - first;
+                    let band_samples = band.counts.len() as u64 * (end - first) as u64;
+                    state.light_paths = band_samples;
+                    control
+                        .samples_done
+                        .fetch_add(band_samples, Ordering::Relaxed);
+                    control.rays.fetch_add(counters.rays, Ordering::Relaxed);
+                    control.invalid.fetch_add(invalid, Ordering::Relaxed);
+                });
+            if self.estimator.splats() {
+                for state in &states {
+                    film.add_splats(&state.splats, state.light_paths);
                 }
-                let band_pixels = band.counts.len() as u64;
-                control
-                    .samples_done
-                    .fetch_add(band_pixels * (end - first) as u64, Ordering::Relaxed);
-                control.rays.fetch_add(rays, Ordering::Relaxed);
-                control.invalid.fetch_add(invalid, Ordering::Relaxed);
-            });
+            }
             first = end;
         }
     }

@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use mlt::{RenderSettings, render};
+use mlt::{Algorithm, RenderSettings, render};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -38,8 +38,9 @@ fn allocations_do_not_grow_with_samples() {
     let scene = furnace_scene([0.5; 3], [1.0; 3]);
     let camera = furnace_camera();
     let mut image = vec![0.0; 128 * 128 * 3];
-    let mut count = |spp: u32| {
+    let mut count = |algorithm: Algorithm, spp: u32| {
         let settings = RenderSettings {
+            algorithm,
             width: 128,
             height: 128,
             samples_per_pixel: spp,
@@ -50,12 +51,14 @@ fn allocations_do_not_grow_with_samples() {
         render(&scene, &camera, &settings, &mut image, None).unwrap();
         ALLOCATIONS.load(Ordering::SeqCst) - before
     };
-    count(1); // warm up lazily initialized runtime state
-    let few = count(2);
-    let many = count(20);
-    assert!(few > 0, "the counter must see the render's own allocations");
-    assert_eq!(
-        few, many,
-        "2 spp made {few} allocations, 20 spp made {many}"
-    );
+    for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
+        count(algorithm, 1); // warm up lazily initialized runtime state
+        let few = count(algorithm, 2);
+        let many = count(algorithm, 20);
+        assert!(few > 0, "the counter must see the render's own allocations");
+        assert_eq!(
+            few, many,
+            "{algorithm:?}: 2 spp made {few} allocations, 20 spp made {many}"
+        );
+    }
 }

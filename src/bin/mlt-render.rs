@@ -14,6 +14,8 @@ use std::time::Instant;
 enum AlgorithmArg {
     /// Path tracing with next-event estimation and MIS.
     Path,
+    /// Bidirectional path tracing with MIS over every connection strategy.
+    Bdpt,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -163,6 +165,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         height: args.height.unwrap_or(camera.height),
         algorithm: match args.algorithm {
             AlgorithmArg::Path => mlt::Algorithm::Path,
+            AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
         },
         samples_per_pixel: args.spp,
         max_depth: args.max_depth,

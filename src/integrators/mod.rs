@@ -1,10 +1,49 @@
 //! Light-transport estimators.
 
+pub mod bdpt;
 pub mod path;
 
 use crate::accel::Ray;
-use crate::scene::Scene;
+use crate::sampling::Rng;
+use crate::scene::{CameraModel, Scene};
 use glam::Vec3A;
+
+/// A contribution to an arbitrary pixel (light tracing onto the film), recorded by a work
+/// unit and added to the film in a fixed order so the image never depends on scheduling.
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    pub pixel: u32,
+    pub value: Vec3A,
+}
+
+/// Counters a sample updates; summed per work unit.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleCounters {
+    pub rays: u64,
+}
+
+/// An estimator of pixel values from camera samples, run by the render driver.
+pub trait PixelEstimator: Sync {
+    /// Per-work-unit memory reused by every sample (path vertices...): allocated once per
+    /// render, so sampling never allocates.
+    type Scratch: Send;
+    fn scratch(&self) -> Self::Scratch;
+    /// Whether samples add splats (then the film keeps a splat image).
+    fn splats(&self) -> bool;
+    /// One sample through film position (x, y) in pixels. Returns the contribution to that
+    /// pixel; contributions to other pixels go to `splats`.
+    #[allow(clippy::too_many_arguments)]
+    fn sample(
+        &self,
+        camera: &CameraModel,
+        x: f32,
+        y: f32,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+        scratch: &mut Self::Scratch,
+        splats: &mut Vec<Splat>,
+    ) -> Vec3A;
+}
 
 /// A ray leaving surface point `p` (geometric normal `normal`) in `direction`, with its origin
 /// moved off the surface to the side it leaves on, so it cannot hit its own triangle.

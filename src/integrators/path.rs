@@ -1,10 +1,10 @@
 //! Unidirectional path tracing: BSDF importance sampling, next-event estimation to area
 //! lights, multiple importance sampling (power heuristic) and Russian roulette.
 
-use super::{shadow_ray, spawn_ray};
+use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
 use crate::sampling::{Rng, power_heuristic, uniform_triangle};
-use crate::scene::{MaterialKind, Scene};
+use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;
 
 /// Bounces after which Russian roulette may end a path.
@@ -146,5 +146,31 @@ impl PathTracer<'_> {
         let bsdf_pdf = bsdf::pdf(material, normal, wo, wi);
         let weight = power_heuristic(light_pdf, bsdf_pdf);
         f * light.emission * (wi.dot(normal).abs() * weight / light_pdf)
+    }
+}
+
+impl PixelEstimator for PathTracer<'_> {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    fn splats(&self) -> bool {
+        false
+    }
+
+    #[inline]
+    fn sample(
+        &self,
+        camera: &CameraModel,
+        x: f32,
+        y: f32,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+        _scratch: &mut (),
+        _splats: &mut Vec<Splat>,
+    ) -> Vec3A {
+        let lens = rng.uniform2();
+        let (origin, direction) = camera.generate_ray(x, y, lens);
+        self.radiance(origin, direction, rng, &mut counters.rays)
     }
 }

@@ -186,3 +186,93 @@ impl CameraModel {
         }
     }
 }
+
+/// The camera as an endpoint of light paths: where a direction lands on the film and the
+/// importance and densities bidirectional methods need. Importance is normalized so that
+/// a pixel's measurement equals its mean radiance (the quantity the path tracer estimates).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraImportance {
+    /// Importance We of the ray.
+    pub importance: f32,
+    /// Continuous film position in pixels, (0, 0) the top-left corner.
+    pub raster: [f32; 2],
+}
+
+impl CameraModel {
+    /// Area of the image plane at distance 1 in front of the eye.
+    #[inline]
+    fn film_area(&self) -> f32 {
+        4.0 * self.half_width * self.half_height
+    }
+
+    /// Area of the lens, or 1 for a pinhole (whose position density is a Dirac delta).
+    #[inline]
+    pub fn lens_area(&self) -> f32 {
+        if self.lens_radius > 0.0 {
+            std::f32::consts::PI * self.lens_radius * self.lens_radius
+        } else {
+            1.0
+        }
+    }
+
+    /// Film position of the ray leaving lens point `origin` in unit direction `direction`,
+    /// if it lands on the film.
+    #[inline]
+    pub fn raster_position(&self, origin: Vec3A, direction: Vec3A) -> Option<[f32; 2]> {
+        let cos_theta = direction.dot(self.forward);
+        if cos_theta <= 0.0 {
+            return None;
+        }
+        // Through a thin lens, the ray meets the pinhole ray of the same film point on the
+        // focal plane; a pinhole's origin is the eye and any plane will do.
+        let focus = origin + direction * (self.focus_distance / cos_theta);
+        let local = focus - self.eye;
+        let depth = local.dot(self.forward);
+        if depth <= 0.0 {
+            return None;
+        }
+        let sx = local.dot(self.right) / depth;
+        let sy = local.dot(self.up) / depth;
+        let x = (sx / self.half_width + 1.0) * 0.5 * self.width as f32;
+        let y = (1.0 - sy / self.half_height) * 0.5 * self.height as f32;
+        if (0.0..self.width as f32).contains(&x) && (0.0..self.height as f32).contains(&y) {
+            Some([x, y])
+        } else {
+            None
+        }
+    }
+
+    /// Importance of the ray and where it lands, or None if it misses the film.
+    #[inline]
+    pub fn importance(&self, origin: Vec3A, direction: Vec3A) -> Option<CameraImportance> {
+        let raster = self.raster_position(origin, direction)?;
+        let cos_theta = direction.dot(self.forward);
+        let cos2 = cos_theta * cos_theta;
+        Some(CameraImportance {
+            importance: 1.0 / (self.film_area() * self.lens_area() * cos2 * cos2),
+            raster,
+        })
+    }
+
+    /// Solid-angle density with which `generate_ray` produces `direction` (0 off the film).
+    #[inline]
+    pub fn direction_pdf(&self, origin: Vec3A, direction: Vec3A) -> f32 {
+        if self.raster_position(origin, direction).is_none() {
+            return 0.0;
+        }
+        let cos_theta = direction.dot(self.forward);
+        1.0 / (self.film_area() * cos_theta * cos_theta * cos_theta)
+    }
+
+    /// A lens point for connecting to `point`, from `u` in the unit square: the eye for a
+    /// pinhole.
+    #[inline]
+    pub fn sample_lens(&self, u: [f32; 2]) -> Vec3A {
+        if self.lens_radius > 0.0 {
+            let [lx, ly] = crate::sampling::uniform_disk(u);
+            self.eye + (self.right * lx + self.up * ly) * self.lens_radius
+        } else {
+            self.eye
+        }
+    }
+}

@@ -68,6 +68,8 @@ pub struct AreaLight {
     pub emission: Vec3A,
     /// Selection probability / area: the area density of light sampling on this light.
     pub area_pdf: f32,
+    /// Internal index of the light's triangle.
+    pub triangle: u32,
 }
 
 pub struct Scene {
@@ -158,6 +160,7 @@ impl Scene {
                     normal,
                     emission,
                     area_pdf: 0.0,
+                    triangle: internal as u32,
                 });
             }
             shading.push(TriangleShading {

@@ -1,0 +1,584 @@
+//! Bidirectional path tracing (Veach 1997, ch. 10): a camera subpath and a light subpath per
+//! sample, every connection strategy (s light vertices, t camera vertices) including the camera
+//! hitting an emitter (s = 0), next-event estimation (s = 1) and light tracing onto the film
+//! (t = 1), combined with the power heuristic over all strategies of each path length.
+//!
+//! Densities are kept per vertex in area measure: `pdf_forward` is the density of the vertex
+//! as its own subpath sampled it, `pdf_reverse` the density had it been sampled from the other
+//! end. The MIS weight of a strategy is then 1 / Σ_i (p_i / p_s)², the ratios built vertex by
+//! vertex from those two numbers. Specular (Dirac) vertices cannot be connected; their
+//! densities are excluded from the ratios (set to 0 and remapped to 1), so strategies that
+//! would need to connect through them get no weight.
+//!
+//! Russian roulette is not used: subpaths end at the depth limit, which keeps the densities
+//! of both directions exact for MIS.
+
+use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
+use crate::bsdf::{self, TransportMode};
+use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
+use crate::scene::{CameraModel, Scene};
+use glam::Vec3A;
+use std::f32::consts::FRAC_1_PI;
+
+pub struct Bdpt<'a> {
+    pub scene: &'a Scene,
+    /// At most this many scattering vertices between camera and light.
+    pub max_depth: u32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum VertexKind {
+    /// The lens point; `normal` is the view direction.
+    Camera,
+    /// A point sampled on an area light; `normal` is the light's front normal.
+    Light,
+    /// A surface hit by a subpath.
+    Surface,
+}
+
+/// A path vertex with what connections and MIS need.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    kind: VertexKind,
+    p: Vec3A,
+    /// Geometric normal of the front side (camera: view direction).
+    normal: Vec3A,
+    /// Unit direction towards the previous vertex of its own subpath (surfaces only).
+    wo: Vec3A,
+    /// Subpath throughput up to and including this vertex's sampling.
+    beta: Vec3A,
+    pdf_forward: f32,
+    pdf_reverse: f32,
+    /// Internal triangle index (surfaces and lights).
+    triangle: u32,
+    /// Scattering here is a Dirac delta (mirror, glass).
+    specular: bool,
+}
+
+impl Vertex {
+    const EMPTY: Vertex = Vertex {
+        kind: VertexKind::Surface,
+        p: Vec3A::ZERO,
+        normal: Vec3A::ZERO,
+        wo: Vec3A::ZERO,
+        beta: Vec3A::ZERO,
+        pdf_forward: 0.0,
+        pdf_reverse: 0.0,
+        triangle: 0,
+        specular: false,
+    };
+
+    /// Whether a connection may end at this vertex.
+    #[inline]
+    fn connectible(&self) -> bool {
+        !self.specular
+    }
+}
+
+/// The two subpaths of one sample, reused by every sample of a work unit.
+pub struct BdptScratch {
+    camera: Vec<Vertex>,
+    light: Vec<Vertex>,
+}
+
+/// Converts a solid-angle density at `from` of the direction towards `to` into an area
+/// density at `to`.
+#[inline]
+fn to_area(pdf_solid_angle: f32, from: &Vertex, to: &Vertex) -> f32 {
+    let d = to.p - from.p;
+    let distance2 = d.length_squared();
+    if distance2 == 0.0 {
+        return 0.0;
+    }
+    let mut pdf = pdf_solid_angle / distance2;
+    if to.kind != VertexKind::Camera {
+        pdf *= (d.dot(to.normal) / distance2.sqrt()).abs();
+    }
+    pdf
+}
+
+impl Bdpt<'_> {
+    #[inline]
+    fn material(&self, v: &Vertex) -> &crate::scene::Material {
+        let shading = &self.scene.shading[v.triangle as usize];
+        &self.scene.materials[shading.material as usize]
+    }
+
+    /// Radiance a surface vertex emits towards direction `w` (front side only).
+    #[inline]
+    fn emitted(&self, v: &Vertex, w: Vec3A) -> Vec3A {
+        let shading = &self.scene.shading[v.triangle as usize];
+        if shading.light_area_pdf > 0.0 && w.dot(v.normal) > 0.0 {
+            Vec3A::from(self.scene.materials[shading.material as usize].emission)
+        } else {
+            Vec3A::ZERO
+        }
+    }
+
+    /// Area density at `next` of sampling it from `v`, which was reached from `prev`.
+    #[inline]
+    fn pdf(&self, camera: &CameraModel, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -> f32 {
+        let to_next = next.p - v.p;
+        let distance = to_next.length();
+        if distance == 0.0 {
+            return 0.0;
+        }
+        let wn = to_next / distance;
+        let pdf_solid_angle = match v.kind {
+            VertexKind::Camera => camera.direction_pdf(v.p, wn),
+            VertexKind::Light => return self.pdf_light_direction(v, next),
+            VertexKind::Surface => {
+                let wp = match prev {
+                    Some(prev) => (prev.p - v.p).normalize(),
+                    None => v.wo,
+                };
+                bsdf::pdf(self.material(v), v.normal, wp, wn)
+            }
+        };
+        to_area(pdf_solid_angle, v, next)
+    }
+
+    /// Area density at `next` of an emission direction from light point `v` (cosine-weighted
+    /// about the light's normal, as light subpaths sample it).
+    #[inline]
+    fn pdf_light_direction(&self, v: &Vertex, next: &Vertex) -> f32 {
+        let w = (next.p - v.p).normalize();
+        let cos = w.dot(v.normal);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        to_area(cos * FRAC_1_PI, v, next)
+    }
+
+    /// Area density of sampling `v` (on an emitter) as a light subpath's first vertex.
+    #[inline]
+    fn pdf_light_origin(&self, v: &Vertex) -> f32 {
+        self.scene.shading[v.triangle as usize].light_area_pdf
+    }
+
+    /// Extends `path` (whose last vertex is the subpath's start) by a random walk; returns
+    /// the number of vertices.
+    #[allow(clippy::too_many_arguments)]
+    fn random_walk(
+        &self,
+        path: &mut [Vertex],
+        mut ray: crate::accel::Ray,
+        mut beta: Vec3A,
+        mut pdf_solid_angle: f32,
+        max_vertices: usize,
+        mode: TransportMode,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+    ) -> usize {
+        let mut count = 1;
+        while count < max_vertices {
+            counters.rays += 1;
+            let Some(hit) = self.scene.accel.intersect(&ray) else {
+                break;
+            };
+            let shading = &self.scene.shading[hit.triangle as usize];
+            let material = &self.scene.materials[shading.material as usize];
+            let mut vertex = Vertex {
+                kind: VertexKind::Surface,
+                p: ray.origin + ray.direction * hit.t,
+                normal: shading.normal,
+                wo: -ray.direction,
+                beta,
+                pdf_forward: 0.0,
+                pdf_reverse: 0.0,
+                triangle: hit.triangle,
+                specular: false,
+            };
+            vertex.pdf_forward = to_area(pdf_solid_angle, &path[count - 1], &vertex);
+            path[count] = vertex;
+            count += 1;
+            if count >= max_vertices {
+                break;
+            }
+            let Some(sample) = bsdf::sample(
+                material,
+                vertex.normal,
+                vertex.wo,
+                rng.uniform2(),
+                rng.uniform(),
+                mode,
+            ) else {
+                break;
+            };
+            let index = count - 1;
+            let reverse_solid_angle;
+            if sample.specular {
+                path[index].specular = true;
+                pdf_solid_angle = 0.0;
+                reverse_solid_angle = 0.0;
+            } else {
+                pdf_solid_angle = sample.pdf;
+                reverse_solid_angle = bsdf::pdf(material, vertex.normal, sample.wi, vertex.wo);
+            }
+            beta *= sample.weight;
+            if beta.max_element() <= 0.0 {
+                break;
+            }
+            let reverse = to_area(reverse_solid_angle, &path[index], &path[index - 1]);
+            path[index - 1].pdf_reverse = reverse;
+            ray = spawn_ray(self.scene, vertex.p, vertex.normal, sample.wi);
+        }
+        count
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn camera_subpath(
+        &self,
+        camera: &CameraModel,
+        x: f32,
+        y: f32,
+        path: &mut [Vertex],
+        max_vertices: usize,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+    ) -> usize {
+        let lens = rng.uniform2();
+        let (origin, direction) = camera.generate_ray(x, y, lens);
+        path[0] = Vertex {
+            kind: VertexKind::Camera,
+            p: origin,
+            normal: camera.forward,
+            beta: Vec3A::ONE,
+            ..Vertex::EMPTY
+        };
+        let pdf_direction = camera.direction_pdf(origin, direction);
+        let ray = crate::accel::Ray::new(origin, direction, 0.0, f32::INFINITY);
+        self.random_walk(
+            path,
+            ray,
+            Vec3A::ONE,
+            pdf_direction,
+            max_vertices,
+            TransportMode::Radiance,
+            rng,
+            counters,
+        )
+    }
+
+    fn light_subpath(
+        &self,
+        path: &mut [Vertex],
+        max_vertices: usize,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+    ) -> usize {
+        let u_select = rng.uniform();
+        let u_point = rng.uniform2();
+        let u_direction = rng.uniform2();
+        if self.scene.lights.is_empty() || max_vertices == 0 {
+            return 0;
+        }
+        let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
+        let light = &self.scene.lights[index];
+        let [b1, b2] = uniform_triangle(u_point);
+        let p = light.v0 + light.edge1 * b1 + light.edge2 * b2;
+        let local = cosine_hemisphere(u_direction);
+        let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
+        let pdf_direction = local.z * FRAC_1_PI;
+        path[0] = Vertex {
+            kind: VertexKind::Light,
+            p,
+            normal: light.normal,
+            // Le / p_position: what a connection to this vertex carries.
+            beta: light.emission / light.area_pdf,
+            pdf_forward: light.area_pdf,
+            triangle: light.triangle,
+            ..Vertex::EMPTY
+        };
+        if local.z <= 0.0 {
+            return 1;
+        }
+        // Le·cos / (p_position · p_direction) = Le·π / p_position.
+        let beta = light.emission * (local.z / (light.area_pdf * pdf_direction));
+        let ray = spawn_ray(self.scene, p, light.normal, direction);
+        self.random_walk(
+            path,
+            ray,
+            beta,
+            pdf_direction,
+            max_vertices,
+            TransportMode::Importance,
+            rng,
+            counters,
+        )
+    }
+
+    /// The MIS weight of strategy (s, t), given the vertices the strategy actually uses:
+    /// `sampled` replaces light[0] (s = 1) or camera[0] (t = 1) when one was sampled anew.
+    #[allow(clippy::too_many_arguments)]
+    fn mis_weight(
+        &self,
+        camera_model: &CameraModel,
+        camera: &mut [Vertex],
+        light: &mut [Vertex],
+        s: usize,
+        t: usize,
+    ) -> f32 {
+        if s + t == 2 {
+            return 1.0;
+        }
+        // Temporarily give the connection vertices the densities of the other direction.
+        let saved_camera = [
+            camera[t - 1],
+            if t >= 2 { camera[t - 2] } else { Vertex::EMPTY },
+        ];
+        let saved_light = [
+            if s >= 1 { light[s - 1] } else { Vertex::EMPTY },
+            if s >= 2 { light[s - 2] } else { Vertex::EMPTY },
+        ];
+        let pt = camera[t - 1];
+        let pt_minus = (t >= 2).then(|| camera[t - 2]);
+        let qs = (s >= 1).then(|| light[s - 1]);
+        let qs_minus = (s >= 2).then(|| light[s - 2]);
+
+        camera[t - 1].specular = false;
+        camera[t - 1].pdf_reverse = match qs {
+            Some(qs) => self.pdf(camera_model, &qs, qs_minus.as_ref(), &pt),
+            None => self.pdf_light_origin(&pt),
+        };
+        if let Some(pt_minus) = pt_minus {
+            camera[t - 2].pdf_reverse = match qs {
+                Some(qs) => self.pdf(camera_model, &pt, Some(&qs), &pt_minus),
+                None => self.pdf_light_direction(&pt, &pt_minus),
+            };
+        }
+        if let Some(qs) = qs {
+            light[s - 1].specular = false;
+            light[s - 1].pdf_reverse = self.pdf(camera_model, &pt, pt_minus.as_ref(), &qs);
+            if let Some(qs_minus) = qs_minus {
+                light[s - 2].pdf_reverse = self.pdf(camera_model, &qs, Some(&pt), &qs_minus);
+            }
+        }
+
+        // A zero density marks a specular vertex; the ratio through it is taken as 1.
+        let remap = |x: f32| if x != 0.0 { x } else { 1.0 };
+        let mut sum = 0.0f32;
+        let mut ratio = 1.0f32;
+        for i in (1..t).rev() {
+            let r = remap(camera[i].pdf_reverse) / remap(camera[i].pdf_forward);
+            ratio *= r * r;
+            if !camera[i].specular && !camera[i - 1].specular {
+                sum += ratio;
+            }
+        }
+        ratio = 1.0;
+        for i in (0..s).rev() {
+            let r = remap(light[i].pdf_reverse) / remap(light[i].pdf_forward);
+            ratio *= r * r;
+            // Area lights are never Dirac, so light[0] can always be connected.
+            let previous_specular = i > 0 && light[i - 1].specular;
+            if !light[i].specular && !previous_specular {
+                sum += ratio;
+            }
+        }
+
+        camera[t - 1] = saved_camera[0];
+        if t >= 2 {
+            camera[t - 2] = saved_camera[1];
+        }
+        if s >= 1 {
+            light[s - 1] = saved_light[0];
+        }
+        if s >= 2 {
+            light[s - 2] = saved_light[1];
+        }
+        1.0 / (1.0 + sum)
+    }
+
+    /// Throughput factor of a surface vertex scattering from its predecessor towards `to`.
+    #[inline]
+    fn f(&self, v: &Vertex, to: Vec3A) -> Vec3A {
+        let w = to - v.p;
+        let length = w.length();
+        if length == 0.0 {
+            return Vec3A::ZERO;
+        }
+        bsdf::eval(self.material(v), v.normal, v.wo, w / length)
+    }
+
+    /// Whether nothing blocks the segment between two vertices.
+    #[inline]
+    fn visible(&self, a: &Vertex, b: &Vertex, counters: &mut SampleCounters) -> bool {
+        let normal_a = if a.kind == VertexKind::Camera {
+            Vec3A::ZERO
+        } else {
+            a.normal
+        };
+        let normal_b = if b.kind == VertexKind::Camera {
+            Vec3A::ZERO
+        } else {
+            b.normal
+        };
+        let Some(ray) = shadow_ray(self.scene, a.p, normal_a, b.p, normal_b) else {
+            return false;
+        };
+        counters.rays += 1;
+        !self.scene.accel.occluded(&ray)
+    }
+}
+
+impl PixelEstimator for Bdpt<'_> {
+    type Scratch = BdptScratch;
+
+    fn scratch(&self) -> BdptScratch {
+        let n = self.max_depth as usize + 2;
+        BdptScratch {
+            camera: vec![Vertex::EMPTY; n],
+            light: vec![Vertex::EMPTY; n],
+        }
+    }
+
+    fn splats(&self) -> bool {
+        true
+    }
+
+    fn sample(
+        &self,
+        camera_model: &CameraModel,
+        x: f32,
+        y: f32,
+        rng: &mut Rng,
+        counters: &mut SampleCounters,
+        scratch: &mut BdptScratch,
+        splats: &mut Vec<Splat>,
+    ) -> Vec3A {
+        let max_depth = self.max_depth as usize;
+        let camera = &mut scratch.camera;
+        let light = &mut scratch.light;
+        let n_camera =
+            self.camera_subpath(camera_model, x, y, camera, max_depth + 2, rng, counters);
+        let n_light = self.light_subpath(light, max_depth + 1, rng, counters);
+        let mut radiance = Vec3A::ZERO;
+
+        for t in 1..=n_camera {
+            for s in 0..=n_light {
+                let depth = s + t;
+                if depth < 2 || depth - 2 > max_depth || (s == 1 && t == 1) {
+                    continue;
+                }
+                if s == 0 {
+                    // The camera subpath reached an emitter.
+                    let pt = camera[t - 1];
+                    if pt.kind != VertexKind::Surface {
+                        continue;
+                    }
+                    let le = self.emitted(&pt, pt.wo);
+                    if le.max_element() <= 0.0 {
+                        continue;
+                    }
+                    let weight = self.mis_weight(camera_model, camera, light, 0, t);
+                    radiance += pt.beta * le * weight;
+                } else if t == 1 {
+                    // Light tracing: connect a light-subpath vertex to the lens.
+                    let qs = light[s - 1];
+                    if !qs.connectible() {
+                        continue;
+                    }
+                    let lens = camera_model.sample_lens(rng.uniform2());
+                    let to_lens = lens - qs.p;
+                    let distance2 = to_lens.length_squared();
+                    if distance2 == 0.0 {
+                        continue;
+                    }
+                    let direction = -to_lens / distance2.sqrt();
+                    let Some(importance) = camera_model.importance(lens, direction) else {
+                        continue;
+                    };
+                    let cos_lens = direction.dot(camera_model.forward);
+                    // Density of the lens point in solid angle at qs.
+                    let pdf = distance2 / cos_lens / camera_model.lens_area();
+                    let sampled = Vertex {
+                        kind: VertexKind::Camera,
+                        p: lens,
+                        normal: camera_model.forward,
+                        beta: Vec3A::splat(importance.importance / pdf),
+                        ..Vertex::EMPTY
+                    };
+                    // s >= 2 here, so qs is a surface vertex.
+                    let contribution =
+                        qs.beta * sampled.beta * self.f(&qs, lens) * direction.dot(qs.normal).abs();
+                    if contribution.max_element() <= 0.0 || !self.visible(&qs, &sampled, counters) {
+                        continue;
+                    }
+                    let saved = camera[0];
+                    camera[0] = sampled;
+                    let weight = self.mis_weight(camera_model, camera, light, s, 1);
+                    camera[0] = saved;
+                    let [rx, ry] = importance.raster;
+                    let pixel = ry as u32 * camera_model.width + rx as u32;
+                    splats.push(Splat {
+                        pixel,
+                        value: contribution * weight,
+                    });
+                } else if s == 1 {
+                    // Next-event estimation: a new point on a light.
+                    let pt = camera[t - 1];
+                    if !pt.connectible() || pt.kind != VertexKind::Surface {
+                        continue;
+                    }
+                    let u_select = rng.uniform();
+                    let u_point = rng.uniform2();
+                    let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
+                    let l = &self.scene.lights[index];
+                    let [b1, b2] = uniform_triangle(u_point);
+                    let sampled = Vertex {
+                        kind: VertexKind::Light,
+                        p: l.v0 + l.edge1 * b1 + l.edge2 * b2,
+                        normal: l.normal,
+                        beta: l.emission / l.area_pdf,
+                        pdf_forward: l.area_pdf,
+                        triangle: l.triangle,
+                        ..Vertex::EMPTY
+                    };
+                    let d = sampled.p - pt.p;
+                    let distance2 = d.length_squared();
+                    if distance2 == 0.0 {
+                        continue;
+                    }
+                    let w = d / distance2.sqrt();
+                    let cos_light = -w.dot(l.normal);
+                    if cos_light <= 0.0 {
+                        continue;
+                    }
+                    let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
+                    let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
+                    if contribution.max_element() <= 0.0 || !self.visible(&pt, &sampled, counters) {
+                        continue;
+                    }
+                    let saved = light[0];
+                    light[0] = sampled;
+                    let weight = self.mis_weight(camera_model, camera, light, 1, t);
+                    light[0] = saved;
+                    radiance += contribution * weight;
+                } else {
+                    // Connect light vertex s-1 and camera vertex t-1.
+                    let qs = light[s - 1];
+                    let pt = camera[t - 1];
+                    if !qs.connectible() || !pt.connectible() {
+                        continue;
+                    }
+                    let d = pt.p - qs.p;
+                    let distance2 = d.length_squared();
+                    if distance2 == 0.0 {
+                        continue;
+                    }
+                    let w = d / distance2.sqrt();
+                    let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
+                    let contribution =
+                        qs.beta * self.f(&qs, pt.p) * self.f(&pt, qs.p) * pt.beta * geometry;
+                    if contribution.max_element() <= 0.0 || !self.visible(&qs, &pt, counters) {
+                        continue;
+                    }
+                    let weight = self.mis_weight(camera_model, camera, light, s, t);
+                    radiance += contribution * weight;
+                }
+            }
+        }
+        radiance
+    }
+}

@@ -1,0 +1,119 @@
+//! Bidirectional path tracing against ground truth and against the path tracer: the white
+//! furnace, the analytic area light, and the Cornell scenes (image mean and per-region means
+//! within 4 combined standard errors, a 2% bias resolvable). Light tracing splats land on
+//! arbitrary pixels; the image must still be identical for any thread count.
+
+mod common;
+
+use common::*;
+use mlt::{Algorithm, Camera, RenderSettings, Scene, render};
+
+#[allow(clippy::too_many_arguments)]
+fn render_with(
+    scene: &Scene,
+    camera: &Camera,
+    algorithm: Algorithm,
+    size: u32,
+    spp: u32,
+    max_depth: u32,
+    seed: u64,
+    threads: u32,
+) -> Vec<f32> {
+    let settings = RenderSettings {
+        width: size,
+        height: size,
+        algorithm,
+        samples_per_pixel: spp,
+        max_depth,
+        seed,
+        threads,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; (size * size * 3) as usize];
+    let stats = render(scene, camera, &settings, &mut image, None).unwrap();
+    assert_eq!(stats.invalid_samples, 0);
+    image
+}
+
+fn estimate(
+    scene: &Scene,
+    camera: &Camera,
+    algorithm: Algorithm,
+    size: u32,
+    spp: u32,
+    seeds: std::ops::Range<u64>,
+) -> Estimate {
+    let renders: Vec<Vec<f32>> = seeds
+        .map(|seed| render_with(scene, camera, algorithm, size, spp, 5, seed, 0))
+        .collect();
+    Estimate::from_renders(size as usize, size as usize, &renders)
+}
+
+fn load(name: &str) -> (Scene, Camera) {
+    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    (scene, data.camera.unwrap().camera)
+}
+
+#[test]
+fn bdpt_furnace_matches_the_geometric_series() {
+    let albedo = [0.5, 0.7, 0.9];
+    let emission = [1.0, 0.5, 2.0];
+    let scene = furnace_scene(albedo, emission);
+    for depth in [1, 4] {
+        let image = render_with(
+            &scene,
+            &furnace_camera(),
+            Algorithm::Bdpt,
+            32,
+            8,
+            depth,
+            5,
+            0,
+        );
+        let (mean, error) = mean_and_standard_error(&image);
+        for c in 0..3 {
+            let a = albedo[c] as f64;
+            let truth = emission[c] as f64 * (0..=depth).map(|k| a.powi(k as i32)).sum::<f64>();
+            // Splats make neighbouring pixels slightly correlated; 5 standard errors.
+            let tolerance = 5.0 * error[c];
+            assert!(
+                (mean[c] - truth).abs() <= tolerance,
+                "depth {depth} channel {c}: {} vs {truth} ± {tolerance}",
+                mean[c]
+            );
+            assert!((mean[c] - truth * 1.02).abs() > tolerance);
+            assert!((mean[c] - truth * 0.98).abs() > tolerance);
+        }
+    }
+}
+
+#[test]
+fn bdpt_agrees_with_the_path_tracer_on_the_cornell_box() {
+    let (scene, camera) = load("cornell-box");
+    let reference = estimate(&scene, &camera, Algorithm::Path, 64, 256, 1000..1004);
+    let test = estimate(&scene, &camera, Algorithm::Bdpt, 64, 64, 0..4);
+    assert_estimates_agree("cornell-box bdpt", &test, &reference, 4, 4.0);
+}
+
+#[test]
+fn bdpt_agrees_with_the_path_tracer_on_cornell_glass() {
+    let (scene, camera) = load("cornell-glass");
+    let reference = estimate(&scene, &camera, Algorithm::Path, 64, 256, 1000..1004);
+    let test = estimate(&scene, &camera, Algorithm::Bdpt, 64, 64, 0..4);
+    assert_estimates_agree("cornell-glass bdpt", &test, &reference, 4, 4.0);
+}
+
+#[test]
+fn bdpt_image_is_identical_for_any_thread_count() {
+    let (scene, camera) = load("cornell-glass");
+    let bits = |threads| {
+        render_with(&scene, &camera, Algorithm::Bdpt, 40, 3, 5, 9, threads)
+            .iter()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    let one = bits(1);
+    assert_eq!(one, bits(2));
+    assert_eq!(one, bits(3));
+}
