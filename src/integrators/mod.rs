@@ -1,6 +1,7 @@
 //! Light-transport estimators.
 
 pub mod bdpt;
+pub mod mlt;
 pub mod path;
 
 use crate::accel::Ray;
