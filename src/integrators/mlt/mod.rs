@@ -8,10 +8,11 @@
 /// left (chains may start there only by accident).
 #[inline]
 pub fn acceptance(f_current: f32, f_proposal: f32, transfer_ratio: f32) -> f32 {
-    if !(f_proposal > 0.0 && transfer_ratio > 0.0) {
+    let proposal_possible = f_proposal > 0.0 && transfer_ratio > 0.0;
+    if !proposal_possible {
         return 0.0;
     }
-    if !(f_current > 0.0) {
+    if f_current.is_nan() || f_current <= 0.0 {
         return 1.0;
     }
     (f_proposal * transfer_ratio / f_current).min(1.0)
