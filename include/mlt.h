@@ -70,6 +70,13 @@
 #define MLT_ALGORITHM_BDPT 1
 
 /**
+ * `MltRenderSettings.algorithm`: primary-sample-space Metropolis light transport (Kelemen
+ * et al. 2002) over the path tracer; uses the `mutations_per_pixel`, `bootstrap_samples`,
+ * `chains`, `large_step_probability` and `small_step_sigma` settings.
+ */
+#define MLT_ALGORITHM_PSSMLT 2
+
+/**
  * `MltHit.triangle_id` of a ray that hit nothing.
  */
 #define MLT_INVALID_ID UINT32_MAX
@@ -87,6 +94,8 @@
 #define MLT_MAX_THREADS 4096
 
 #define MLT_MAX_TIME_LIMIT_SECONDS 1.0e7
+
+#define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
 
 /**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
@@ -259,6 +268,28 @@ typedef struct MltRenderSettings {
    * Stop after this many seconds (0: no limit). Finite, at most 1e7.
    */
   double time_limit_seconds;
+  /**
+   * Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
+   */
+  uint32_t mutations_per_pixel;
+  /**
+   * Metropolis: independent samples that estimate the image normalization and seed the
+   * chains, in [1, 2^28].
+   */
+  uint32_t bootstrap_samples;
+  /**
+   * Metropolis: number of Markov chains, in [1, bootstrap_samples]. The image does not
+   * depend on the thread count.
+   */
+  uint32_t chains;
+  /**
+   * PSSMLT: probability of a large (independent) step, in [0, 1].
+   */
+  float large_step_probability;
+  /**
+   * PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
+   */
+  float small_step_sigma;
 } MltRenderSettings;
 
 /**
@@ -313,6 +344,15 @@ typedef struct MltRenderStats {
    * Worker threads used.
    */
   uint32_t threads;
+  /**
+   * Metropolis: accepted mutations (`samples` counts all mutations).
+   */
+  uint64_t accepted_mutations;
+  /**
+   * Metropolis: the normalization b (mean luminance of the path contribution) the image
+   * was scaled by.
+   */
+  double normalization;
 } MltRenderStats;
 
 /**

@@ -39,6 +39,10 @@ pub const MLT_ALGORITHM_PATH: i32 = 0;
 /// `MltRenderSettings.algorithm`: bidirectional path tracing, all strategies combined by MIS
 /// (including light tracing onto the film).
 pub const MLT_ALGORITHM_BDPT: i32 = 1;
+/// `MltRenderSettings.algorithm`: primary-sample-space Metropolis light transport (Kelemen
+/// et al. 2002) over the path tracer; uses the `mutations_per_pixel`, `bootstrap_samples`,
+/// `chains`, `large_step_probability` and `small_step_sigma` settings.
+pub const MLT_ALGORITHM_PSSMLT: i32 = 2;
 
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
@@ -125,6 +129,18 @@ pub struct MltRenderSettings {
     pub seed: u64,
     /// Stop after this many seconds (0: no limit). Finite, at most 1e7.
     pub time_limit_seconds: f64,
+    /// Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
+    pub mutations_per_pixel: u32,
+    /// Metropolis: independent samples that estimate the image normalization and seed the
+    /// chains, in [1, 2^28].
+    pub bootstrap_samples: u32,
+    /// Metropolis: number of Markov chains, in [1, bootstrap_samples]. The image does not
+    /// depend on the thread count.
+    pub chains: u32,
+    /// PSSMLT: probability of a large (independent) step, in [0, 1].
+    pub large_step_probability: f32,
+    /// PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
+    pub small_step_sigma: f32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -141,6 +157,11 @@ pub struct MltRenderStats {
     pub seconds: f64,
     /// Worker threads used.
     pub threads: u32,
+    /// Metropolis: accepted mutations (`samples` counts all mutations).
+    pub accepted_mutations: u64,
+    /// Metropolis: the normalization b (mean luminance of the path contribution) the image
+    /// was scaled by.
+    pub normalization: f64,
 }
 
 /// Facts about a created scene.
@@ -343,9 +364,10 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
     let algorithm = match s.algorithm {
         MLT_ALGORITHM_PATH => Algorithm::Path,
         MLT_ALGORITHM_BDPT => Algorithm::Bdpt,
+        MLT_ALGORITHM_PSSMLT => Algorithm::Pssmlt,
         other => {
             return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0) or MLT_ALGORITHM_BDPT (1)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1) or MLT_ALGORITHM_PSSMLT (2)"
             )));
         }
     };
@@ -358,6 +380,11 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         seed: s.seed,
         threads: s.threads,
         time_limit_seconds: s.time_limit_seconds,
+        mutations_per_pixel: s.mutations_per_pixel,
+        bootstrap_samples: s.bootstrap_samples,
+        chains: s.chains,
+        large_step_probability: s.large_step_probability,
+        small_step_sigma: s.small_step_sigma,
     })
 }
 
@@ -485,6 +512,11 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             threads: d.threads,
             seed: d.seed,
             time_limit_seconds: d.time_limit_seconds,
+            mutations_per_pixel: d.mutations_per_pixel,
+            bootstrap_samples: d.bootstrap_samples,
+            chains: d.chains,
+            large_step_probability: d.large_step_probability,
+            small_step_sigma: d.small_step_sigma,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;
@@ -674,6 +706,8 @@ pub unsafe extern "C" fn mlt_render_ex(
                 invalid_samples: stats.invalid_samples,
                 seconds: stats.seconds,
                 threads: stats.threads,
+                accepted_mutations: stats.accepted_mutations,
+                normalization: stats.normalization,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };

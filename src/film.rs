@@ -14,6 +14,8 @@ pub struct Film {
     splats: Vec<[f64; 3]>,
     /// Light paths traced in all, the normalization of the splats.
     light_paths: u64,
+    /// Overrides the splat normalization (Metropolis: b / mutations per pixel).
+    splat_scale: Option<f64>,
 }
 
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
@@ -38,7 +40,13 @@ impl Film {
                 Vec::new()
             },
             light_paths: 0,
+            splat_scale: None,
         }
+    }
+
+    /// Sets the factor splats are multiplied by, instead of pixels / light paths.
+    pub fn set_splat_scale(&mut self, scale: f64) {
+        self.splat_scale = Some(scale);
     }
 
     /// Adds the splats of a work unit (in the unit's order) and the light paths it traced.
@@ -78,7 +86,9 @@ impl Film {
     /// pixel (each light path's splats estimate the whole film once).
     pub fn write_rgb(&self, out: &mut [f32]) {
         let pixels = self.counts.len() as f64;
-        let splat_scale = if self.light_paths > 0 {
+        let splat_scale = if let Some(scale) = self.splat_scale {
+            scale
+        } else if self.light_paths > 0 {
             pixels / self.light_paths as f64
         } else {
             0.0

@@ -4,6 +4,7 @@
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
+use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
 use crate::integrators::path::PathTracer;
 use crate::integrators::{PixelEstimator, SampleCounters, Splat};
 use crate::sampling::Rng;
@@ -11,7 +12,7 @@ use crate::scene::{Camera, CameraModel, Scene};
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc;
+use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 /// The light-transport algorithm of a render.
@@ -22,12 +23,15 @@ pub enum Algorithm {
     Path,
     /// Bidirectional path tracing: every connection strategy, combined by MIS.
     Bdpt,
+    /// Primary-sample-space Metropolis light transport (Kelemen) over the path tracer.
+    Pssmlt,
 }
 
 /// The estimator a render runs, chosen from the settings.
 enum Estimator<'a> {
     Path(&'a PathTracer<'a>),
     Bdpt(&'a Bdpt<'a>),
+    Pssmlt(&'a PathTracer<'a>),
 }
 
 impl Estimator<'_> {
@@ -37,22 +41,42 @@ impl Estimator<'_> {
         settings: &RenderSettings,
         film: &mut Film,
         control: &Control,
-    ) {
+    ) -> PssmltOutcome {
         match *self {
-            Estimator::Path(estimator) => CameraSampleJob {
-                estimator,
-                camera: *camera,
-                seed: settings.seed,
-                samples_per_pixel: settings.samples_per_pixel,
+            Estimator::Path(estimator) => {
+                CameraSampleJob {
+                    estimator,
+                    camera: *camera,
+                    seed: settings.seed,
+                    samples_per_pixel: settings.samples_per_pixel,
+                }
+                .run(film, control);
+                PssmltOutcome::default()
             }
-            .run(film, control),
-            Estimator::Bdpt(estimator) => CameraSampleJob {
-                estimator,
-                camera: *camera,
-                seed: settings.seed,
-                samples_per_pixel: settings.samples_per_pixel,
+            Estimator::Bdpt(estimator) => {
+                CameraSampleJob {
+                    estimator,
+                    camera: *camera,
+                    seed: settings.seed,
+                    samples_per_pixel: settings.samples_per_pixel,
+                }
+                .run(film, control);
+                PssmltOutcome::default()
             }
-            .run(film, control),
+            Estimator::Pssmlt(tracer) => pssmlt::run(
+                tracer,
+                camera,
+                &PssmltSettings {
+                    mutations_per_pixel: settings.mutations_per_pixel,
+                    bootstrap_samples: settings.bootstrap_samples,
+                    chains: settings.chains,
+                    large_step_probability: settings.large_step_probability,
+                    small_step_sigma: settings.small_step_sigma,
+                    seed: settings.seed,
+                },
+                film,
+                control,
+            ),
         }
     }
 }
@@ -64,6 +88,7 @@ pub const MLT_MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
 pub const MLT_MAX_DEPTH_LIMIT: u32 = 1024;
 pub const MLT_MAX_THREADS: u32 = 4096;
 pub const MLT_MAX_TIME_LIMIT_SECONDS: f64 = 1.0e7;
+pub const MLT_MAX_BOOTSTRAP_SAMPLES: u32 = 1 << 28;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -79,6 +104,16 @@ pub struct RenderSettings {
     pub threads: u32,
     /// Stop after this many seconds; 0 means no limit.
     pub time_limit_seconds: f64,
+    /// Metropolis: mutations per pixel; 0 means "until the time limit".
+    pub mutations_per_pixel: u32,
+    /// Metropolis: independent samples that estimate the normalization b and seed the chains.
+    pub bootstrap_samples: u32,
+    /// Metropolis: number of Markov chains (independent of the thread count).
+    pub chains: u32,
+    /// PSSMLT: probability that a mutation is a large (independent) step.
+    pub large_step_probability: f32,
+    /// PSSMLT: standard deviation of a small step in primary sample space.
+    pub small_step_sigma: f32,
 }
 
 impl Default for RenderSettings {
@@ -92,6 +127,11 @@ impl Default for RenderSettings {
             seed: 0,
             threads: 0,
             time_limit_seconds: 0.0,
+            mutations_per_pixel: 64,
+            bootstrap_samples: 1 << 20,
+            chains: 1024,
+            large_step_probability: 0.3,
+            small_step_sigma: 0.01,
         }
     }
 }
@@ -129,10 +169,46 @@ impl RenderSettings {
                 "settings.time_limit_seconds is {t}; it must be 0 (no limit) or a positive number of seconds up to {MLT_MAX_TIME_LIMIT_SECONDS}"
             )));
         }
-        if self.samples_per_pixel == 0 && t == 0.0 {
+        if self.algorithm == Algorithm::Pssmlt {
+            if self.mutations_per_pixel == 0 && t == 0.0 {
+                return Err(Error::invalid(
+                    "settings.mutations_per_pixel is 0 and there is no time limit; the render would never end",
+                ));
+            }
+            if self.mutations_per_pixel > MLT_MAX_SAMPLES_PER_PIXEL {
+                return Err(Error::invalid(format!(
+                    "settings.mutations_per_pixel is {}; at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported",
+                    self.mutations_per_pixel
+                )));
+            }
+        } else if self.samples_per_pixel == 0 && t == 0.0 {
             return Err(Error::invalid(
                 "settings.samples_per_pixel is 0 and there is no time limit; the render would never end",
             ));
+        }
+        if self.bootstrap_samples == 0 || self.bootstrap_samples > MLT_MAX_BOOTSTRAP_SAMPLES {
+            return Err(Error::invalid(format!(
+                "settings.bootstrap_samples is {}; it must be between 1 and {MLT_MAX_BOOTSTRAP_SAMPLES}",
+                self.bootstrap_samples
+            )));
+        }
+        if self.chains == 0 || self.chains > self.bootstrap_samples {
+            return Err(Error::invalid(format!(
+                "settings.chains is {}; it must be between 1 and settings.bootstrap_samples ({})",
+                self.chains, self.bootstrap_samples
+            )));
+        }
+        let p = self.large_step_probability;
+        if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+            return Err(Error::invalid(format!(
+                "settings.large_step_probability is {p}; it must be in [0, 1]"
+            )));
+        }
+        let sigma = self.small_step_sigma;
+        if !(sigma.is_finite() && sigma > 0.0 && sigma <= 1.0) {
+            return Err(Error::invalid(format!(
+                "settings.small_step_sigma is {sigma}; it must be in (0, 1]"
+            )));
         }
         Ok(())
     }
@@ -163,7 +239,7 @@ pub enum StopReason {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderStats {
     pub stop: StopReason,
-    /// Camera samples taken over the whole image.
+    /// Camera samples taken over the whole image (Metropolis: mutations).
     pub samples: u64,
     /// Rays traced (closest-hit and shadow).
     pub rays: u64,
@@ -171,6 +247,10 @@ pub struct RenderStats {
     pub invalid_samples: u64,
     pub seconds: f64,
     pub threads: u32,
+    /// Metropolis: accepted mutations.
+    pub accepted_mutations: u64,
+    /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by.
+    pub normalization: f64,
 }
 
 /// Called from the rendering call's own thread with the fraction done; return `false` to stop.
@@ -206,7 +286,7 @@ pub fn render(
     let mut film = try_film(
         settings.width,
         settings.height,
-        settings.algorithm == Algorithm::Bdpt,
+        settings.algorithm != Algorithm::Path,
     )?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads as usize)
@@ -249,31 +329,37 @@ pub fn render(
             };
             Estimator::Bdpt(&bdpt)
         }
+        Algorithm::Pssmlt => {
+            path_tracer = PathTracer {
+                scene,
+                max_depth: settings.max_depth,
+            };
+            Estimator::Pssmlt(&path_tracer)
+        }
     };
     let pixels = settings.width as u64 * settings.height as u64;
-    let planned = if settings.samples_per_pixel > 0 {
-        settings.samples_per_pixel as u64 * pixels
+    let per_pixel = if settings.algorithm == Algorithm::Pssmlt {
+        settings.mutations_per_pixel
     } else {
-        0
+        settings.samples_per_pixel
     };
+    let planned = per_pixel as u64 * pixels;
 
     let mut progress = progress;
+    let done = DoneSignal::default();
     let outcome = std::thread::scope(|s| {
-        let (done_tx, done_rx) = mpsc::channel::<()>();
+        let done = &done;
         let control = &control;
         let film = &mut film;
         let estimator = &estimator;
         let model = &model;
         let pool = &pool;
         let worker = s.spawn(move || {
-            pool.install(|| estimator.run(model, settings, film, control));
-            let _ = done_tx.send(());
+            // Signals even when the render panics, so the caller never waits forever.
+            let _signal = SignalOnDrop(done);
+            pool.install(|| estimator.run(model, settings, film, control))
         });
-        loop {
-            match done_rx.recv_timeout(PROGRESS_INTERVAL) {
-                Ok(()) | Err(mpsc::RecvTimeoutError::Disconnected) => break,
-                Err(mpsc::RecvTimeoutError::Timeout) => {}
-            }
+        while !done.wait(PROGRESS_INTERVAL) {
             if let Some(callback) = progress.as_mut() {
                 let fraction = control.fraction(planned, start);
                 if !callback(fraction) {
@@ -287,14 +373,14 @@ pub fn render(
         }
         worker.join()
     });
-    if outcome.is_err() {
+    let Ok(metropolis) = outcome else {
         return Err(Error::new(
             MLT_STATUS_INTERNAL_ERROR,
             "a rendering thread panicked; this is a bug in mlt",
         ));
-    }
+    };
     film.write_rgb(&mut rgb_out[..needed]);
-    let samples = film.sample_count();
+    let samples = control.samples_done.load(Ordering::Relaxed);
     let stop = if control.cancelled.load(Ordering::Relaxed) {
         StopReason::Cancelled
     } else if planned == 0 || samples < planned {
@@ -313,7 +399,38 @@ pub fn render(
         invalid_samples: control.invalid.load(Ordering::Relaxed),
         seconds: start.elapsed().as_secs_f64(),
         threads,
+        accepted_mutations: metropolis.accepted,
+        normalization: metropolis.normalization,
     })
+}
+
+/// Tells the calling thread the render finished. A mutex and condition variable rather than
+/// a channel: waiting on them never allocates, so allocation counts do not depend on timing.
+#[derive(Default)]
+struct DoneSignal {
+    done: Mutex<bool>,
+    changed: Condvar,
+}
+
+impl DoneSignal {
+    /// Waits up to `timeout`; returns whether the render has finished.
+    fn wait(&self, timeout: Duration) -> bool {
+        let guard = self.done.lock().unwrap_or_else(|e| e.into_inner());
+        let (guard, _) = self
+            .changed
+            .wait_timeout_while(guard, timeout, |done| !*done)
+            .unwrap_or_else(|e| e.into_inner());
+        *guard
+    }
+}
+
+struct SignalOnDrop<'a>(&'a DoneSignal);
+
+impl Drop for SignalOnDrop<'_> {
+    fn drop(&mut self) {
+        *self.0.done.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.0.changed.notify_all();
+    }
 }
 
 /// Allocates the film, reporting failure as a status instead of aborting.
@@ -332,18 +449,18 @@ fn try_film(width: u32, height: u32, with_splats: bool) -> Result<Film> {
 }
 
 /// Shared state between the workers and the calling thread.
-struct Control {
+pub(crate) struct Control {
     /// Set when workers should finish their current band and start no more.
     stop: AtomicBool,
     cancelled: AtomicBool,
     deadline: Option<Instant>,
-    samples_done: AtomicU64,
-    rays: AtomicU64,
+    pub(crate) samples_done: AtomicU64,
+    pub(crate) rays: AtomicU64,
     invalid: AtomicU64,
 }
 
 impl Control {
-    fn should_stop(&self) -> bool {
+    pub(crate) fn should_stop(&self) -> bool {
         if self.stop.load(Ordering::Relaxed) {
             return true;
         }

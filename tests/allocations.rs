@@ -1,5 +1,6 @@
-//! No heap allocation per sample: a render with 10× the samples (and more passes) makes exactly as many
-//! allocations. A counting global allocator sees every thread's allocations.
+//! No heap allocation per sample or mutation: a render with 10× the samples makes as many
+//! allocations, up to the scheduling noise of rayon's internals (see below). A counting global
+//! allocator sees every thread's allocations.
 
 mod common;
 
@@ -37,28 +38,39 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 fn allocations_do_not_grow_with_samples() {
     let scene = furnace_scene([0.5; 3], [1.0; 3]);
     let camera = furnace_camera();
-    let mut image = vec![0.0; 128 * 128 * 3];
-    let mut count = |algorithm: Algorithm, spp: u32| {
+    let mut image = vec![0.0; 32 * 32 * 3];
+    let mut count = |algorithm: Algorithm, per_pixel: u32| {
         let settings = RenderSettings {
             algorithm,
-            width: 128,
-            height: 128,
-            samples_per_pixel: spp,
+            width: 32,
+            height: 32,
+            samples_per_pixel: per_pixel,
+            mutations_per_pixel: per_pixel,
+            bootstrap_samples: 4096,
+            chains: 64,
             threads: 2,
+            max_depth: 3,
             ..Default::default()
         };
         let before = ALLOCATIONS.load(Ordering::SeqCst);
         render(&scene, &camera, &settings, &mut image, None).unwrap();
         ALLOCATIONS.load(Ordering::SeqCst) - before
     };
-    for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
+    for algorithm in [Algorithm::Path, Algorithm::Bdpt, Algorithm::Pssmlt] {
+        // 32 x 32 pixels: both renders take the same number of passes (one sample, then up
+        // to 64 per pass) and rounds, so only per-sample allocations could differ.
         count(algorithm, 1); // warm up lazily initialized runtime state
-        let few = count(algorithm, 2);
-        let many = count(algorithm, 20);
+        // Rayon's work-stealing deques retire buffers through crossbeam-epoch, which
+        // allocates 2 KiB garbage bags depending on scheduling: a render's count varies by
+        // a couple either way. The fewest over a few renders, compared with a slack of 2,
+        // still catches any per-sample allocation (18,432 more samples here).
+        let mut fewest = |per_pixel| (0..3).map(|_| count(algorithm, per_pixel)).min().unwrap();
+        let few = fewest(2);
+        let many = fewest(20);
         assert!(few > 0, "the counter must see the render's own allocations");
-        assert_eq!(
-            few, many,
-            "{algorithm:?}: 2 spp made {few} allocations, 20 spp made {many}"
+        assert!(
+            many.abs_diff(few) <= 2,
+            "{algorithm:?}: 2 samples (or mutations) per pixel made {few} allocations, 20 made {many}"
         );
     }
 }

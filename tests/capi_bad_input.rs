@@ -1070,7 +1070,7 @@ fn zero_samples_without_time_limit() {
 #[test]
 fn unknown_algorithm() {
     let scene = HostScene::floor_and_light().create();
-    for bad in [2, -1, i32::MAX] {
+    for bad in [3, -1, i32::MAX] {
         let s = MltRenderSettings {
             algorithm: bad,
             ..small_settings(4, 4, 1)

@@ -59,13 +59,25 @@ fn cornell_glass_agrees_with_a_long_render() {
 fn cornell_error_falls_like_one_over_square_root_of_samples() {
     let (scene, camera) = load("cornell-box");
     let reference = estimate(&scene, &camera, 256, 2000..2004).image;
-    let coarse = rmse(&render_image(&scene, &camera, 4, 1), &reference);
-    let fine = rmse(&render_image(&scene, &camera, 64, 2), &reference);
-    // The reference's own noise (1024 spp) adds to both: expected ratio
-    // sqrt((1/4 + 1/1024) / (1/64 + 1/1024)) = 3.89.
+    // Mean squared error over four renders: pixels on the light's edge make a single
+    // render's error heavy-tailed at low sample counts.
+    let rms_error = |spp: u32, seeds: std::ops::Range<u64>| {
+        let renders = (seeds.end - seeds.start) as f64;
+        let mse: f64 = seeds
+            .map(|seed| rmse(&render_image(&scene, &camera, spp, seed), &reference).powi(2))
+            .sum::<f64>()
+            / renders;
+        mse.sqrt()
+    };
+    let coarse = rms_error(16, 0..4);
+    let fine = rms_error(256, 10..14);
+    // 16× the samples shrink the error 4×; the reference's own noise (1024 spp) adds to
+    // both: expected ratio sqrt((1/16 + 1/1024) / (1/256 + 1/1024)) = 3.61 to 4 (the
+    // light-edge pixels keep the 16 spp error heavy-tailed, so its estimate is loose). A
+    // biased estimator's error stops shrinking (ratio near 1); a 1/N^¼ rate gives 2.
     let ratio = coarse / fine;
     assert!(
-        (3.3..=4.5).contains(&ratio),
+        (3.0..=4.6).contains(&ratio),
         "ratio {ratio} ({coarse} / {fine})"
     );
 }

@@ -16,6 +16,8 @@ enum AlgorithmArg {
     Path,
     /// Bidirectional path tracing with MIS over every connection strategy.
     Bdpt,
+    /// Primary-sample-space Metropolis light transport over the path tracer.
+    Pssmlt,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -45,6 +47,21 @@ struct Args {
     /// Samples per pixel (0: until the time limit).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().samples_per_pixel)]
     spp: u32,
+    /// Metropolis: mutations per pixel (0: until the time limit).
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().mutations_per_pixel)]
+    mutations_per_pixel: u32,
+    /// Metropolis: bootstrap samples estimating the normalization and seeding the chains.
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().bootstrap_samples)]
+    bootstrap: u32,
+    /// Metropolis: number of Markov chains.
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().chains)]
+    chains: u32,
+    /// PSSMLT: probability of a large (independent) step.
+    #[arg(long, value_name = "P", default_value_t = RenderSettings::default().large_step_probability)]
+    large_step: f32,
+    /// PSSMLT: standard deviation of a small step in primary sample space.
+    #[arg(long, value_name = "SIGMA", default_value_t = RenderSettings::default().small_step_sigma)]
+    small_step: f32,
     /// Stop after this many seconds (0: no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
     time_limit: f64,
@@ -166,12 +183,18 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         algorithm: match args.algorithm {
             AlgorithmArg::Path => mlt::Algorithm::Path,
             AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
+            AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
         },
         samples_per_pixel: args.spp,
         max_depth: args.max_depth,
         seed: args.seed,
         threads: args.threads,
         time_limit_seconds: args.time_limit,
+        mutations_per_pixel: args.mutations_per_pixel,
+        bootstrap_samples: args.bootstrap,
+        chains: args.chains,
+        large_step_probability: args.large_step,
+        small_step_sigma: args.small_step,
     }
 }
 
@@ -259,6 +282,13 @@ fn print_summary(
         stats.rays as f64 / seconds / 1e6
     );
     println!("  threads    {}", stats.threads);
+    if stats.normalization > 0.0 {
+        println!(
+            "  metropolis b = {:.6}, {:.1}% of mutations accepted",
+            stats.normalization,
+            100.0 * stats.accepted_mutations as f64 / stats.samples.max(1) as f64
+        );
+    }
     if stats.invalid_samples > 0 {
         println!(
             "  invalid    {} samples with non-finite radiance dropped",

@@ -3,7 +3,7 @@
 
 use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
-use crate::sampling::{Rng, power_heuristic, uniform_triangle};
+use crate::sampling::{Rng, Sampler, power_heuristic, uniform_triangle};
 use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;
 
@@ -21,11 +21,11 @@ pub struct PathTracer<'a> {
 impl PathTracer<'_> {
     /// Radiance arriving at `origin` from `direction` (unit length). `rays` counts traced rays.
     #[inline]
-    pub fn radiance(
+    pub fn radiance<S: Sampler>(
         &self,
         origin: Vec3A,
         direction: Vec3A,
-        rng: &mut Rng,
+        rng: &mut S,
         rays: &mut u64,
     ) -> Vec3A {
         let scene = self.scene;
@@ -102,13 +102,13 @@ impl PathTracer<'_> {
     /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
     /// against BSDF sampling. Returns the contribution before the path throughput.
     #[inline]
-    fn sample_light(
+    fn sample_light<S: Sampler>(
         &self,
         p: Vec3A,
         normal: Vec3A,
         wo: Vec3A,
         material: &crate::scene::Material,
-        rng: &mut Rng,
+        rng: &mut S,
         rays: &mut u64,
     ) -> Vec3A {
         let scene = self.scene;

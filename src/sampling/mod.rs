@@ -2,10 +2,12 @@
 
 mod distribution;
 mod rng;
+mod sampler;
 mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
 pub use rng::Rng;
+pub use sampler::Sampler;
 pub use warp::{
     OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic, uniform_disk,
     uniform_triangle,

@@ -27,7 +27,9 @@ impl Rng {
             increment: (mix64(stream ^ 0x9e37_79b9_7f4a_7c15) << 1) | 1,
         };
         rng.next_u32();
-        rng.state = rng.state.wrapping_add(mix64(seed));
+        // The starting state depends on the stream too: PCG streams that differ only in
+        // their increment and share a state are correlated.
+        rng.state = rng.state.wrapping_add(mix64(seed ^ mix64(stream)));
         rng.next_u32();
         rng
     }

@@ -158,6 +158,9 @@ pub struct Estimate {
     pub image: Vec<f32>,
     /// Variance of each float of `image` (the variance of a mean over the renders).
     pub variance: Vec<f64>,
+    /// The renders, kept when pixels of one render are correlated (Metropolis), so region
+    /// variances come from the spread of whole-region means between renders.
+    correlated_renders: Vec<Vec<f32>>,
 }
 
 impl Estimate {
@@ -186,11 +189,25 @@ impl Estimate {
             height,
             image,
             variance,
+            correlated_renders: Vec::new(),
+        }
+    }
+
+    /// As `from_renders`, for estimators whose pixels are correlated within a render (Markov
+    /// chains): variances of means over regions are then estimated from the spread of the
+    /// region means between the independent renders.
+    pub fn from_correlated_renders(width: usize, height: usize, renders: &[Vec<f32>]) -> Self {
+        Estimate {
+            correlated_renders: renders.to_vec(),
+            ..Estimate::from_renders(width, height, renders)
         }
     }
 
     /// Mean RGB over the pixels of a rectangle and the variance of that mean.
     pub fn region(&self, x0: usize, y0: usize, x1: usize, y1: usize) -> ([f64; 3], [f64; 3]) {
+        if !self.correlated_renders.is_empty() {
+            return self.region_between_renders(x0, y0, x1, y1);
+        }
         let mut mean = [0.0; 3];
         let mut variance = [0.0; 3];
         let count = ((x1 - x0) * (y1 - y0)) as f64;
@@ -207,6 +224,37 @@ impl Estimate {
             mean.map(|m| m / count),
             variance.map(|v| v / (count * count)),
         )
+    }
+
+    fn region_between_renders(
+        &self,
+        x0: usize,
+        y0: usize,
+        x1: usize,
+        y1: usize,
+    ) -> ([f64; 3], [f64; 3]) {
+        let k = self.correlated_renders.len() as f64;
+        let count = ((x1 - x0) * (y1 - y0)) as f64;
+        let means: Vec<[f64; 3]> = self
+            .correlated_renders
+            .iter()
+            .map(|render| {
+                let mut m = [0.0; 3];
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        for (c, mc) in m.iter_mut().enumerate() {
+                            *mc += render[(y * self.width + x) * 3 + c] as f64;
+                        }
+                    }
+                }
+                m.map(|v| v / count)
+            })
+            .collect();
+        let mean: [f64; 3] = std::array::from_fn(|c| means.iter().map(|m| m[c]).sum::<f64>() / k);
+        let variance = std::array::from_fn(|c| {
+            means.iter().map(|m| (m[c] - mean[c]).powi(2)).sum::<f64>() / (k - 1.0) / k
+        });
+        (mean, variance)
     }
 
     /// Whole-image mean and its variance.

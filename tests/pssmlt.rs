@@ -1,0 +1,166 @@
+//! Primary-sample-space MLT against ground truth and the path tracer: the white furnace, the
+//! Cornell scenes (image mean and per-region means within 4 combined standard errors
+//! estimated from independent renders; a 2% bias resolvable), identical images for any
+//! thread count, and a stopped render normalized by the mutations actually made.
+
+mod common;
+
+use common::*;
+use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
+
+fn pssmlt_settings(size: u32, mutations_per_pixel: u32, seed: u64) -> RenderSettings {
+    RenderSettings {
+        width: size,
+        height: size,
+        algorithm: Algorithm::Pssmlt,
+        mutations_per_pixel,
+        bootstrap_samples: 1 << 16,
+        chains: 256,
+        seed,
+        ..Default::default()
+    }
+}
+
+fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Vec<f32> {
+    let mut image = vec![0.0; (settings.width * settings.height * 3) as usize];
+    render(scene, camera, settings, &mut image, None).unwrap();
+    image
+}
+
+fn load(name: &str) -> (Scene, Camera) {
+    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    (scene, data.camera.unwrap().camera)
+}
+
+fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
+    let renders: Vec<Vec<f32>> = (1000..1004)
+        .map(|seed| {
+            let settings = RenderSettings {
+                width: 64,
+                height: 64,
+                samples_per_pixel: 256,
+                seed,
+                ..Default::default()
+            };
+            render_image(scene, camera, &settings)
+        })
+        .collect();
+    Estimate::from_renders(64, 64, &renders)
+}
+
+/// The luminance of a PSSMLT image's mean is exactly its normalization b, so the image mean
+/// is only as good as b: enough bootstrap samples make a 2% error resolvable.
+fn pssmlt_estimate(scene: &Scene, camera: &Camera, mutations_per_pixel: u32) -> Estimate {
+    let renders: Vec<Vec<f32>> = (0..16)
+        .map(|seed| {
+            let settings = RenderSettings {
+                bootstrap_samples: 1 << 19,
+                ..pssmlt_settings(64, mutations_per_pixel, seed)
+            };
+            render_image(scene, camera, &settings)
+        })
+        .collect();
+    Estimate::from_correlated_renders(64, 64, &renders)
+}
+
+#[test]
+fn pssmlt_furnace_matches_the_geometric_series() {
+    let albedo = [0.5, 0.7, 0.9];
+    let emission = [1.0, 0.5, 2.0];
+    let scene = furnace_scene(albedo, emission);
+    let renders: Vec<Vec<f32>> = (0..4)
+        .map(|seed| {
+            let settings = RenderSettings {
+                max_depth: 3,
+                ..pssmlt_settings(32, 32, seed)
+            };
+            render_image(&scene, &furnace_camera(), &settings)
+        })
+        .collect();
+    let estimate = Estimate::from_correlated_renders(32, 32, &renders);
+    let (mean, variance) = estimate.mean();
+    for c in 0..3 {
+        let a = albedo[c] as f64;
+        let truth = emission[c] as f64 * (0..=3).map(|k| a.powi(k)).sum::<f64>();
+        let tolerance = 4.0 * variance[c].sqrt();
+        assert!(
+            (mean[c] - truth).abs() <= tolerance,
+            "channel {c}: {} vs {truth} ± {tolerance}",
+            mean[c]
+        );
+        assert!((mean[c] - truth * 1.02).abs() > tolerance);
+        assert!((mean[c] - truth * 0.98).abs() > tolerance);
+    }
+}
+
+#[test]
+fn pssmlt_agrees_with_the_path_tracer_on_the_cornell_box() {
+    let (scene, camera) = load("cornell-box");
+    let reference = path_reference(&scene, &camera);
+    let test = pssmlt_estimate(&scene, &camera, 64);
+    assert_estimates_agree("cornell-box pssmlt", &test, &reference, 4, 4.0);
+}
+
+#[test]
+fn pssmlt_agrees_with_the_path_tracer_on_cornell_glass() {
+    let (scene, camera) = load("cornell-glass");
+    let reference = path_reference(&scene, &camera);
+    let test = pssmlt_estimate(&scene, &camera, 64);
+    assert_estimates_agree("cornell-glass pssmlt", &test, &reference, 4, 4.0);
+}
+
+#[test]
+fn pssmlt_image_is_identical_for_any_thread_count() {
+    let (scene, camera) = load("cornell-glass");
+    let bits = |threads| {
+        let settings = RenderSettings {
+            threads,
+            ..pssmlt_settings(32, 8, 3)
+        };
+        render_image(&scene, &camera, &settings)
+            .iter()
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    let one = bits(1);
+    assert_eq!(one, bits(2));
+    assert_eq!(one, bits(3));
+}
+
+#[test]
+fn cancelled_pssmlt_is_normalized_by_the_mutations_made() {
+    let (scene, camera) = load("cornell-box");
+    let reference = path_reference(&scene, &camera).mean().0;
+    let settings = RenderSettings {
+        mutations_per_pixel: 1 << 20,
+        ..pssmlt_settings(64, 0, 5)
+    };
+    let mut image = vec![0.0; 64 * 64 * 3];
+    let mut calls = 0;
+    let mut cancel_soon = |_fraction: f32| {
+        calls += 1;
+        calls < 4
+    };
+    let stats = render(
+        &scene,
+        &camera,
+        &settings,
+        &mut image,
+        Some(&mut cancel_soon),
+    )
+    .unwrap();
+    assert_eq!(stats.stop, StopReason::Cancelled);
+    assert!(stats.samples > 0 && stats.samples < (1u64 << 20) * 64 * 64);
+    // A partial Metropolis image is still an estimate of the same image: its mean is right
+    // to within the noise of a short render.
+    let got = mean(&image);
+    for c in 0..3 {
+        assert!(
+            (got[c] - reference[c]).abs() < 0.1 * reference[c],
+            "channel {c}: {} vs {}",
+            got[c],
+            reference[c]
+        );
+    }
+}
