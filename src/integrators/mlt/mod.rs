@@ -1,6 +1,8 @@
 //! Metropolis light transport: Markov chains whose states are light paths (or the random
 //! numbers that generate them), accepted with the Metropolis–Hastings rule.
 
+pub mod image_chain;
+
 /// Metropolis–Hastings acceptance probability of moving from state x to proposal y:
 /// min(1, f(y)·T(y→x) / (f(x)·T(x→y))), where `f_current` = f(x), `f_proposal` = f(y) are
 /// the scalar target values (luminance of the path contribution) and `transfer_ratio` is
