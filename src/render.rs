@@ -44,23 +44,11 @@ impl Estimator<'_> {
     ) -> PssmltOutcome {
         match *self {
             Estimator::Path(estimator) => {
-                CameraSampleJob {
-                    estimator,
-                    camera: *camera,
-                    seed: settings.seed,
-                    samples_per_pixel: settings.samples_per_pixel,
-                }
-                .run(film, control);
+                CameraSampleJob::new(estimator, camera, settings).run(film, control);
                 PssmltOutcome::default()
             }
             Estimator::Bdpt(estimator) => {
-                CameraSampleJob {
-                    estimator,
-                    camera: *camera,
-                    seed: settings.seed,
-                    samples_per_pixel: settings.samples_per_pixel,
-                }
-                .run(film, control);
+                CameraSampleJob::new(estimator, camera, settings).run(film, control);
                 PssmltOutcome::default()
             }
             Estimator::Pssmlt(tracer) => pssmlt::run(
@@ -503,7 +491,16 @@ struct CameraSampleJob<'a, E> {
     samples_per_pixel: u32,
 }
 
-impl<E: PixelEstimator> CameraSampleJob<'_, E> {
+impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
+    fn new(estimator: &'a E, camera: &CameraModel, settings: &RenderSettings) -> Self {
+        CameraSampleJob {
+            estimator,
+            camera: *camera,
+            seed: settings.seed,
+            samples_per_pixel: settings.samples_per_pixel,
+        }
+    }
+
     fn run(&self, film: &mut Film, control: &Control) {
         let width = film.width;
         let pixels = width as u64 * film.height as u64;

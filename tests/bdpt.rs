@@ -49,12 +49,6 @@ fn estimate(
     Estimate::from_renders(size as usize, size as usize, &renders)
 }
 
-fn load(name: &str) -> (Scene, Camera) {
-    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).unwrap();
-    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
-    (scene, data.camera.unwrap().camera)
-}
-
 #[test]
 fn bdpt_furnace_matches_the_geometric_series() {
     let albedo = [0.5, 0.7, 0.9];
@@ -90,7 +84,7 @@ fn bdpt_furnace_matches_the_geometric_series() {
 
 #[test]
 fn bdpt_agrees_with_the_path_tracer_on_the_cornell_box() {
-    let (scene, camera) = load("cornell-box");
+    let (scene, camera) = load_canonical("cornell-box");
     let reference = estimate(&scene, &camera, Algorithm::Path, 64, 256, 1000..1004);
     let test = estimate(&scene, &camera, Algorithm::Bdpt, 64, 64, 0..4);
     assert_estimates_agree("cornell-box bdpt", &test, &reference, 4, 4.0);
@@ -98,7 +92,7 @@ fn bdpt_agrees_with_the_path_tracer_on_the_cornell_box() {
 
 #[test]
 fn bdpt_agrees_with_the_path_tracer_on_cornell_glass() {
-    let (scene, camera) = load("cornell-glass");
+    let (scene, camera) = load_canonical("cornell-glass");
     let reference = estimate(&scene, &camera, Algorithm::Path, 64, 256, 1000..1004);
     let test = estimate(&scene, &camera, Algorithm::Bdpt, 64, 64, 0..4);
     assert_estimates_agree("cornell-glass bdpt", &test, &reference, 4, 4.0);
@@ -106,7 +100,7 @@ fn bdpt_agrees_with_the_path_tracer_on_cornell_glass() {
 
 #[test]
 fn bdpt_image_is_identical_for_any_thread_count() {
-    let (scene, camera) = load("cornell-glass");
+    let (scene, camera) = load_canonical("cornell-glass");
     let bits = |threads| {
         render_with(&scene, &camera, Algorithm::Bdpt, 40, 3, 5, 9, threads)
             .iter()

@@ -7,18 +7,8 @@ mod common;
 
 use common::*;
 use mlt::{Camera, RenderSettings, Scene, render};
-use std::path::Path;
 
 const SIZE: u32 = 64;
-
-fn load(name: &str) -> (Scene, Camera) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/scenes")
-        .join(format!("{name}.obj"));
-    let data = mlt::io::load_scene(&path).unwrap();
-    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
-    (scene, data.camera.unwrap().camera)
-}
 
 fn render_image(scene: &Scene, camera: &Camera, spp: u32, seed: u64) -> Vec<f32> {
     let settings = RenderSettings {
@@ -41,7 +31,7 @@ fn estimate(scene: &Scene, camera: &Camera, spp: u32, seeds: std::ops::Range<u64
 
 #[test]
 fn cornell_box_agrees_with_a_long_render() {
-    let (scene, camera) = load("cornell-box");
+    let (scene, camera) = load_canonical("cornell-box");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
     let test = estimate(&scene, &camera, 64, 0..4);
     assert_estimates_agree("cornell-box", &test, &reference, 4, 4.0);
@@ -49,7 +39,7 @@ fn cornell_box_agrees_with_a_long_render() {
 
 #[test]
 fn cornell_glass_agrees_with_a_long_render() {
-    let (scene, camera) = load("cornell-glass");
+    let (scene, camera) = load_canonical("cornell-glass");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
     let test = estimate(&scene, &camera, 64, 0..4);
     assert_estimates_agree("cornell-glass", &test, &reference, 4, 4.0);
@@ -57,7 +47,7 @@ fn cornell_glass_agrees_with_a_long_render() {
 
 #[test]
 fn cornell_error_falls_like_one_over_square_root_of_samples() {
-    let (scene, camera) = load("cornell-box");
+    let (scene, camera) = load_canonical("cornell-box");
     let reference = estimate(&scene, &camera, 256, 2000..2004).image;
     // Mean squared error over four renders: pixels on the light's edge make a single
     // render's error heavy-tailed at low sample counts.

@@ -27,12 +27,6 @@ fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Ve
     image
 }
 
-fn load(name: &str) -> (Scene, Camera) {
-    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).unwrap();
-    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
-    (scene, data.camera.unwrap().camera)
-}
-
 fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
     let renders: Vec<Vec<f32>> = (1000..1004)
         .map(|seed| {
@@ -96,7 +90,7 @@ fn pssmlt_furnace_matches_the_geometric_series() {
 
 #[test]
 fn pssmlt_agrees_with_the_path_tracer_on_the_cornell_box() {
-    let (scene, camera) = load("cornell-box");
+    let (scene, camera) = load_canonical("cornell-box");
     let reference = path_reference(&scene, &camera);
     let test = pssmlt_estimate(&scene, &camera, 64);
     assert_estimates_agree("cornell-box pssmlt", &test, &reference, 4, 4.0);
@@ -104,7 +98,7 @@ fn pssmlt_agrees_with_the_path_tracer_on_the_cornell_box() {
 
 #[test]
 fn pssmlt_agrees_with_the_path_tracer_on_cornell_glass() {
-    let (scene, camera) = load("cornell-glass");
+    let (scene, camera) = load_canonical("cornell-glass");
     let reference = path_reference(&scene, &camera);
     let test = pssmlt_estimate(&scene, &camera, 64);
     assert_estimates_agree("cornell-glass pssmlt", &test, &reference, 4, 4.0);
@@ -112,7 +106,7 @@ fn pssmlt_agrees_with_the_path_tracer_on_cornell_glass() {
 
 #[test]
 fn pssmlt_image_is_identical_for_any_thread_count() {
-    let (scene, camera) = load("cornell-glass");
+    let (scene, camera) = load_canonical("cornell-glass");
     let bits = |threads| {
         let settings = RenderSettings {
             threads,
@@ -130,7 +124,7 @@ fn pssmlt_image_is_identical_for_any_thread_count() {
 
 #[test]
 fn cancelled_pssmlt_is_normalized_by_the_mutations_made() {
-    let (scene, camera) = load("cornell-box");
+    let (scene, camera) = load_canonical("cornell-box");
     let reference = path_reference(&scene, &camera).mean().0;
     let settings = RenderSettings {
         mutations_per_pixel: 1 << 20,

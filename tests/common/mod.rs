@@ -362,6 +362,13 @@ pub fn scenes_dir() -> std::path::PathBuf {
     std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes")
 }
 
+/// A canonical scene of tests/scenes (`NAME.obj` with its camera sidecar), built.
+pub fn load_canonical(name: &str) -> (Scene, Camera) {
+    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).expect("loads");
+    let scene = Scene::new(&data.desc(Backend::Bvh)).expect("a valid scene");
+    (scene, data.camera.expect("a camera sidecar").camera)
+}
+
 /// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
 pub fn cornell_box() -> Mesh {
     let data = mlt::io::load_scene(&scenes_dir().join("cornell-box.obj")).expect("loads");
