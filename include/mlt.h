@@ -82,19 +82,33 @@
 #define MLT_INVALID_ID UINT32_MAX
 
 /**
- * Largest accepted image side, samples per pixel, depth and thread count: beyond these a
- * value is a mistake, not a request.
+ * Largest accepted image width or height.
  */
 #define MLT_MAX_IMAGE_SIDE (1 << 16)
 
+/**
+ * Largest accepted samples (or mutations) per pixel.
+ */
 #define MLT_MAX_SAMPLES_PER_PIXEL (1 << 24)
 
+/**
+ * Largest accepted max depth.
+ */
 #define MLT_MAX_DEPTH_LIMIT 1024
 
+/**
+ * Largest accepted thread count.
+ */
 #define MLT_MAX_THREADS 4096
 
+/**
+ * Largest accepted time limit in seconds.
+ */
 #define MLT_MAX_TIME_LIMIT_SECONDS 1.0e7
 
+/**
+ * Largest accepted number of Metropolis bootstrap samples.
+ */
 #define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
 
 /**

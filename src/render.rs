@@ -69,13 +69,19 @@ impl Estimator<'_> {
     }
 }
 
-/// Largest accepted image side, samples per pixel, depth and thread count: beyond these a
-/// value is a mistake, not a request.
+// Limits beyond which a setting is a mistake, not a request.
+
+/// Largest accepted image width or height.
 pub const MLT_MAX_IMAGE_SIDE: u32 = 1 << 16;
+/// Largest accepted samples (or mutations) per pixel.
 pub const MLT_MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
+/// Largest accepted max depth.
 pub const MLT_MAX_DEPTH_LIMIT: u32 = 1024;
+/// Largest accepted thread count.
 pub const MLT_MAX_THREADS: u32 = 4096;
+/// Largest accepted time limit in seconds.
 pub const MLT_MAX_TIME_LIMIT_SECONDS: f64 = 1.0e7;
+/// Largest accepted number of Metropolis bootstrap samples.
 pub const MLT_MAX_BOOTSTRAP_SAMPLES: u32 = 1 << 28;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
