@@ -76,11 +76,6 @@ impl Film {
             })
     }
 
-    /// Total samples taken over all pixels.
-    pub fn sample_count(&self) -> u64 {
-        self.counts.iter().map(|&c| c as u64).sum()
-    }
-
     /// Writes the estimate per pixel as RGB floats, rows top to bottom: the mean of the
     /// pixel's own samples plus the splats, which are normalized by the light paths per
     /// pixel (each light path's splats estimate the whole film once).

@@ -72,6 +72,11 @@ impl Material {
                     "{name}.color.{axis} is {c}; colors must not be negative"
                 )));
             }
+            if c > 1.0 {
+                return Err(Error::invalid(format!(
+                    "{name}.color.{axis} is {c}; a reflectance above 1 would create energy"
+                )));
+            }
         }
         for (axis, e) in ["x", "y", "z"].iter().zip(self.emission) {
             if e < 0.0 {
@@ -85,13 +90,6 @@ impl Material {
                 "{name}.ior is {}; a dielectric's index of refraction must be greater than 0",
                 self.ior
             )));
-        }
-        for (axis, c) in ["x", "y", "z"].iter().zip(self.color) {
-            if c > 1.0 {
-                return Err(Error::invalid(format!(
-                    "{name}.color.{axis} is {c}; a reflectance above 1 would create energy"
-                )));
-            }
         }
         Ok(())
     }
