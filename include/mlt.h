@@ -77,6 +77,19 @@
 #define MLT_ALGORITHM_PSSMLT 2
 
 /**
+ * `MltRenderSettings.algorithm`: multiplexed Metropolis light transport (Hachisuka et al. 2014): primary-sample-space
+ * chains over bidirectional path tracing that also pick the path depth and one connection
+ * strategy; one group of chains per depth, each normalized by its own bootstrap estimate.
+ */
+#define MLT_ALGORITHM_MMLT 3
+
+/**
+ * `MltRenderSettings.algorithm`: primary-sample-space MLT over bidirectional path tracing,
+ * all strategies of a sample summed.
+ */
+#define MLT_ALGORITHM_PSSMLT_BDPT 4
+
+/**
  * `MltHit.triangle_id` of a ray that hit nothing.
  */
 #define MLT_INVALID_ID UINT32_MAX
@@ -304,6 +317,14 @@ typedef struct MltRenderSettings {
    * PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
    */
   float small_step_sigma;
+  /**
+   * Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
+   * mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
+   * depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
+   * the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
+   * pass, the chains render every depth.
+   */
+  uint32_t direct_samples_per_mutation;
 } MltRenderSettings;
 
 /**

@@ -43,6 +43,13 @@ pub const MLT_ALGORITHM_BDPT: i32 = 1;
 /// et al. 2002) over the path tracer; uses the `mutations_per_pixel`, `bootstrap_samples`,
 /// `chains`, `large_step_probability` and `small_step_sigma` settings.
 pub const MLT_ALGORITHM_PSSMLT: i32 = 2;
+/// `MltRenderSettings.algorithm`: multiplexed Metropolis light transport (Hachisuka et al. 2014): primary-sample-space
+/// chains over bidirectional path tracing that also pick the path depth and one connection
+/// strategy; one group of chains per depth, each normalized by its own bootstrap estimate.
+pub const MLT_ALGORITHM_MMLT: i32 = 3;
+/// `MltRenderSettings.algorithm`: primary-sample-space MLT over bidirectional path tracing,
+/// all strategies of a sample summed.
+pub const MLT_ALGORITHM_PSSMLT_BDPT: i32 = 4;
 
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
@@ -141,6 +148,12 @@ pub struct MltRenderSettings {
     pub large_step_probability: f32,
     /// PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
     pub small_step_sigma: f32,
+    /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
+    /// mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
+    /// depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
+    /// the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
+    /// pass, the chains render every depth.
+    pub direct_samples_per_mutation: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -365,9 +378,11 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         MLT_ALGORITHM_PATH => Algorithm::Path,
         MLT_ALGORITHM_BDPT => Algorithm::Bdpt,
         MLT_ALGORITHM_PSSMLT => Algorithm::Pssmlt,
+        MLT_ALGORITHM_MMLT => Algorithm::Mmlt,
+        MLT_ALGORITHM_PSSMLT_BDPT => Algorithm::PssmltBdpt,
         other => {
             return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1) or MLT_ALGORITHM_PSSMLT (2)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3) or MLT_ALGORITHM_PSSMLT_BDPT (4)"
             )));
         }
     };
@@ -385,6 +400,7 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         chains: s.chains,
         large_step_probability: s.large_step_probability,
         small_step_sigma: s.small_step_sigma,
+        direct_samples_per_mutation: s.direct_samples_per_mutation,
     })
 }
 
@@ -517,6 +533,7 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             chains: d.chains,
             large_step_probability: d.large_step_probability,
             small_step_sigma: d.small_step_sigma,
+            direct_samples_per_mutation: d.direct_samples_per_mutation,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;

@@ -52,10 +52,15 @@ impl Film {
     /// Adds the splats of a work unit (in the unit's order) and the light paths it traced.
     pub fn add_splats(&mut self, splats: &[crate::integrators::Splat], light_paths: u64) {
         self.light_paths += light_paths;
+        self.add_weighted_splats(splats, 1.0);
+    }
+
+    /// Adds `weight` × the splats of a work unit, in the unit's order.
+    pub fn add_weighted_splats(&mut self, splats: &[crate::integrators::Splat], weight: f64) {
         for splat in splats {
             let sum = &mut self.splats[splat.pixel as usize];
             for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
-                *s += v as f64;
+                *s += v as f64 * weight;
             }
         }
     }

@@ -5,6 +5,7 @@ use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, R
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
+use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
 use crate::integrators::{PixelEstimator, SampleCounters, Splat};
 use crate::sampling::Rng;
@@ -25,6 +26,21 @@ pub enum Algorithm {
     Bdpt,
     /// Primary-sample-space Metropolis light transport (Kelemen) over the path tracer.
     Pssmlt,
+    /// Multiplexed MLT (Hachisuka): primary-sample-space chains over BDPT that also pick the
+    /// path depth and one connection strategy.
+    Mmlt,
+    /// Primary-sample-space MLT over BDPT, all strategies of a sample summed.
+    PssmltBdpt,
+}
+
+impl Algorithm {
+    /// Whether the algorithm runs Metropolis chains (settings in mutations per pixel).
+    pub fn is_metropolis(self) -> bool {
+        matches!(
+            self,
+            Algorithm::Pssmlt | Algorithm::Mmlt | Algorithm::PssmltBdpt
+        )
+    }
 }
 
 /// The estimator a render runs, chosen from the settings.
@@ -32,39 +48,66 @@ enum Estimator<'a> {
     Path(&'a PathTracer<'a>),
     Bdpt(&'a Bdpt<'a>),
     Pssmlt(&'a PathTracer<'a>),
+    Mmlt(&'a BdptMultiplexed<'a>),
+    PssmltBdpt(&'a BdptAllStrategies<'a>),
 }
 
+/// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
+const DIRECT_PASS_DEPTHS: u32 = 2;
+
 impl Estimator<'_> {
+    /// Runs the render; `direct` is the path tracer of a Metropolis render's direct pass.
     fn run(
         &self,
         camera: &CameraModel,
         settings: &RenderSettings,
+        direct: Option<&PathTracer>,
         film: &mut Film,
         control: &Control,
     ) -> PssmltOutcome {
+        let seed = settings.seed;
+        let spp = settings.samples_per_pixel;
+        let chains = PssmltSettings {
+            mutations_per_pixel: settings.mutations_per_pixel,
+            bootstrap_samples: settings.bootstrap_samples,
+            chains: settings.chains,
+            large_step_probability: settings.large_step_probability,
+            small_step_sigma: settings.small_step_sigma,
+            seed,
+        };
+        // The direct pass keeps pace with the chains: after each round of mutations it
+        // catches up to its share of samples.
+        let ratio = settings.direct_samples_per_mutation;
+        let mut direct_job = direct.map(|direct| {
+            let total = ratio * settings.mutations_per_pixel;
+            let mut job = CameraSampleJob::new(direct, camera, seed, total, film);
+            job.run_until(film, control, 1);
+            job
+        });
+        let mut keep_pace = |film: &mut Film, mutations_per_pixel: f64| {
+            if let Some(job) = direct_job.as_mut() {
+                let target = (ratio as f64 * mutations_per_pixel).ceil().min(u32::MAX as f64);
+                job.run_until(film, control, target as u32);
+            }
+        };
         match *self {
             Estimator::Path(estimator) => {
-                CameraSampleJob::new(estimator, camera, settings).run(film, control);
+                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
                 PssmltOutcome::default()
             }
             Estimator::Bdpt(estimator) => {
-                CameraSampleJob::new(estimator, camera, settings).run(film, control);
+                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
                 PssmltOutcome::default()
             }
-            Estimator::Pssmlt(tracer) => pssmlt::run(
-                tracer,
-                camera,
-                &PssmltSettings {
-                    mutations_per_pixel: settings.mutations_per_pixel,
-                    bootstrap_samples: settings.bootstrap_samples,
-                    chains: settings.chains,
-                    large_step_probability: settings.large_step_probability,
-                    small_step_sigma: settings.small_step_sigma,
-                    seed: settings.seed,
-                },
-                film,
-                control,
-            ),
+            Estimator::Pssmlt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::Mmlt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::PssmltBdpt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
         }
     }
 }
@@ -108,6 +151,13 @@ pub struct RenderSettings {
     pub large_step_probability: f32,
     /// PSSMLT: standard deviation of a small step in primary sample space.
     pub small_step_sigma: f32,
+    /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel).
+    /// The direct pass path-traces the paths of depth 0 and 1 (emitters seen directly,
+    /// direct lighting), which chains render poorly: they spend mutations in proportion to
+    /// brightness, on what stratified camera samples get right. The chains render the longer
+    /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
+    /// pass; the chains render every depth.
+    pub direct_samples_per_mutation: u32,
 }
 
 impl Default for RenderSettings {
@@ -126,6 +176,7 @@ impl Default for RenderSettings {
             chains: 1024,
             large_step_probability: 0.3,
             small_step_sigma: 0.01,
+            direct_samples_per_mutation: 8,
         }
     }
 }
@@ -163,11 +214,19 @@ impl RenderSettings {
                 "settings.time_limit_seconds is {t}; it must be 0 (no limit) or a positive number of seconds up to {MLT_MAX_TIME_LIMIT_SECONDS}"
             )));
         }
-        if self.algorithm == Algorithm::Pssmlt {
+        if self.algorithm.is_metropolis() {
             if self.mutations_per_pixel == 0 && t == 0.0 {
                 return Err(Error::invalid(
                     "settings.mutations_per_pixel is 0 and there is no time limit; the render would never end",
                 ));
+            }
+            let direct = self.direct_samples_per_mutation as u64;
+            if direct * (self.mutations_per_pixel.max(1) as u64) > MLT_MAX_SAMPLES_PER_PIXEL as u64
+            {
+                return Err(Error::invalid(format!(
+                    "settings.direct_samples_per_mutation is {direct}; times settings.mutations_per_pixel ({}) it must be at most {MLT_MAX_SAMPLES_PER_PIXEL}",
+                    self.mutations_per_pixel
+                )));
             }
             if self.mutations_per_pixel > MLT_MAX_SAMPLES_PER_PIXEL {
                 return Err(Error::invalid(format!(
@@ -306,38 +365,60 @@ pub fn render(
     };
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
-    let path_tracer;
-    let bdpt;
+    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer.
+    let direct = (settings.algorithm.is_metropolis() && settings.direct_samples_per_mutation > 0)
+        .then(|| PathTracer {
+            scene,
+            max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
+            min_depth: 0,
+        });
+    let min_depth = if direct.is_some() {
+        DIRECT_PASS_DEPTHS
+    } else {
+        0
+    };
+    let path_tracer = PathTracer {
+        scene,
+        max_depth: settings.max_depth,
+        min_depth,
+    };
+    let bdpt = Bdpt {
+        scene,
+        max_depth: settings.max_depth,
+        min_depth,
+    };
+    let multiplexed;
+    let all_strategies;
     let estimator: Estimator = match settings.algorithm {
-        Algorithm::Path => {
-            path_tracer = PathTracer {
-                scene,
-                max_depth: settings.max_depth,
-            };
-            Estimator::Path(&path_tracer)
+        Algorithm::Path => Estimator::Path(&path_tracer),
+        Algorithm::Bdpt => Estimator::Bdpt(&bdpt),
+        Algorithm::Pssmlt => Estimator::Pssmlt(&path_tracer),
+        Algorithm::Mmlt => {
+            multiplexed = BdptMultiplexed(bdpt);
+            Estimator::Mmlt(&multiplexed)
         }
-        Algorithm::Bdpt => {
-            bdpt = Bdpt {
-                scene,
-                max_depth: settings.max_depth,
-            };
-            Estimator::Bdpt(&bdpt)
-        }
-        Algorithm::Pssmlt => {
-            path_tracer = PathTracer {
-                scene,
-                max_depth: settings.max_depth,
-            };
-            Estimator::Pssmlt(&path_tracer)
+        Algorithm::PssmltBdpt => {
+            all_strategies = BdptAllStrategies(bdpt);
+            Estimator::PssmltBdpt(&all_strategies)
         }
     };
     let pixels = settings.width as u64 * settings.height as u64;
-    let per_pixel = if settings.algorithm == Algorithm::Pssmlt {
-        settings.mutations_per_pixel
+    // Progress counts camera samples and mutations alike; without a count (time limit
+    // only) there is no plan.
+    let planned = if settings.algorithm.is_metropolis() {
+        let direct_samples = if direct.is_some() {
+            settings.direct_samples_per_mutation as u64 * settings.mutations_per_pixel as u64
+        } else {
+            0
+        };
+        if settings.mutations_per_pixel > 0 {
+            (settings.mutations_per_pixel as u64 + direct_samples) * pixels
+        } else {
+            0
+        }
     } else {
-        settings.samples_per_pixel
+        settings.samples_per_pixel as u64 * pixels
     };
-    let planned = per_pixel as u64 * pixels;
 
     let mut progress = progress;
     let done = DoneSignal::default();
@@ -346,12 +427,13 @@ pub fn render(
         let control = &control;
         let film = &mut film;
         let estimator = &estimator;
+        let direct = direct.as_ref();
         let model = &model;
         let pool = &pool;
         let worker = s.spawn(move || {
             // Signals even when the render panics, so the caller never waits forever.
             let _signal = SignalOnDrop(done);
-            pool.install(|| estimator.run(model, settings, film, control))
+            pool.install(|| estimator.run(model, settings, direct, film, control))
         });
         while !done.wait(PROGRESS_INTERVAL) {
             if let Some(callback) = progress.as_mut() {
@@ -488,51 +570,75 @@ struct BandState<S> {
     light_paths: u64,
 }
 
-/// Runs a pixel estimator over the film, pass by pass.
-struct CameraSampleJob<'a, E> {
+/// Runs a pixel estimator over the film, pass by pass; can stop at a sample count and go on
+/// later (a Metropolis render interleaves its direct pass with the chains).
+struct CameraSampleJob<'a, E: PixelEstimator> {
     estimator: &'a E,
     camera: CameraModel,
     seed: u64,
     /// 0 = until stopped.
     samples_per_pixel: u32,
+    /// Samples per pixel of a full pass.
+    batch: u32,
+    /// Samples per pixel taken so far.
+    samples_taken: u32,
+    states: Vec<BandState<E::Scratch>>,
 }
 
 impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
-    fn new(estimator: &'a E, camera: &CameraModel, settings: &RenderSettings) -> Self {
-        CameraSampleJob {
-            estimator,
-            camera: *camera,
-            seed: settings.seed,
-            samples_per_pixel: settings.samples_per_pixel,
-        }
-    }
-
-    fn run(&self, film: &mut Film, control: &Control) {
+    fn new(
+        estimator: &'a E,
+        camera: &CameraModel,
+        seed: u64,
+        samples_per_pixel: u32,
+        film: &Film,
+    ) -> Self {
         let width = film.width;
         let pixels = width as u64 * film.height as u64;
         let batch = SAMPLES_PER_PASS.div_ceil(pixels).clamp(1, 64) as u32;
-        let total = if self.samples_per_pixel > 0 {
-            self.samples_per_pixel
-        } else {
-            u32::MAX
-        };
         let bands = film.height.div_ceil(BAND_ROWS) as usize;
-        let splat_capacity = if self.estimator.splats() {
+        let splat_capacity = if estimator.splats() {
             (BAND_ROWS * width * batch * 2) as usize
         } else {
             0
         };
-        let mut states: Vec<BandState<E::Scratch>> = (0..bands)
+        let states = (0..bands)
             .map(|_| BandState {
-                scratch: self.estimator.scratch(),
+                scratch: estimator.scratch(),
                 splats: Vec::with_capacity(splat_capacity),
                 light_paths: 0,
             })
             .collect();
-        let mut first = 0u32;
+        CameraSampleJob {
+            estimator,
+            camera: *camera,
+            seed,
+            samples_per_pixel,
+            batch,
+            samples_taken: 0,
+            states,
+        }
+    }
+
+    fn run(&mut self, film: &mut Film, control: &Control) {
+        self.run_until(film, control, u32::MAX);
+    }
+
+    /// Takes samples until every pixel has `target` (or all it should have), or the render
+    /// stops.
+    fn run_until(&mut self, film: &mut Film, control: &Control, target: u32) {
+        let width = film.width;
+        let batch = self.batch;
+        let total = if self.samples_per_pixel > 0 {
+            self.samples_per_pixel.min(target)
+        } else {
+            target
+        };
+        let states = &mut self.states;
         // The first pass takes one sample per pixel and always completes, so a render
         // stopped at any moment still has a sample in every pixel.
-        while first < total && (first == 0 || !control.should_stop()) {
+        while self.samples_taken < total && (self.samples_taken == 0 || !control.should_stop()) {
+            let first = self.samples_taken;
             let end = if first == 0 {
                 1
             } else {
@@ -592,11 +698,11 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                     control.invalid.fetch_add(invalid, Ordering::Relaxed);
                 });
             if self.estimator.splats() {
-                for state in &states {
+                for state in states.iter() {
                     film.add_splats(&state.splats, state.light_paths);
                 }
             }
-            first = end;
+            self.samples_taken = end;
         }
     }
 }

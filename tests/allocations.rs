@@ -56,7 +56,13 @@ fn allocations_do_not_grow_with_samples() {
         render(&scene, &camera, &settings, &mut image, None).unwrap();
         ALLOCATIONS.load(Ordering::SeqCst) - before
     };
-    for algorithm in [Algorithm::Path, Algorithm::Bdpt, Algorithm::Pssmlt] {
+    for algorithm in [
+        Algorithm::Path,
+        Algorithm::Bdpt,
+        Algorithm::Pssmlt,
+        Algorithm::PssmltBdpt,
+        Algorithm::Mmlt,
+    ] {
         // 32 x 32 pixels: both renders take the same number of passes (one sample, then up
         // to 64 per pass) and rounds, so only per-sample allocations could differ.
         count(algorithm, 1); // warm up lazily initialized runtime state

@@ -18,6 +18,10 @@ enum AlgorithmArg {
     Bdpt,
     /// Primary-sample-space Metropolis light transport over the path tracer.
     Pssmlt,
+    /// Multiplexed MLT: chains over BDPT that pick the path depth and one strategy.
+    Mmlt,
+    /// Primary-sample-space MLT over BDPT, all strategies of a sample summed.
+    PssmltBdpt,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -62,6 +66,10 @@ struct Args {
     /// PSSMLT: standard deviation of a small step in primary sample space.
     #[arg(long, value_name = "SIGMA", default_value_t = RenderSettings::default().small_step_sigma)]
     small_step: f32,
+    /// Metropolis: samples of the path-traced pass for paths of depth 0 and 1 (emitters
+    /// seen, direct lighting) per chain mutation (0: the chains render every depth).
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().direct_samples_per_mutation)]
+    direct_per_mutation: u32,
     /// Stop after this many seconds (0: no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
     time_limit: f64,
@@ -184,6 +192,8 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
             AlgorithmArg::Path => mlt::Algorithm::Path,
             AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
             AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
+            AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
+            AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
         },
         samples_per_pixel: args.spp,
         max_depth: args.max_depth,
@@ -195,6 +205,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         chains: args.chains,
         large_step_probability: args.large_step,
         small_step_sigma: args.small_step,
+        direct_samples_per_mutation: args.direct_per_mutation,
     }
 }
 

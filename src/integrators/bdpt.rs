@@ -15,8 +15,8 @@
 
 use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
-use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
-use crate::scene::{CameraModel, Scene};
+use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere, uniform_triangle};
+use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
 
@@ -24,6 +24,8 @@ pub struct Bdpt<'a> {
     pub scene: &'a Scene,
     /// At most this many scattering vertices between camera and light.
     pub max_depth: u32,
+    /// Paths with fewer scattering vertices contribute nothing (another pass renders them).
+    pub min_depth: u32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,7 +161,7 @@ impl Bdpt<'_> {
     /// Extends `path` (whose last vertex is the subpath's start) by a random walk; returns
     /// the number of vertices.
     #[allow(clippy::too_many_arguments)]
-    fn random_walk(
+    fn random_walk<S: Sampler>(
         &self,
         path: &mut [Vertex],
         mut ray: crate::accel::Ray,
@@ -167,7 +169,7 @@ impl Bdpt<'_> {
         mut pdf_solid_angle: f32,
         max_vertices: usize,
         mode: TransportMode,
-        rng: &mut Rng,
+        sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
         let mut count = 1;
@@ -187,7 +189,8 @@ impl Bdpt<'_> {
                 pdf_forward: 0.0,
                 pdf_reverse: 0.0,
                 triangle: hit.triangle,
-                specular: false,
+                // Known from the material, so a subpath cut short here is marked too.
+                specular: material.kind != MaterialKind::Diffuse,
             };
             vertex.pdf_forward = to_area(pdf_solid_angle, &path[count - 1], &vertex);
             path[count] = vertex;
@@ -199,8 +202,8 @@ impl Bdpt<'_> {
                 material,
                 vertex.normal,
                 vertex.wo,
-                rng.uniform2(),
-                rng.uniform(),
+                sampler.uniform2(),
+                sampler.uniform(),
                 mode,
             ) else {
                 break;
@@ -227,17 +230,17 @@ impl Bdpt<'_> {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn camera_subpath(
+    fn camera_subpath<S: Sampler>(
         &self,
         camera: &CameraModel,
         x: f32,
         y: f32,
         path: &mut [Vertex],
         max_vertices: usize,
-        rng: &mut Rng,
+        sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
-        let lens = rng.uniform2();
+        let lens = sampler.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
         path[0] = Vertex {
             kind: VertexKind::Camera,
@@ -255,21 +258,21 @@ impl Bdpt<'_> {
             pdf_direction,
             max_vertices,
             TransportMode::Radiance,
-            rng,
+            sampler,
             counters,
         )
     }
 
-    fn light_subpath(
+    fn light_subpath<S: Sampler>(
         &self,
         path: &mut [Vertex],
         max_vertices: usize,
-        rng: &mut Rng,
+        sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
-        let u_select = rng.uniform();
-        let u_point = rng.uniform2();
-        let u_direction = rng.uniform2();
+        let u_select = sampler.uniform();
+        let u_point = sampler.uniform2();
+        let u_direction = sampler.uniform2();
         if self.scene.lights.is_empty() || max_vertices == 0 {
             return 0;
         }
@@ -303,7 +306,7 @@ impl Bdpt<'_> {
             pdf_direction,
             max_vertices,
             TransportMode::Importance,
-            rng,
+            sampler,
             counters,
         )
     }
@@ -422,6 +425,227 @@ impl Bdpt<'_> {
     }
 }
 
+/// Stream of the camera subpath (film position first): see `Sampler::start_stream`.
+pub(crate) const CAMERA_STREAM: usize = 0;
+/// Stream of the light subpath.
+pub(crate) const LIGHT_STREAM: usize = 1;
+/// Stream of the connection (the lens point for t = 1, the light point for s = 1); every
+/// strategy reads it from its start.
+pub(crate) const CONNECTION_STREAM: usize = 2;
+/// Streams a Metropolis sampler driving BDPT interleaves.
+pub(crate) const STREAMS: usize = 3;
+
+/// One strategy's contribution: to the sample's own pixel, or (light tracing, t = 1) to the
+/// pixel the light subpath projects to.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Contribution {
+    pub value: Vec3A,
+    pub splat_pixel: Option<u32>,
+}
+
+impl Bdpt<'_> {
+    /// Most coordinates one stream is read at by any sample: a Metropolis sampler reserves
+    /// `STREAMS` times this many.
+    pub(crate) fn coordinates_per_stream(&self) -> usize {
+        // Film position 2, strategy 1, lens 2, then 3 per scattering vertex.
+        5 + 3 * (self.max_depth as usize + 2)
+    }
+
+    /// Traces the camera subpath through film position (x, y) with at most `camera_vertices`
+    /// vertices (the lens included) and the light subpath with at most `light_vertices`;
+    /// returns how many vertices each has. The camera subpath continues the sampler's
+    /// current stream (the caller read the film position from it).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn trace_subpaths<S: Sampler>(
+        &self,
+        camera_model: &CameraModel,
+        x: f32,
+        y: f32,
+        camera_vertices: usize,
+        light_vertices: usize,
+        sampler: &mut S,
+        scratch: &mut BdptScratch,
+        counters: &mut SampleCounters,
+    ) -> (usize, usize) {
+        let n_camera = self.camera_subpath(
+            camera_model,
+            x,
+            y,
+            &mut scratch.camera,
+            camera_vertices,
+            sampler,
+            counters,
+        );
+        sampler.start_stream(LIGHT_STREAM);
+        let n_light = self.light_subpath(&mut scratch.light, light_vertices, sampler, counters);
+        (n_camera, n_light)
+    }
+
+    /// Calls `visit(s, t, contribution)` for every strategy of the traced subpaths with a
+    /// nonzero MIS-weighted contribution, in a fixed order.
+    pub(crate) fn for_each_strategy<S: Sampler>(
+        &self,
+        camera_model: &CameraModel,
+        (n_camera, n_light): (usize, usize),
+        sampler: &mut S,
+        scratch: &mut BdptScratch,
+        counters: &mut SampleCounters,
+        mut visit: impl FnMut(usize, usize, Contribution),
+    ) {
+        for t in 1..=n_camera {
+            for s in 0..=n_light {
+                let vertices = s + t;
+                if vertices < 2 + self.min_depth as usize
+                    || vertices - 2 > self.max_depth as usize
+                    || (s == 1 && t == 1)
+                {
+                    continue;
+                }
+                sampler.start_stream(CONNECTION_STREAM);
+                if let Some(c) = self.connect(camera_model, scratch, s, t, sampler, counters) {
+                    visit(s, t, c);
+                }
+            }
+        }
+    }
+
+    /// The MIS-weighted contribution of strategy (s, t) of the traced subpaths; `None` when
+    /// it is zero.
+    pub(crate) fn connect<S: Sampler>(
+        &self,
+        camera_model: &CameraModel,
+        scratch: &mut BdptScratch,
+        s: usize,
+        t: usize,
+        sampler: &mut S,
+        counters: &mut SampleCounters,
+    ) -> Option<Contribution> {
+        let camera = &mut scratch.camera;
+        let light = &mut scratch.light;
+        if s == 0 {
+            // The camera subpath reached an emitter.
+            let pt = camera[t - 1];
+            if pt.kind != VertexKind::Surface {
+                return None;
+            }
+            let le = self.emitted(&pt, pt.wo);
+            if le.max_element() <= 0.0 {
+                return None;
+            }
+            let weight = self.mis_weight(camera_model, camera, light, 0, t);
+            Some(Contribution {
+                value: pt.beta * le * weight,
+                splat_pixel: None,
+            })
+        } else if t == 1 {
+            // Light tracing: connect a light-subpath vertex to the lens.
+            let qs = light[s - 1];
+            let lens = camera_model.sample_lens(sampler.uniform2());
+            if !qs.connectible() {
+                return None;
+            }
+            let to_lens = lens - qs.p;
+            let distance2 = to_lens.length_squared();
+            if distance2 == 0.0 {
+                return None;
+            }
+            let direction = -to_lens / distance2.sqrt();
+            let importance = camera_model.importance(lens, direction)?;
+            let cos_lens = direction.dot(camera_model.forward);
+            // Density of the lens point in solid angle at qs.
+            let pdf = distance2 / cos_lens / camera_model.lens_area();
+            let sampled = Vertex {
+                kind: VertexKind::Camera,
+                p: lens,
+                normal: camera_model.forward,
+                beta: Vec3A::splat(importance.importance / pdf),
+                ..Vertex::EMPTY
+            };
+            // s >= 2 here, so qs is a surface vertex.
+            let contribution =
+                qs.beta * sampled.beta * self.f(&qs, lens) * direction.dot(qs.normal).abs();
+            if contribution.max_element() <= 0.0 || !self.visible(&qs, &sampled, counters) {
+                return None;
+            }
+            let saved = camera[0];
+            camera[0] = sampled;
+            let weight = self.mis_weight(camera_model, camera, light, s, 1);
+            camera[0] = saved;
+            let [rx, ry] = importance.raster;
+            Some(Contribution {
+                value: contribution * weight,
+                splat_pixel: Some(ry as u32 * camera_model.width + rx as u32),
+            })
+        } else if s == 1 {
+            // Next-event estimation: a new point on a light.
+            let pt = camera[t - 1];
+            let u_select = sampler.uniform();
+            let u_point = sampler.uniform2();
+            if !pt.connectible() || pt.kind != VertexKind::Surface {
+                return None;
+            }
+            let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
+            let l = &self.scene.lights[index];
+            let [b1, b2] = uniform_triangle(u_point);
+            let sampled = Vertex {
+                kind: VertexKind::Light,
+                p: l.v0 + l.edge1 * b1 + l.edge2 * b2,
+                normal: l.normal,
+                beta: l.emission / l.area_pdf,
+                pdf_forward: l.area_pdf,
+                triangle: l.triangle,
+                ..Vertex::EMPTY
+            };
+            let d = sampled.p - pt.p;
+            let distance2 = d.length_squared();
+            if distance2 == 0.0 {
+                return None;
+            }
+            let w = d / distance2.sqrt();
+            let cos_light = -w.dot(l.normal);
+            if cos_light <= 0.0 {
+                return None;
+            }
+            let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
+            let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
+            if contribution.max_element() <= 0.0 || !self.visible(&pt, &sampled, counters) {
+                return None;
+            }
+            let saved = light[0];
+            light[0] = sampled;
+            let weight = self.mis_weight(camera_model, camera, light, 1, t);
+            light[0] = saved;
+            Some(Contribution {
+                value: contribution * weight,
+                splat_pixel: None,
+            })
+        } else {
+            // Connect light vertex s-1 and camera vertex t-1.
+            let qs = light[s - 1];
+            let pt = camera[t - 1];
+            if !qs.connectible() || !pt.connectible() {
+                return None;
+            }
+            let d = pt.p - qs.p;
+            let distance2 = d.length_squared();
+            if distance2 == 0.0 {
+                return None;
+            }
+            let w = d / distance2.sqrt();
+            let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
+            let contribution = qs.beta * self.f(&qs, pt.p) * self.f(&pt, qs.p) * pt.beta * geometry;
+            if contribution.max_element() <= 0.0 || !self.visible(&qs, &pt, counters) {
+                return None;
+            }
+            let weight = self.mis_weight(camera_model, camera, light, s, t);
+            Some(Contribution {
+                value: contribution * weight,
+                splat_pixel: None,
+            })
+        }
+    }
+}
+
 impl PixelEstimator for Bdpt<'_> {
     type Scratch = BdptScratch;
 
@@ -448,137 +672,31 @@ impl PixelEstimator for Bdpt<'_> {
         splats: &mut Vec<Splat>,
     ) -> Vec3A {
         let max_depth = self.max_depth as usize;
-        let camera = &mut scratch.camera;
-        let light = &mut scratch.light;
-        let n_camera =
-            self.camera_subpath(camera_model, x, y, camera, max_depth + 2, rng, counters);
-        let n_light = self.light_subpath(light, max_depth + 1, rng, counters);
+        let lengths = self.trace_subpaths(
+            camera_model,
+            x,
+            y,
+            max_depth + 2,
+            max_depth + 1,
+            rng,
+            scratch,
+            counters,
+        );
         let mut radiance = Vec3A::ZERO;
-
-        for t in 1..=n_camera {
-            for s in 0..=n_light {
-                let depth = s + t;
-                if depth < 2 || depth - 2 > max_depth || (s == 1 && t == 1) {
-                    continue;
-                }
-                if s == 0 {
-                    // The camera subpath reached an emitter.
-                    let pt = camera[t - 1];
-                    if pt.kind != VertexKind::Surface {
-                        continue;
-                    }
-                    let le = self.emitted(&pt, pt.wo);
-                    if le.max_element() <= 0.0 {
-                        continue;
-                    }
-                    let weight = self.mis_weight(camera_model, camera, light, 0, t);
-                    radiance += pt.beta * le * weight;
-                } else if t == 1 {
-                    // Light tracing: connect a light-subpath vertex to the lens.
-                    let qs = light[s - 1];
-                    if !qs.connectible() {
-                        continue;
-                    }
-                    let lens = camera_model.sample_lens(rng.uniform2());
-                    let to_lens = lens - qs.p;
-                    let distance2 = to_lens.length_squared();
-                    if distance2 == 0.0 {
-                        continue;
-                    }
-                    let direction = -to_lens / distance2.sqrt();
-                    let Some(importance) = camera_model.importance(lens, direction) else {
-                        continue;
-                    };
-                    let cos_lens = direction.dot(camera_model.forward);
-                    // Density of the lens point in solid angle at qs.
-                    let pdf = distance2 / cos_lens / camera_model.lens_area();
-                    let sampled = Vertex {
-                        kind: VertexKind::Camera,
-                        p: lens,
-                        normal: camera_model.forward,
-                        beta: Vec3A::splat(importance.importance / pdf),
-                        ..Vertex::EMPTY
-                    };
-                    // s >= 2 here, so qs is a surface vertex.
-                    let contribution =
-                        qs.beta * sampled.beta * self.f(&qs, lens) * direction.dot(qs.normal).abs();
-                    if contribution.max_element() <= 0.0 || !self.visible(&qs, &sampled, counters) {
-                        continue;
-                    }
-                    let saved = camera[0];
-                    camera[0] = sampled;
-                    let weight = self.mis_weight(camera_model, camera, light, s, 1);
-                    camera[0] = saved;
-                    let [rx, ry] = importance.raster;
-                    let pixel = ry as u32 * camera_model.width + rx as u32;
-                    splats.push(Splat {
-                        pixel,
-                        value: contribution * weight,
-                    });
-                } else if s == 1 {
-                    // Next-event estimation: a new point on a light.
-                    let pt = camera[t - 1];
-                    if !pt.connectible() || pt.kind != VertexKind::Surface {
-                        continue;
-                    }
-                    let u_select = rng.uniform();
-                    let u_point = rng.uniform2();
-                    let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
-                    let l = &self.scene.lights[index];
-                    let [b1, b2] = uniform_triangle(u_point);
-                    let sampled = Vertex {
-                        kind: VertexKind::Light,
-                        p: l.v0 + l.edge1 * b1 + l.edge2 * b2,
-                        normal: l.normal,
-                        beta: l.emission / l.area_pdf,
-                        pdf_forward: l.area_pdf,
-                        triangle: l.triangle,
-                        ..Vertex::EMPTY
-                    };
-                    let d = sampled.p - pt.p;
-                    let distance2 = d.length_squared();
-                    if distance2 == 0.0 {
-                        continue;
-                    }
-                    let w = d / distance2.sqrt();
-                    let cos_light = -w.dot(l.normal);
-                    if cos_light <= 0.0 {
-                        continue;
-                    }
-                    let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
-                    let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
-                    if contribution.max_element() <= 0.0 || !self.visible(&pt, &sampled, counters) {
-                        continue;
-                    }
-                    let saved = light[0];
-                    light[0] = sampled;
-                    let weight = self.mis_weight(camera_model, camera, light, 1, t);
-                    light[0] = saved;
-                    radiance += contribution * weight;
-                } else {
-                    // Connect light vertex s-1 and camera vertex t-1.
-                    let qs = light[s - 1];
-                    let pt = camera[t - 1];
-                    if !qs.connectible() || !pt.connectible() {
-                        continue;
-                    }
-                    let d = pt.p - qs.p;
-                    let distance2 = d.length_squared();
-                    if distance2 == 0.0 {
-                        continue;
-                    }
-                    let w = d / distance2.sqrt();
-                    let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
-                    let contribution =
-                        qs.beta * self.f(&qs, pt.p) * self.f(&pt, qs.p) * pt.beta * geometry;
-                    if contribution.max_element() <= 0.0 || !self.visible(&qs, &pt, counters) {
-                        continue;
-                    }
-                    let weight = self.mis_weight(camera_model, camera, light, s, t);
-                    radiance += contribution * weight;
-                }
-            }
-        }
+        self.for_each_strategy(
+            camera_model,
+            lengths,
+            rng,
+            scratch,
+            counters,
+            |_, _, c| match c.splat_pixel {
+                None => radiance += c.value,
+                Some(pixel) => splats.push(Splat {
+                    pixel,
+                    value: c.value.into(),
+                }),
+            },
+        );
         radiance
     }
 }

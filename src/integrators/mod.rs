@@ -7,14 +7,15 @@ pub mod path;
 use crate::accel::Ray;
 use crate::sampling::Rng;
 use crate::scene::{CameraModel, Scene};
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 
-/// A contribution to an arbitrary pixel (light tracing onto the film), recorded by a work
-/// unit and added to the film in a fixed order so the image never depends on scheduling.
+/// A contribution to an arbitrary pixel (light tracing onto the film, Metropolis deposits),
+/// recorded by a work unit and added to the film in a fixed order so the image never depends
+/// on scheduling. 16 bytes: work units keep many.
 #[derive(Clone, Copy, Debug)]
 pub struct Splat {
     pub pixel: u32,
-    pub value: Vec3A,
+    pub value: Vec3,
 }
 
 /// Counters a sample updates; summed per work unit.

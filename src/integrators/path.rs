@@ -16,6 +16,8 @@ pub struct PathTracer<'a> {
     pub scene: &'a Scene,
     /// At most this many scattering vertices between camera and light.
     pub max_depth: u32,
+    /// Paths with fewer scattering vertices contribute nothing (another pass renders them).
+    pub min_depth: u32,
 }
 
 impl PathTracer<'_> {
@@ -51,7 +53,7 @@ impl PathTracer<'_> {
             let cos_o = wo.dot(normal);
 
             // Emission from the front side.
-            if shading.light_area_pdf > 0.0 && cos_o > 0.0 {
+            if shading.light_area_pdf > 0.0 && cos_o > 0.0 && depth >= self.min_depth {
                 let emission = Vec3A::from(material.emission);
                 let weight = if previous_specular {
                     1.0
@@ -65,8 +67,17 @@ impl PathTracer<'_> {
                 break;
             }
 
-            if material.kind == MaterialKind::Diffuse {
-                radiance += throughput * self.sample_light(p, normal, wo, material, rng, rays);
+            // A light sample here ends a path of depth + 1 scattering vertices. At the last
+            // vertex it is the only strategy: a BSDF-sampled ray would only look for
+            // emission, so it is not traced and the light sample takes the full weight.
+            let diffuse = material.kind == MaterialKind::Diffuse;
+            let last = depth + 1 == self.max_depth;
+            if diffuse && depth + 1 >= self.min_depth {
+                radiance +=
+                    throughput * self.sample_light(p, normal, wo, material, !last, rng, rays);
+            }
+            if diffuse && last {
+                break;
             }
 
             let Some(sample) = bsdf::sample(
@@ -100,14 +111,17 @@ impl PathTracer<'_> {
     }
 
     /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
-    /// against BSDF sampling. Returns the contribution before the path throughput.
+    /// against BSDF sampling when `mis` (else the only strategy). Returns the contribution
+    /// before the path throughput.
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     fn sample_light<S: Sampler>(
         &self,
         p: Vec3A,
         normal: Vec3A,
         wo: Vec3A,
         material: &crate::scene::Material,
+        mis: bool,
         rng: &mut S,
         rays: &mut u64,
     ) -> Vec3A {
@@ -143,8 +157,11 @@ impl PathTracer<'_> {
             return Vec3A::ZERO;
         }
         let light_pdf = light.area_pdf * distance2 / cos_light;
-        let bsdf_pdf = bsdf::pdf(material, normal, wo, wi);
-        let weight = power_heuristic(light_pdf, bsdf_pdf);
+        let weight = if mis {
+            power_heuristic(light_pdf, bsdf::pdf(material, normal, wo, wi))
+        } else {
+            1.0
+        };
         f * light.emission * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }

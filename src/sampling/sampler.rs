@@ -11,6 +11,13 @@ pub trait Sampler {
     fn uniform2(&mut self) -> [f32; 2] {
         [self.uniform(), self.uniform()]
     }
+
+    /// Continues from the start of stream `stream`. A Metropolis sampler interleaves its
+    /// coordinates by stream, so that the numbers a part of the estimator reads (the camera
+    /// subpath, the light subpath, the connection) keep their coordinates when another part
+    /// reads more or fewer. Independent samplers have one stream and ignore this.
+    #[inline]
+    fn start_stream(&mut self, _stream: usize) {}
 }
 
 impl Sampler for Rng {

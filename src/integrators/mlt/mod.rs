@@ -4,6 +4,7 @@
 pub mod image_chain;
 pub mod pss;
 pub mod pssmlt;
+pub mod targets;
 
 /// Metropolis–Hastings acceptance probability of moving from state x to proposal y:
 /// min(1, f(y)·T(y→x) / (f(x)·T(x→y))), where `f_current` = f(x), `f_proposal` = f(y) are

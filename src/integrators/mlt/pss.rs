@@ -19,7 +19,14 @@ struct PrimarySample {
 pub struct PssSampler {
     rng: Rng,
     samples: Vec<PrimarySample>,
+    /// Coordinates are interleaved by stream: coordinate k of stream j is `j + k·streams`.
+    streams: usize,
+    stream: usize,
+    /// The next coordinate of the current stream.
     next: usize,
+    /// Values the first two coordinates of stream 0 (the film position) take in the first
+    /// evaluation instead of random ones: the bootstrap stratifies the film with them.
+    film_position: Option<[f32; 2]>,
     iteration: u64,
     large_step: bool,
     last_large_step: u64,
@@ -31,18 +38,24 @@ pub struct PssSampler {
 impl PssSampler {
     /// A sampler whose first evaluation (before any `start_iteration`) is an independent
     /// sample determined by (seed, stream): a chain restarted with the same pair reproduces
-    /// the bootstrap path it was resampled from. `dimensions` is a capacity hint.
+    /// the bootstrap path it was resampled from. `streams` is the number of interleaved
+    /// streams (see `Sampler::start_stream`); `dimensions` the most coordinates an
+    /// evaluation reads, reserved up front so that mutations never allocate.
     pub fn new(
         seed: u64,
         stream: u64,
         large_step_probability: f32,
         sigma: f32,
+        streams: usize,
         dimensions: usize,
     ) -> Self {
         PssSampler {
             rng: Rng::new(seed, stream),
             samples: Vec::with_capacity(dimensions),
+            streams: streams.max(1),
+            stream: 0,
             next: 0,
+            film_position: None,
             iteration: 0,
             large_step: true,
             last_large_step: 0,
@@ -56,16 +69,38 @@ impl PssSampler {
     pub fn restart(&mut self, seed: u64, stream: u64) {
         self.rng = Rng::new(seed, stream);
         self.samples.clear();
+        self.stream = 0;
         self.next = 0;
+        self.film_position = None;
         self.iteration = 0;
         self.large_step = true;
         self.last_large_step = 0;
+    }
+
+    /// `restart`, with the film position of the first evaluation given (in [0, 1)²).
+    pub fn restart_at(&mut self, seed: u64, stream: u64, film_position: [f32; 2]) {
+        self.restart(seed, stream);
+        self.film_position = Some(film_position);
+    }
+
+    /// Continues with the random numbers of (seed, stream), keeping the state.
+    pub fn reseed(&mut self, seed: u64, stream: u64) {
+        self.rng = Rng::new(seed, stream);
+    }
+
+    /// Sets coordinate `index` of `stream`, which the current state has read, to `value`:
+    /// a chain seeded from a sample that summed alternatives picks one this way.
+    pub fn set_coordinate(&mut self, stream: usize, index: usize, value: f32) {
+        let i = stream + index * self.streams;
+        debug_assert!(i < self.samples.len() && (0.0..1.0).contains(&value));
+        self.samples[i].value = value;
     }
 
     /// Begins a proposal.
     pub fn start_iteration(&mut self) {
         self.iteration += 1;
         self.large_step = self.rng.uniform() < self.large_step_probability;
+        self.stream = 0;
         self.next = 0;
     }
 
@@ -110,7 +145,15 @@ impl PssSampler {
         }
         x.backup_value = x.value;
         x.backup_modified = x.modified;
-        if self.large_step {
+        let preset = match self.film_position {
+            Some(position) if self.iteration == 0 && i < 2 * self.streams => i
+                .is_multiple_of(self.streams)
+                .then(|| position[i / self.streams]),
+            _ => None,
+        };
+        if let Some(value) = preset {
+            x.value = value;
+        } else if self.large_step {
             x.value = self.rng.uniform();
         } else {
             let small_steps = (self.iteration - x.modified) as f32;
@@ -128,10 +171,17 @@ impl PssSampler {
 impl Sampler for PssSampler {
     #[inline]
     fn uniform(&mut self) -> f32 {
-        let i = self.next;
+        let i = self.stream + self.next * self.streams;
         self.next += 1;
         self.ensure_ready(i);
         self.samples[i].value
+    }
+
+    #[inline]
+    fn start_stream(&mut self, stream: usize) {
+        debug_assert!(stream < self.streams);
+        self.stream = stream;
+        self.next = 0;
     }
 }
 
@@ -148,7 +198,7 @@ mod tests {
 
     #[test]
     fn rejection_restores_the_state_exactly() {
-        let mut s = PssSampler::new(1, 2, 0.3, 0.01, 8);
+        let mut s = PssSampler::new(1, 2, 0.3, 0.01, 1, 8);
         let first: Vec<f32> = (0..5).map(|_| s.uniform()).collect();
         for _ in 0..50 {
             s.start_iteration();
@@ -166,8 +216,8 @@ mod tests {
 
     #[test]
     fn reproduces_its_first_sample() {
-        let mut a = PssSampler::new(7, 9, 0.3, 0.01, 8);
-        let mut b = PssSampler::new(7, 9, 0.3, 0.01, 8);
+        let mut a = PssSampler::new(7, 9, 0.3, 0.01, 1, 8);
+        let mut b = PssSampler::new(7, 9, 0.3, 0.01, 1, 8);
         let va: Vec<f32> = (0..6).map(|_| a.uniform()).collect();
         let vb: Vec<f32> = (0..6).map(|_| b.uniform()).collect();
         assert_eq!(va, vb);
@@ -177,7 +227,7 @@ mod tests {
     fn coordinates_stay_uniform_under_mutation() {
         // The uniform density is stationary for these mutations when every proposal is
         // accepted: the mean and variance of a coordinate stay those of U(0, 1).
-        let mut s = PssSampler::new(3, 4, 0.2, 0.05, 2);
+        let mut s = PssSampler::new(3, 4, 0.2, 0.05, 1, 2);
         let n = 200_000;
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..n {
@@ -218,7 +268,7 @@ mod chain_tests {
         let bins = 16;
         let mut histogram = vec![0.0f64; bins];
         for chain in 0..8u64 {
-            let mut s = PssSampler::new(11, chain, 0.3, 0.05, 2);
+            let mut s = PssSampler::new(11, chain, 0.3, 0.05, 1, 2);
             let (mut x0, mut fx) = eval(&mut s);
             for _ in 0..400_000 {
                 s.start_iteration();

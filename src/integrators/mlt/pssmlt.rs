@@ -1,33 +1,50 @@
-//! Primary-sample-space MLT (Kelemen et al. 2002) over the path tracer.
+//! Markov chains over primary sample space (Kelemen et al. 2002), shared by PSSMLT over the
+//! path tracer, PSSMLT over BDPT and multiplexed MLT (Hachisuka et al. 2014), which differ only
+//! in the function of the primary samples the chains explore (`PrimarySpaceTarget`).
 //!
-//! 1. Bootstrap: N independent samples estimate b = ∫ luminance(f) over primary sample space.
-//! 2. Chains start from bootstrap samples resampled in proportion to their luminance, which
-//!    removes start-up bias up to the resampling's own accuracy.
-//! 3. Each mutation splats the proposal with weight a and the current state with 1 − a
-//!    (expected-value splatting), each as f / luminance(f).
-//! 4. The image is the splat sum × b / (mutations per pixel); b is refined with the large
-//!    steps, which are independent samples of the same integral.
+//! 1. Bootstrap: N samples, stratified over the film, estimate b_g = ∫ f for every chain group
+//!    g (MMLT: one group per path depth, each estimated with all of BDPT's strategies; the
+//!    others: a single group).
+//! 2. Chains are allotted to the groups in proportion to b_g (largest remainder, at least one
+//!    per group with light) and start from bootstrap samples resampled in proportion to their
+//!    value (systematic resampling), which removes start-up bias up to the resampling's own
+//!    accuracy. Every chain makes the same number of mutations.
+//! 3. Each mutation deposits the proposal with weight a and the current state with 1 − a
+//!    (expected-value splatting), each as f⃗ / f, so a chain's deposits sum to one unit of
+//!    luminance per mutation.
+//! 4. A chain of group g is scaled by b_g / (its group's chains × mutations per chain): every
+//!    group then carries exactly its bootstrap estimate b_g of the image's luminance, however
+//!    its chains wandered. The image's brightness error is the error of the b_g alone, which
+//!    the stratified bootstrap keeps small; a single group normalized by the chains' own visits
+//!    (pbrt-v3's design) adds the random allotment of chains to depths on top.
 //!
-//! Determinism: chains run in rounds; within a round they run in parallel, each recording
-//! its splats, which are added to the film in chain order after the round.
+//! Determinism: each chain's random numbers derive from (seed, chain index). Chains run in
+//! rounds; within a round they run in parallel, each recording its deposits, which are added
+//! to the film in chain order after the round.
 
 use super::acceptance;
 use super::pss::PssSampler;
 use crate::film::Film;
-use crate::integrators::path::PathTracer;
-use crate::integrators::{SampleCounters, Splat};
+use crate::integrators::Splat;
 use crate::render::Control;
-use crate::sampling::{Distribution1D, Rng, Sampler};
-use crate::scene::{CameraModel, luminance};
+use crate::sampling::Rng;
+use crate::scene::CameraModel;
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 
-/// Target mutations per round over all chains: bounds the splat memory and how long a stop
-/// takes.
-const MUTATIONS_PER_ROUND: u64 = 1 << 18;
-/// Stream offset that keeps the chains' start selection apart from the bootstrap streams.
-const CHAIN_SELECTION_STREAM: u64 = 0x5eed_c4a1_0000_0000;
+/// Deposits recorded per round over all chains: bounds the round's memory (16 bytes each)
+/// and how long a stop takes.
+const DEPOSITS_PER_ROUND: u64 = 1 << 20;
+/// Bootstrap samples evaluated by one parallel work unit with one sampler.
+const BOOTSTRAP_CHUNK: u64 = 1024;
+/// Most per-sample, per-group values the bootstrap keeps for resampling chain seeds; the
+/// normalization always uses every bootstrap sample.
+const BOOTSTRAP_KEPT_VALUES: u64 = 1 << 23;
+/// Stream offsets that keep the chains' own random numbers apart from the bootstrap's.
+const CHAIN_STREAM: u64 = 0x5eed_c4a1_0000_0000;
+const RESAMPLING_STREAM: u64 = 0x5eed_5e1e_0000_0000;
+const SEED_CHOICE_STREAM: u64 = 0x5eed_c401_0000_0000;
 
 #[derive(Clone, Copy, Debug)]
 pub struct PssmltSettings {
@@ -39,90 +56,306 @@ pub struct PssmltSettings {
     pub seed: u64,
 }
 
-/// What a PSSMLT render measured.
+/// What a Metropolis render measured.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PssmltOutcome {
     pub mutations: u64,
     pub accepted: u64,
-    /// The normalization b = ∫ luminance(f) used for the image.
+    /// The normalization b = ∫ f (summed over chain groups) the image is scaled by.
     pub normalization: f64,
 }
 
-struct Chain {
+/// What one state of a chain contributes to the image: a few (pixel, value) entries and the
+/// scalar target f the chain is distributed by.
+pub(crate) struct PathSample {
+    pub entries: Vec<Splat>,
+    pub target: f32,
+}
+
+impl PathSample {
+    pub fn with_capacity(entries: usize) -> Self {
+        PathSample {
+            entries: Vec::with_capacity(entries),
+            target: 0.0,
+        }
+    }
+
+    pub fn clear(&mut self) {
+        self.entries.clear();
+        self.target = 0.0;
+    }
+
+    /// The luminance of a contribution, or 0 for one that is not finite or not positive
+    /// (dropped: a chain must not be drawn to a NaN).
+    #[inline]
+    pub fn usable_luminance(value: Vec3A) -> f32 {
+        let luminance = crate::scene::luminance(value);
+        if luminance > 0.0 && luminance.is_finite() && value.is_finite() {
+            luminance
+        } else {
+            0.0
+        }
+    }
+
+    /// Adds a contribution; non-finite or black ones are dropped.
+    #[inline]
+    pub fn push(&mut self, pixel: u32, value: Vec3A) {
+        let luminance = Self::usable_luminance(value);
+        if luminance > 0.0 {
+            self.entries.push(Splat {
+                pixel,
+                value: value.into(),
+            });
+            self.target += luminance;
+        }
+    }
+}
+
+/// A function over primary sample space whose luminance the chains are distributed by.
+pub(crate) trait PrimarySpaceTarget: Sync {
+    type Scratch: Send;
+    fn scratch(&self) -> Self::Scratch;
+    /// Streams the sampler interleaves (see `Sampler::start_stream`).
+    fn streams(&self) -> usize;
+    /// Most coordinates one evaluation reads.
+    fn dimensions(&self) -> usize;
+    /// Most entries of one `PathSample`.
+    fn max_entries(&self) -> usize;
+    /// Groups with separate chains and normalizations (MMLT: path depths).
+    fn groups(&self) -> usize;
+    /// Evaluates an independent sample, adding each group's target value to `targets`.
+    fn bootstrap(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut Self::Scratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+    );
+    /// Evaluates the state a chain of `group` starts from: the sampler was restarted where
+    /// a bootstrap sample was drawn. Where the bootstrap summed alternatives the chain state
+    /// picks one of (MMLT: strategies), `choice` ∈ [0, 1) picks one in proportion to its value
+    /// and the sampler is changed to hold it.
+    #[allow(clippy::too_many_arguments)]
+    fn seed(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut Self::Scratch,
+        group: usize,
+        choice: f32,
+        out: &mut PathSample,
+        rays: &mut u64,
+    );
+    /// Evaluates the sampler's current state for a chain of `group`.
+    fn evaluate(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut Self::Scratch,
+        group: usize,
+        out: &mut PathSample,
+        rays: &mut u64,
+    );
+}
+
+/// The film position of a primary sample pair, in pixels, and its pixel index.
+#[inline]
+pub(crate) fn film_position(camera: &CameraModel, [u, v]: [f32; 2]) -> (f32, f32, u32) {
+    let x = (u * camera.width as f32).min(camera.width as f32 - 1.0);
+    let y = (v * camera.height as f32).min(camera.height as f32 - 1.0);
+    (x, y, y as u32 * camera.width + x as u32)
+}
+
+struct Chain<T: PrimarySpaceTarget> {
+    group: usize,
+    /// b_g / (chains of the group): the factor of this chain's deposits.
+    weight: f64,
     sampler: PssSampler,
-    current: Vec3A,
-    current_luminance: f32,
-    current_pixel: u32,
-    remaining: u64,
-    splats: Vec<Splat>,
-    large_step_sum: f64,
-    large_steps: u64,
+    scratch: T::Scratch,
+    current: PathSample,
+    proposal: PathSample,
+    deposits: Vec<Splat>,
     accepted: u64,
-    mutations: u64,
     rays: u64,
 }
 
-/// One evaluation of the estimator at the sampler's state: (contribution, pixel).
-#[inline]
-fn evaluate(
-    tracer: &PathTracer,
-    camera: &CameraModel,
-    sampler: &mut PssSampler,
-    rays: &mut u64,
-) -> (Vec3A, u32) {
-    let [u, v] = sampler.uniform2();
-    let x = (u * camera.width as f32).min(camera.width as f32 - 1.0);
-    let y = (v * camera.height as f32).min(camera.height as f32 - 1.0);
-    let lens = sampler.uniform2();
-    let (origin, direction) = camera.generate_ray(x, y, lens);
-    let l = tracer.radiance(origin, direction, sampler, rays);
-    let pixel = y as u32 * camera.width + x as u32;
-    let l = if l.is_finite() { l } else { Vec3A::ZERO };
-    (l, pixel)
+/// The stratified film position of bootstrap sample `i` of `n`: the samples sweep the pixels
+/// in order, each covering 1/n of the film.
+fn bootstrap_film_position(i: u64, n: u64, camera: &CameraModel, rng: &mut Rng) -> [f32; 2] {
+    let pixels = camera.width as u64 * camera.height as u64;
+    let t = (i as f64 + rng.uniform() as f64) / n as f64 * pixels as f64;
+    let pixel = (t.floor() as u64).min(pixels - 1);
+    let x = (pixel % camera.width as u64) as f64 + (t - pixel as f64);
+    let y = (pixel / camera.width as u64) as f32 + rng.uniform();
+    [
+        ((x / camera.width as f64) as f32).min(1.0 - f32::EPSILON),
+        (y / camera.height as f32).min(1.0 - f32::EPSILON),
+    ]
 }
 
-pub(crate) fn run(
-    tracer: &PathTracer,
+/// Restarts `sampler` as bootstrap sample `i` of `n`.
+fn restart_as_bootstrap(
+    sampler: &mut PssSampler,
+    settings: &PssmltSettings,
+    camera: &CameraModel,
+    i: u64,
+    n: u64,
+) {
+    let mut jitter = Rng::new(settings.seed, i);
+    let position = bootstrap_film_position(i, n, camera, &mut jitter);
+    // The sampler's stream is offset so its numbers differ from the jitter's.
+    sampler.restart_at(settings.seed, i + (1 << 40), position);
+}
+
+/// The bootstrap: per group, the sum of the target over all samples, and the values of the
+/// first samples (sample-major) for resampling.
+struct Bootstrap {
+    sums: Vec<f64>,
+    kept: Vec<f32>,
+    kept_samples: u64,
+}
+
+fn bootstrap<T: PrimarySpaceTarget>(
+    target: &T,
     camera: &CameraModel,
     settings: &PssmltSettings,
-    film: &mut Film,
     control: &Control,
-) -> PssmltOutcome {
-    let dimensions = 4 + 7 * (tracer.max_depth as usize + 1);
-    // 1. Bootstrap, in fixed chunks that each reuse one sampler (no allocation per sample).
-    const BOOTSTRAP_CHUNK: u64 = 1024;
-    let bootstrap_count = settings.bootstrap_samples as u64;
-    let mut bootstrap = vec![(0.0f32, 0u64); bootstrap_count as usize];
-    bootstrap
-        .par_chunks_mut(BOOTSTRAP_CHUNK as usize)
-        .enumerate()
-        .for_each(|(chunk, out)| {
+) -> Bootstrap {
+    let groups = target.groups();
+    let n = settings.bootstrap_samples as u64;
+    let kept_samples = n.min(BOOTSTRAP_KEPT_VALUES / groups as u64).max(1);
+    let chunks = n.div_ceil(BOOTSTRAP_CHUNK);
+    let results: Vec<(Vec<f64>, Vec<f32>, u64)> = (0..chunks)
+        .into_par_iter()
+        .map(|chunk| {
             let mut sampler = PssSampler::new(
                 settings.seed,
                 0,
                 settings.large_step_probability,
                 settings.small_step_sigma,
-                dimensions,
+                target.streams(),
+                target.dimensions(),
             );
-            for (i, slot) in out.iter_mut().enumerate() {
-                sampler.restart(settings.seed, chunk as u64 * BOOTSTRAP_CHUNK + i as u64);
-                let mut rays = 0;
-                let l = evaluate(tracer, camera, &mut sampler, &mut rays).0;
-                *slot = (luminance(l), rays);
+            let mut scratch = target.scratch();
+            let mut sums = vec![0.0f64; groups];
+            let mut values = vec![0.0f32; groups];
+            let first = chunk * BOOTSTRAP_CHUNK;
+            let end = (first + BOOTSTRAP_CHUNK).min(n);
+            let mut kept =
+                Vec::with_capacity((end.min(kept_samples).saturating_sub(first)) as usize * groups);
+            let mut rays = 0;
+            for i in first..end {
+                restart_as_bootstrap(&mut sampler, settings, camera, i, n);
+                values.fill(0.0);
+                target.bootstrap(camera, &mut sampler, &mut scratch, &mut values, &mut rays);
+                for (sum, &v) in sums.iter_mut().zip(&values) {
+                    *sum += v as f64;
+                }
+                if i < kept_samples {
+                    kept.extend_from_slice(&values);
+                }
             }
-        });
-    let weights: Vec<f32> = bootstrap.iter().map(|&(w, _)| w).collect();
-    let bootstrap_sum: f64 = weights.iter().map(|&w| w as f64).sum();
-    control
-        .rays
-        .fetch_add(bootstrap.iter().map(|&(_, r)| r).sum(), Ordering::Relaxed);
-    drop(bootstrap);
-    if bootstrap_sum <= 0.0 {
+            (sums, kept, rays)
+        })
+        .collect();
+    let mut sums = vec![0.0f64; groups];
+    let mut kept = Vec::with_capacity(kept_samples as usize * groups);
+    let mut rays = 0;
+    for (chunk_sums, chunk_kept, chunk_rays) in results {
+        for (sum, s) in sums.iter_mut().zip(chunk_sums) {
+            *sum += s;
+        }
+        kept.extend_from_slice(&chunk_kept);
+        rays += chunk_rays;
+    }
+    control.rays.fetch_add(rays, Ordering::Relaxed);
+    Bootstrap {
+        sums,
+        kept,
+        kept_samples,
+    }
+}
+
+/// Chains per group: `total` in proportion to `b`, at least one per group with b > 0
+/// (largest remainder).
+fn allot_chains(b: &[f64], total: u64) -> Vec<u64> {
+    let sum: f64 = b.iter().sum();
+    let lit = b.iter().filter(|&&x| x > 0.0).count() as u64;
+    let total = total.max(lit);
+    // Every lit group has one chain; the rest go by the largest remainder of their share.
+    let spare = (total - lit) as f64;
+    let shares: Vec<f64> = b.iter().map(|&x| x / sum * spare).collect();
+    let mut chains: Vec<u64> = b
+        .iter()
+        .zip(&shares)
+        .map(|(&x, &share)| if x > 0.0 { 1 + share as u64 } else { 0 })
+        .collect();
+    let mut left = total - chains.iter().sum::<u64>();
+    let mut order: Vec<usize> = (0..b.len()).filter(|&g| b[g] > 0.0).collect();
+    order.sort_by(|&a, &c| {
+        let fa = shares[a] - shares[a].floor();
+        let fc = shares[c] - shares[c].floor();
+        fc.total_cmp(&fa).then(a.cmp(&c))
+    });
+    for g in order.into_iter().cycle() {
+        if left == 0 {
+            break;
+        }
+        chains[g] += 1;
+        left -= 1;
+    }
+    chains
+}
+
+/// For each group, `chains[g]` bootstrap sample indices drawn in proportion to the kept
+/// values of that group by systematic resampling (one uniform number per group, so the
+/// seeds spread over the samples as evenly as their values allow).
+fn resample_seeds(bootstrap: &Bootstrap, chains: &[u64], seed: u64) -> Vec<(usize, u64)> {
+    let groups = chains.len();
+    let mut seeds = Vec::with_capacity(chains.iter().sum::<u64>() as usize);
+    for (g, &count) in chains.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        let total: f64 = (0..bootstrap.kept_samples as usize)
+            .map(|i| bootstrap.kept[i * groups + g] as f64)
+            .sum();
+        let offset = Rng::new(seed, RESAMPLING_STREAM + g as u64).uniform() as f64;
+        let mut i = 0usize;
+        let mut cumulative = bootstrap.kept[g] as f64;
+        for k in 0..count {
+            let goal = (k as f64 + offset) / count as f64 * total;
+            while cumulative <= goal && i + 1 < bootstrap.kept_samples as usize {
+                i += 1;
+                cumulative += bootstrap.kept[i * groups + g] as f64;
+            }
+            seeds.push((g, i as u64));
+        }
+    }
+    seeds
+}
+
+/// Runs the chains. `after_round(film, mutations per pixel so far)` is called after each round
+/// of mutations, to let another pass keep pace.
+pub(crate) fn run<T: PrimarySpaceTarget>(
+    target: &T,
+    camera: &CameraModel,
+    settings: &PssmltSettings,
+    film: &mut Film,
+    control: &Control,
+    after_round: &mut dyn FnMut(&mut Film, f64),
+) -> PssmltOutcome {
+    // 1. Bootstrap.
+    let n = settings.bootstrap_samples as u64;
+    let boot = bootstrap(target, camera, settings, control);
+    let b: Vec<f64> = boot.sums.iter().map(|&s| s / n as f64).collect();
+    let normalization: f64 = b.iter().sum();
+    if normalization <= 0.0 || !normalization.is_finite() {
         return PssmltOutcome::default();
     }
-    let distribution = Distribution1D::new(&weights);
 
-    // 2. Chains from resampled bootstrap paths.
+    // 2. Chains, allotted to groups and seeded from resampled bootstrap samples.
     let pixels = camera.width as u64 * camera.height as u64;
     // Without a mutation count the render runs until the time limit stops it.
     let total = if settings.mutations_per_pixel > 0 {
@@ -130,107 +363,164 @@ pub(crate) fn run(
     } else {
         u64::MAX / 4
     };
-    let chain_count = (settings.chains as u64).min(total).max(1);
-    let per_round = (MUTATIONS_PER_ROUND / chain_count).max(1);
-    let mut chains: Vec<Chain> = (0..chain_count)
+    let chains_per_group = allot_chains(&b, (settings.chains as u64).min(total));
+    let chain_count: u64 = chains_per_group.iter().sum();
+    let mutations_per_chain = total.div_ceil(chain_count);
+    let deposits_per_mutation = 2 * target.max_entries() as u64;
+    let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / chain_count).max(1);
+    let seeds = resample_seeds(&boot, &chains_per_group, settings.seed);
+    drop(boot);
+    let mut chains: Vec<Chain<T>> = seeds
         .into_par_iter()
-        .map(|c| {
-            let mut select = Rng::new(settings.seed, CHAIN_SELECTION_STREAM + c);
-            let (index, _, _) = distribution.sample_discrete(select.uniform());
+        .enumerate()
+        .map(|(c, (group, index))| {
             let mut sampler = PssSampler::new(
                 settings.seed,
-                index as u64,
+                0,
                 settings.large_step_probability,
                 settings.small_step_sigma,
-                dimensions,
+                target.streams(),
+                target.dimensions(),
             );
+            restart_as_bootstrap(&mut sampler, settings, camera, index, n);
+            let mut scratch = target.scratch();
+            let mut current = PathSample::with_capacity(target.max_entries());
+            let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + c as u64);
             let mut rays = 0;
-            let (current, current_pixel) = evaluate(tracer, camera, &mut sampler, &mut rays);
+            target.seed(
+                camera,
+                &mut sampler,
+                &mut scratch,
+                group,
+                choice.uniform(),
+                &mut current,
+                &mut rays,
+            );
+            // Chains seeded from the same sample must still move independently.
+            sampler.reseed(settings.seed, CHAIN_STREAM + c as u64);
             Chain {
+                group,
+                weight: b[group] / chains_per_group[group] as f64,
                 sampler,
+                scratch,
                 current,
-                current_luminance: luminance(current),
-                current_pixel,
-                remaining: total / chain_count + u64::from(c < total % chain_count),
-                splats: Vec::with_capacity(2 * per_round as usize),
-                large_step_sum: 0.0,
-                large_steps: 0,
+                proposal: PathSample::with_capacity(target.max_entries()),
+                deposits: Vec::with_capacity((per_round * deposits_per_mutation) as usize),
                 accepted: 0,
-                mutations: 0,
                 rays,
             }
         })
         .collect();
 
-    // 3. Rounds of mutations.
-    while chains.iter().any(|c| c.remaining > 0) && !control.should_stop() {
+    // 3. Rounds of mutations, every chain making the same number. The first round, about
+    //    one mutation per pixel, always runs, so a stopped render still has an image.
+    let mut mutations_done = 0u64;
+    let first_round = pixels.div_ceil(chain_count).min(per_round);
+    while mutations_done < mutations_per_chain && (mutations_done == 0 || !control.should_stop()) {
+        let round = if mutations_done == 0 {
+            first_round
+        } else {
+            per_round
+        };
+        let steps = (mutations_per_chain - mutations_done).min(round);
         chains.par_iter_mut().for_each(|chain| {
-            chain.splats.clear();
-            let steps = chain.remaining.min(per_round);
+            chain.deposits.clear();
             for _ in 0..steps {
-                mutate(tracer, camera, chain);
+                mutate(target, camera, chain);
             }
-            chain.remaining -= steps;
             control.samples_done.fetch_add(steps, Ordering::Relaxed);
         });
+        mutations_done += steps;
         for chain in &chains {
-            film.add_splats(&chain.splats, 0);
+            film.add_weighted_splats(&chain.deposits, chain.weight);
         }
+        after_round(film, (mutations_done * chain_count) as f64 / pixels as f64);
     }
 
-    // 4. Normalization.
-    let mut outcome = PssmltOutcome::default();
-    let mut luminance_sum = bootstrap_sum;
-    let mut independent_samples = settings.bootstrap_samples as u64;
+    // 4. Normalization: group g's deposits sum to (its chains × mutations per chain) units.
+    let mut outcome = PssmltOutcome {
+        normalization,
+        mutations: mutations_done * chain_count,
+        ..Default::default()
+    };
     let mut rays = 0;
     for chain in &chains {
-        luminance_sum += chain.large_step_sum;
-        independent_samples += chain.large_steps;
-        outcome.mutations += chain.mutations;
         outcome.accepted += chain.accepted;
         rays += chain.rays;
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
-    outcome.normalization = luminance_sum / independent_samples as f64;
-    if outcome.mutations > 0 {
-        film.set_splat_scale(outcome.normalization * pixels as f64 / outcome.mutations as f64);
+    if mutations_done > 0 {
+        film.set_splat_scale(pixels as f64 / mutations_done as f64);
     }
     outcome
 }
 
 #[inline]
-fn mutate(tracer: &PathTracer, camera: &CameraModel, chain: &mut Chain) {
-    let mut counters = SampleCounters::default();
+fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut Chain<T>) {
     chain.sampler.start_iteration();
-    let (proposal, proposal_pixel) =
-        evaluate(tracer, camera, &mut chain.sampler, &mut counters.rays);
-    let proposal_luminance = luminance(proposal);
-    if chain.sampler.is_large_step() {
-        chain.large_step_sum += proposal_luminance as f64;
-        chain.large_steps += 1;
-    }
-    let a = acceptance(chain.current_luminance, proposal_luminance, 1.0);
+    chain.proposal.clear();
+    target.evaluate(
+        camera,
+        &mut chain.sampler,
+        &mut chain.scratch,
+        chain.group,
+        &mut chain.proposal,
+        &mut chain.rays,
+    );
+    let a = acceptance(chain.current.target, chain.proposal.target, 1.0);
     if a > 0.0 {
-        chain.splats.push(Splat {
-            pixel: proposal_pixel,
-            value: proposal * (a / proposal_luminance),
-        });
+        deposit(&mut chain.deposits, &chain.proposal, a);
     }
-    if a < 1.0 && chain.current_luminance > 0.0 {
-        chain.splats.push(Splat {
-            pixel: chain.current_pixel,
-            value: chain.current * ((1.0 - a) / chain.current_luminance),
-        });
+    if a < 1.0 && chain.current.target > 0.0 {
+        deposit(&mut chain.deposits, &chain.current, 1.0 - a);
     }
     if chain.sampler.decision() < a {
-        chain.current = proposal;
-        chain.current_luminance = proposal_luminance;
-        chain.current_pixel = proposal_pixel;
+        std::mem::swap(&mut chain.current, &mut chain.proposal);
         chain.sampler.accept();
         chain.accepted += 1;
     } else {
         chain.sampler.reject();
     }
-    chain.mutations += 1;
-    chain.rays += counters.rays;
+}
+
+/// Records `weight` × the state's contributions, each divided by the state's target value.
+#[inline]
+fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32) {
+    let scale = weight / state.target;
+    for entry in &state.entries {
+        deposits.push(Splat {
+            pixel: entry.pixel,
+            value: entry.value * scale,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chains_follow_the_groups_normalizations() {
+        assert_eq!(allot_chains(&[3.0, 1.0], 8), vec![6, 2]);
+        // Every lit group gets a chain, however dim.
+        assert_eq!(allot_chains(&[1000.0, 0.0, 1e-6], 4), vec![3, 0, 1]);
+        assert_eq!(allot_chains(&[1.0, 1.0, 1.0], 2), vec![1, 1, 1]);
+        let chains = allot_chains(&[0.5, 0.3, 0.2], 1000);
+        assert_eq!(chains.iter().sum::<u64>(), 1000);
+        assert_eq!(chains, vec![500, 300, 200]);
+    }
+
+    #[test]
+    fn bootstrap_positions_cover_each_pixel_equally() {
+        let camera = crate::scene::Camera::default().model(4, 2);
+        let n = 8 * 5;
+        let mut counts = [0u32; 8];
+        let mut rng = Rng::new(1, 2);
+        for i in 0..n {
+            let p = bootstrap_film_position(i, n, &camera, &mut rng);
+            let (_, _, pixel) = film_position(&camera, p);
+            counts[pixel as usize] += 1;
+        }
+        assert_eq!(counts, [5; 8]);
+    }
 }

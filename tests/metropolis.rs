@@ -1,18 +1,24 @@
-//! Primary-sample-space MLT against ground truth and the path tracer: the white furnace, the
-//! Cornell scenes (image mean and per-region means within 4 combined standard errors
-//! estimated from independent renders; a 2% bias resolvable), identical images for any
-//! thread count, and a stopped render normalized by the mutations actually made.
+//! The Metropolis algorithms (PSSMLT over the path tracer, PSSMLT over BDPT, multiplexed MLT)
+//! against ground truth and the path tracer: the white furnace, the Cornell scenes (image
+//! mean and per-region means within 4 combined standard errors estimated from independent
+//! renders; a 2% bias resolvable), identical images for any thread count, and a stopped
+//! render normalized by the mutations actually made.
 
 mod common;
 
 use common::*;
 use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
 
-fn pssmlt_settings(size: u32, mutations_per_pixel: u32, seed: u64) -> RenderSettings {
+fn metropolis_settings(
+    algorithm: Algorithm,
+    size: u32,
+    mutations_per_pixel: u32,
+    seed: u64,
+) -> RenderSettings {
     RenderSettings {
         width: size,
         height: size,
-        algorithm: Algorithm::Pssmlt,
+        algorithm,
         mutations_per_pixel,
         bootstrap_samples: 1 << 16,
         chains: 256,
@@ -43,14 +49,19 @@ fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
     Estimate::from_renders(64, 64, &renders)
 }
 
-/// The luminance of a PSSMLT image's mean is exactly its normalization b, so the image mean
-/// is only as good as b: enough bootstrap samples make a 2% error resolvable.
-fn pssmlt_estimate(scene: &Scene, camera: &Camera, mutations_per_pixel: u32) -> Estimate {
+/// The luminance of a Metropolis image's mean is exactly its normalization b, so the image
+/// mean is only as good as b: enough bootstrap samples make a 2% error resolvable.
+fn metropolis_estimate(
+    algorithm: Algorithm,
+    scene: &Scene,
+    camera: &Camera,
+    mutations_per_pixel: u32,
+) -> Estimate {
     let renders: Vec<Vec<f32>> = (0..16)
         .map(|seed| {
             let settings = RenderSettings {
                 bootstrap_samples: 1 << 19,
-                ..pssmlt_settings(64, mutations_per_pixel, seed)
+                ..metropolis_settings(algorithm, 64, mutations_per_pixel, seed)
             };
             render_image(scene, camera, &settings)
         })
@@ -58,8 +69,7 @@ fn pssmlt_estimate(scene: &Scene, camera: &Camera, mutations_per_pixel: u32) -> 
     Estimate::from_correlated_renders(64, 64, &renders)
 }
 
-#[test]
-fn pssmlt_furnace_matches_the_geometric_series() {
+fn furnace_matches_the_geometric_series(algorithm: Algorithm) {
     let albedo = [0.5, 0.7, 0.9];
     let emission = [1.0, 0.5, 2.0];
     let scene = furnace_scene(albedo, emission);
@@ -67,7 +77,7 @@ fn pssmlt_furnace_matches_the_geometric_series() {
         .map(|seed| {
             let settings = RenderSettings {
                 max_depth: 3,
-                ..pssmlt_settings(32, 32, seed)
+                ..metropolis_settings(algorithm, 32, 32, seed)
             };
             render_image(&scene, &furnace_camera(), &settings)
         })
@@ -88,29 +98,25 @@ fn pssmlt_furnace_matches_the_geometric_series() {
     }
 }
 
-#[test]
-fn pssmlt_agrees_with_the_path_tracer_on_the_cornell_box() {
-    let (scene, camera) = load_canonical("cornell-box");
+fn agrees_with_the_path_tracer(algorithm: Algorithm, scene_name: &str) {
+    let (scene, camera) = load_canonical(scene_name);
     let reference = path_reference(&scene, &camera);
-    let test = pssmlt_estimate(&scene, &camera, 64);
-    assert_estimates_agree("cornell-box pssmlt", &test, &reference, 4, 4.0);
+    let test = metropolis_estimate(algorithm, &scene, &camera, 64);
+    assert_estimates_agree(
+        &format!("{scene_name} {algorithm:?}"),
+        &test,
+        &reference,
+        4,
+        4.0,
+    );
 }
 
-#[test]
-fn pssmlt_agrees_with_the_path_tracer_on_cornell_glass() {
-    let (scene, camera) = load_canonical("cornell-glass");
-    let reference = path_reference(&scene, &camera);
-    let test = pssmlt_estimate(&scene, &camera, 64);
-    assert_estimates_agree("cornell-glass pssmlt", &test, &reference, 4, 4.0);
-}
-
-#[test]
-fn pssmlt_image_is_identical_for_any_thread_count() {
+fn image_is_identical_for_any_thread_count(algorithm: Algorithm) {
     let (scene, camera) = load_canonical("cornell-glass");
     let bits = |threads| {
         let settings = RenderSettings {
             threads,
-            ..pssmlt_settings(32, 8, 3)
+            ..metropolis_settings(algorithm, 32, 8, 3)
         };
         render_image(&scene, &camera, &settings)
             .iter()
@@ -122,13 +128,12 @@ fn pssmlt_image_is_identical_for_any_thread_count() {
     assert_eq!(one, bits(3));
 }
 
-#[test]
-fn cancelled_pssmlt_is_normalized_by_the_mutations_made() {
+fn cancelled_render_is_normalized_by_the_mutations_made(algorithm: Algorithm) {
     let (scene, camera) = load_canonical("cornell-box");
     let reference = path_reference(&scene, &camera).mean().0;
     let settings = RenderSettings {
         mutations_per_pixel: 1 << 20,
-        ..pssmlt_settings(64, 0, 5)
+        ..metropolis_settings(algorithm, 64, 0, 5)
     };
     let mut image = vec![0.0; 64 * 64 * 3];
     let mut calls = 0;
@@ -158,3 +163,41 @@ fn cancelled_pssmlt_is_normalized_by_the_mutations_made() {
         );
     }
 }
+
+/// The tests above for each Metropolis algorithm, in a module named after it.
+macro_rules! metropolis_tests {
+    ($module:ident, $algorithm:expr) => {
+        mod $module {
+            use super::*;
+
+            #[test]
+            fn furnace_matches_the_geometric_series() {
+                super::furnace_matches_the_geometric_series($algorithm);
+            }
+
+            #[test]
+            fn agrees_with_the_path_tracer_on_the_cornell_box() {
+                super::agrees_with_the_path_tracer($algorithm, "cornell-box");
+            }
+
+            #[test]
+            fn agrees_with_the_path_tracer_on_cornell_glass() {
+                super::agrees_with_the_path_tracer($algorithm, "cornell-glass");
+            }
+
+            #[test]
+            fn image_is_identical_for_any_thread_count() {
+                super::image_is_identical_for_any_thread_count($algorithm);
+            }
+
+            #[test]
+            fn cancelled_render_is_normalized_by_the_mutations_made() {
+                super::cancelled_render_is_normalized_by_the_mutations_made($algorithm);
+            }
+        }
+    };
+}
+
+metropolis_tests!(pssmlt, Algorithm::Pssmlt);
+metropolis_tests!(pssmlt_bdpt, Algorithm::PssmltBdpt);
+metropolis_tests!(mmlt, Algorithm::Mmlt);

@@ -1,0 +1,392 @@
+//! The functions of primary sample space that Metropolis chains explore: the path tracer
+//! (PSSMLT, Kelemen et al. 2002), BDPT with all strategies of a sample summed (PSSMLT over
+//! BDPT), and BDPT with the path depth and one strategy picked by the chain (multiplexed MLT,
+//! Hachisuka et al. 2014).
+
+use super::pss::PssSampler;
+use super::pssmlt::{PathSample, PrimarySpaceTarget, film_position};
+use crate::integrators::bdpt::{
+    Bdpt, BdptScratch, CAMERA_STREAM, CONNECTION_STREAM, Contribution, STREAMS,
+};
+use crate::integrators::path::PathTracer;
+use crate::integrators::{PixelEstimator, SampleCounters};
+use crate::sampling::Sampler;
+use crate::scene::CameraModel;
+use glam::Vec3A;
+
+/// PSSMLT over the path tracer: one stream, read in the path tracer's order.
+impl PrimarySpaceTarget for PathTracer<'_> {
+    type Scratch = PathSample;
+
+    fn scratch(&self) -> PathSample {
+        PathSample::with_capacity(1)
+    }
+
+    fn streams(&self) -> usize {
+        1
+    }
+
+    fn dimensions(&self) -> usize {
+        // Film 2, lens 2; per vertex light sample 3, BSDF sample 3, roulette 1.
+        4 + 7 * (self.max_depth as usize + 1)
+    }
+
+    fn max_entries(&self) -> usize {
+        1
+    }
+
+    fn groups(&self) -> usize {
+        1
+    }
+
+    fn bootstrap(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut PathSample,
+        targets: &mut [f32],
+        rays: &mut u64,
+    ) {
+        scratch.clear();
+        trace_path(self, camera, sampler, scratch, rays);
+        targets[0] += scratch.target;
+    }
+
+    fn seed(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        _: &mut PathSample,
+        _: usize,
+        _: f32,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        trace_path(self, camera, sampler, out, rays);
+    }
+
+    fn evaluate(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        _: &mut PathSample,
+        _: usize,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        trace_path(self, camera, sampler, out, rays);
+    }
+}
+
+#[inline]
+fn trace_path(
+    tracer: &PathTracer,
+    camera: &CameraModel,
+    sampler: &mut PssSampler,
+    out: &mut PathSample,
+    rays: &mut u64,
+) {
+    let (x, y, pixel) = film_position(camera, sampler.uniform2());
+    let lens = sampler.uniform2();
+    let (origin, direction) = camera.generate_ray(x, y, lens);
+    out.push(pixel, tracer.radiance(origin, direction, sampler, rays));
+}
+
+/// Memory of the BDPT targets: the subpaths, a path sample for the bootstrap, and the
+/// strategies of one depth for seeding multiplexed chains.
+pub(crate) struct BdptTargetScratch {
+    paths: BdptScratch,
+    sample: PathSample,
+    strategies: Vec<(usize, Contribution, f32)>,
+}
+
+fn bdpt_scratch(bdpt: &Bdpt) -> BdptTargetScratch {
+    BdptTargetScratch {
+        paths: bdpt.scratch(),
+        sample: PathSample::with_capacity(bdpt_max_entries(bdpt)),
+        strategies: Vec::with_capacity(bdpt.max_depth as usize + 2),
+    }
+}
+
+/// The sample's own pixel plus one light-tracing splat per light vertex.
+fn bdpt_max_entries(bdpt: &Bdpt) -> usize {
+    bdpt.max_depth as usize + 3
+}
+
+/// Starts the camera stream: the film position, then the strategy coordinate (read by every
+/// BDPT target so the coordinates after it keep their places). Returns x, y, the pixel and
+/// the strategy coordinate.
+#[inline]
+fn start_camera_stream(camera: &CameraModel, sampler: &mut PssSampler) -> (f32, f32, u32, f32) {
+    sampler.start_stream(CAMERA_STREAM);
+    let (x, y, pixel) = film_position(camera, sampler.uniform2());
+    let strategy = sampler.uniform();
+    (x, y, pixel, strategy)
+}
+
+/// Traces full-length subpaths (as plain BDPT does) and calls `visit` for every strategy.
+fn trace_all_strategies(
+    bdpt: &Bdpt,
+    camera: &CameraModel,
+    sampler: &mut PssSampler,
+    paths: &mut BdptScratch,
+    rays: &mut u64,
+    visit: impl FnMut(usize, usize, Contribution),
+) -> u32 {
+    let mut counters = SampleCounters::default();
+    let (x, y, pixel, _) = start_camera_stream(camera, sampler);
+    let max_depth = bdpt.max_depth as usize;
+    let lengths = bdpt.trace_subpaths(
+        camera,
+        x,
+        y,
+        max_depth + 2,
+        max_depth + 1,
+        sampler,
+        paths,
+        &mut counters,
+    );
+    bdpt.for_each_strategy(camera, lengths, sampler, paths, &mut counters, visit);
+    *rays += counters.rays;
+    pixel
+}
+
+/// A BDPT sample with all strategies summed: the own pixel's radiance and the splats.
+fn evaluate_all_strategies(
+    bdpt: &Bdpt,
+    camera: &CameraModel,
+    sampler: &mut PssSampler,
+    paths: &mut BdptScratch,
+    out: &mut PathSample,
+    rays: &mut u64,
+) {
+    let mut radiance = Vec3A::ZERO;
+    let pixel = trace_all_strategies(bdpt, camera, sampler, paths, rays, |_, _, c| {
+        match c.splat_pixel {
+            None => radiance += c.value,
+            Some(splat_pixel) => out.push(splat_pixel, c.value),
+        }
+    });
+    out.push(pixel, radiance);
+}
+
+/// PSSMLT over BDPT: a state is one BDPT sample, all its strategies summed.
+pub(crate) struct BdptAllStrategies<'a>(pub Bdpt<'a>);
+
+impl PrimarySpaceTarget for BdptAllStrategies<'_> {
+    type Scratch = BdptTargetScratch;
+
+    fn scratch(&self) -> BdptTargetScratch {
+        bdpt_scratch(&self.0)
+    }
+
+    fn streams(&self) -> usize {
+        STREAMS
+    }
+
+    fn dimensions(&self) -> usize {
+        STREAMS * self.0.coordinates_per_stream()
+    }
+
+    fn max_entries(&self) -> usize {
+        bdpt_max_entries(&self.0)
+    }
+
+    fn groups(&self) -> usize {
+        1
+    }
+
+    fn bootstrap(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+    ) {
+        let sample = &mut scratch.sample;
+        sample.clear();
+        evaluate_all_strategies(&self.0, camera, sampler, &mut scratch.paths, sample, rays);
+        targets[0] += sample.target;
+    }
+
+    fn seed(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        _: usize,
+        _: f32,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        evaluate_all_strategies(&self.0, camera, sampler, &mut scratch.paths, out, rays);
+    }
+
+    fn evaluate(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        _: usize,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        evaluate_all_strategies(&self.0, camera, sampler, &mut scratch.paths, out, rays);
+    }
+}
+
+/// Multiplexed MLT: chains are grouped by path depth (scattering vertices, from `min_depth`:
+/// group g holds depth min_depth + g); the strategy
+/// coordinate of the camera stream picks one strategy (s, t) of that depth, whose
+/// MIS-weighted contribution, times the number of strategies, is the state's value.
+pub(crate) struct BdptMultiplexed<'a>(pub Bdpt<'a>);
+
+/// The strategy (s, t) a coordinate picks among those of a depth, and how many there are.
+/// Depth 0 has one: the camera sees the light (s = 1, t = 1 is never used).
+#[inline]
+fn strategy(depth: usize, u: f32) -> (usize, usize, usize) {
+    if depth == 0 {
+        return (0, 2, 1);
+    }
+    let count = depth + 2;
+    let s = ((u * count as f32) as usize).min(count - 1);
+    (s, count - s, count)
+}
+
+/// Index of the strategy coordinate in the camera stream (after the film position).
+const STRATEGY_COORDINATE: usize = 2;
+
+impl PrimarySpaceTarget for BdptMultiplexed<'_> {
+    type Scratch = BdptTargetScratch;
+
+    fn scratch(&self) -> BdptTargetScratch {
+        bdpt_scratch(&self.0)
+    }
+
+    fn streams(&self) -> usize {
+        STREAMS
+    }
+
+    fn dimensions(&self) -> usize {
+        STREAMS * self.0.coordinates_per_stream()
+    }
+
+    fn max_entries(&self) -> usize {
+        1
+    }
+
+    fn groups(&self) -> usize {
+        (self.0.max_depth + 1).saturating_sub(self.0.min_depth) as usize
+    }
+
+    /// All strategies of full-length subpaths, each added to its depth's group: ∫ over the
+    /// strategy coordinate of (strategies × one strategy's value) is their sum.
+    fn bootstrap(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+    ) {
+        let min_depth = self.0.min_depth as usize;
+        trace_all_strategies(
+            &self.0,
+            camera,
+            sampler,
+            &mut scratch.paths,
+            rays,
+            |s, t, c| targets[s + t - 2 - min_depth] += PathSample::usable_luminance(c.value),
+        );
+    }
+
+    /// Reproduces the bootstrap sample, picks one strategy of `group` in proportion to its
+    /// value and sets the strategy coordinate inside that strategy's interval. Subpaths
+    /// cut to the strategy's lengths are prefixes of the full ones (the streams keep every
+    /// vertex's coordinates), and each strategy reads the connection stream from its start,
+    /// so the state evaluates to the picked strategy's value.
+    fn seed(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        group: usize,
+        choice: f32,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        let depth = group + self.0.min_depth as usize;
+        scratch.strategies.clear();
+        let strategies = &mut scratch.strategies;
+        let pixel = trace_all_strategies(
+            &self.0,
+            camera,
+            sampler,
+            &mut scratch.paths,
+            rays,
+            |s, t, c| {
+                let luminance = PathSample::usable_luminance(c.value);
+                if s + t - 2 == depth && luminance > 0.0 {
+                    strategies.push((s, c, luminance));
+                }
+            },
+        );
+        let total: f32 = strategies.iter().map(|&(_, _, l)| l).sum();
+        let mut goal = choice * total;
+        let Some(&(s, c, _)) = strategies
+            .iter()
+            .find(|&&(_, _, l)| {
+                let found = goal < l;
+                if !found {
+                    goal -= l;
+                }
+                found
+            })
+            .or(strategies.last())
+        else {
+            return;
+        };
+        let (_, _, count) = strategy(depth, 0.0);
+        // Where in the strategy's interval: the rest of `choice`, still uniform.
+        let within = (goal / total.max(f32::MIN_POSITIVE)).clamp(0.0, 0.999);
+        let u = ((s as f32 + within) / count as f32).min(1.0 - f32::EPSILON);
+        debug_assert_eq!(strategy(depth, u).0, s);
+        sampler.set_coordinate(CAMERA_STREAM, STRATEGY_COORDINATE, u);
+        out.push(c.splat_pixel.unwrap_or(pixel), c.value * count as f32);
+    }
+
+    fn evaluate(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        group: usize,
+        out: &mut PathSample,
+        rays: &mut u64,
+    ) {
+        let bdpt = &self.0;
+        let mut counters = SampleCounters::default();
+        // The strategy is read before the subpaths, so it fixes their lengths.
+        let (x, y, pixel, u) = start_camera_stream(camera, sampler);
+        let (s, t, count) = strategy(group + self.0.min_depth as usize, u);
+        let lengths = bdpt.trace_subpaths(
+            camera,
+            x,
+            y,
+            t,
+            s,
+            sampler,
+            &mut scratch.paths,
+            &mut counters,
+        );
+        if lengths == (t, s) {
+            sampler.start_stream(CONNECTION_STREAM);
+            if let Some(c) = bdpt.connect(camera, &mut scratch.paths, s, t, sampler, &mut counters)
+            {
+                out.push(c.splat_pixel.unwrap_or(pixel), c.value * count as f32);
+            }
+        }
+        *rays += counters.rays;
+    }
+}
