@@ -1,0 +1,568 @@
+//! Equal-time quality: how close each algorithm gets to a converged reference in the same
+//! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings.
+//!
+//! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
+//! actual seconds, samples or mutations per second, RMSE, RMSE corrected for the reference's
+//! own noise, and the per-channel mean brightness difference to the reference) and writes a
+//! log-log plot of RMSE against seconds, one line per algorithm and one panel per scene, to
+//! `target/mlt-bench/convergence.png`. Numbers are reported, never asserted.
+//!
+//! Each algorithm renders with one thread for a series of time budgets (1, 2, 5, 10 s by
+//! default: the 1-2-5 series from a tenth of the longest budget up to it), then once with two
+//! threads at the longest budget (in the table, not the plot). The table notes renders that
+//! overran their budget or finished no sample at all (a black image, left out of the plot).
+//!
+//! The reference is the path tracer on every core, rendered as two halves with different
+//! seeds and averaged. Half of the RMSE between the halves estimates the reference's own
+//! RMSE; the corrected RMSE is sqrt(max(0, RMSE² − reference RMSE²)). The halves are cached
+//! as PFM in `target/mlt-bench/` (named by scene, size, depth and spp): delete them after a
+//! change to the renderer that changes its converged image.
+//!
+//! Environment:
+//! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
+//! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 4096).
+//! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
+//!   `cornell-box,cornell-glass`).
+//! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
+//! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
+//!   paths); without one the plot is written without text.
+//!
+//! A quick run: `MLT_BENCH_SECONDS=2 MLT_BENCH_REFERENCE_SPP=256 cargo bench --bench equal_time`.
+
+use mlt::{Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render};
+use plotters::prelude::*;
+use std::error::Error;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The algorithms compared, by the name the table, the plot and `MLT_BENCH_ALGORITHMS` use.
+/// A new algorithm is one more line here.
+const ALGORITHMS: &[(&str, Algorithm)] = &[
+    ("path", Algorithm::Path),
+    ("bdpt", Algorithm::Bdpt),
+    ("pssmlt", Algorithm::Pssmlt),
+];
+
+const DEFAULT_SCENES: &[&str] = &["cornell-box", "cornell-glass"];
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 256;
+const MAX_DEPTH: u32 = 5;
+const DEFAULT_MAX_SECONDS: f64 = 10.0;
+const DEFAULT_REFERENCE_SPP: u32 = 4096;
+
+/// Seeds of the two reference halves. The measured renders use seeds 0, 1, 2, …: keeping
+/// these far away means no measured render shares random numbers with the reference, which
+/// would make its error look smaller than it is.
+const REFERENCE_SEEDS: [u64; 2] = [0x5EED_0000_000A, 0x5EED_0000_000B];
+
+/// The family the plot's text asks for; `register_plot_font` registers a font file under it.
+const FONT_FAMILY: &str = "sans-serif";
+const FONT_CANDIDATES: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/System/Library/Fonts/Supplemental/Arial.ttf",
+    "C:\\Windows\\Fonts\\arial.ttf",
+];
+
+/// Line colors of the algorithms, in `ALGORITHMS` order (repeating past the end): distinct
+/// and dark enough to read on white.
+const LINE_COLORS: &[RGBColor] = &[
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn line_color(algorithm_index: usize) -> RGBColor {
+    LINE_COLORS[algorithm_index % LINE_COLORS.len()]
+}
+
+/// A converged image and the estimate of its own remaining error.
+struct Reference {
+    image: Vec<f32>,
+    /// RMSE of the reference against the true image, estimated from its two halves.
+    rmse: f64,
+    spp: u32,
+}
+
+/// One time-limited render compared with the reference.
+struct Measurement {
+    algorithm: &'static str,
+    threads: u32,
+    budget_seconds: f64,
+    stats: RenderStats,
+    rmse: f64,
+    corrected_rmse: f64,
+    /// Per channel: image mean / reference mean − 1, in percent.
+    mean_difference_percent: [f64; 3],
+}
+
+struct SceneResult {
+    scene: String,
+    reference_rmse: f64,
+    measurements: Vec<Measurement>,
+}
+
+fn env_value<T: std::str::FromStr>(name: &str, default: T) -> T {
+    match std::env::var(name) {
+        Ok(text) => text
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("{name}={text:?} is not a valid number")),
+        Err(_) => default,
+    }
+}
+
+/// The comma-separated names in `name`, or `default` when it is not set.
+fn env_names(name: &str, default: &[&str]) -> Vec<String> {
+    match std::env::var(name) {
+        Ok(text) => text
+            .split(',')
+            .map(str::trim)
+            .filter(|s| !s.is_empty())
+            .map(String::from)
+            .collect(),
+        Err(_) => default.iter().map(|s| s.to_string()).collect(),
+    }
+}
+
+/// The 1-2-5 series from a tenth of `max_seconds` up to it, ending at `max_seconds` itself
+/// (10 → 1, 2, 5, 10; 2 → 0.2, 0.5, 1, 2; 30 → 5, 10, 20, 30).
+fn time_budgets(max_seconds: f64) -> Vec<f64> {
+    assert!(
+        max_seconds > 0.0 && max_seconds.is_finite(),
+        "MLT_BENCH_SECONDS must be a positive number of seconds"
+    );
+    // Tolerances so that 10 / 10 = 1 counts as inside the range despite rounding.
+    let low = max_seconds / 10.0 * (1.0 - 1e-9);
+    let high = max_seconds * (1.0 - 1e-9);
+    let first_decade = low.log10().floor() as i32;
+    let mut budgets: Vec<f64> = (first_decade..=first_decade + 2)
+        .flat_map(|exponent| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(exponent)))
+        .filter(|&b| b >= low && b < high)
+        .collect();
+    budgets.push(max_seconds);
+    budgets
+}
+
+/// Root-mean-square difference over all floats (the same definition as the tests' `rmse`).
+fn rmse(a: &[f32], b: &[f32]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+        .sum();
+    (sum / a.len() as f64).sqrt()
+}
+
+fn channel_means(image: &[f32]) -> [f64; 3] {
+    let mut sum = [0.0f64; 3];
+    for pixel in image.chunks_exact(3) {
+        for (s, &value) in sum.iter_mut().zip(pixel) {
+            *s += value as f64;
+        }
+    }
+    sum.map(|s| s / (image.len() / 3) as f64)
+}
+
+fn load_scene(name: &str) -> (Scene, Camera) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/scenes")
+        .join(format!("{name}.obj"));
+    let data = mlt::io::load_scene(&path)
+        .unwrap_or_else(|e| panic!("scene {name} (MLT_BENCH_SCENES) does not load: {e}"));
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).expect("scene builds");
+    let camera = data.camera.expect("camera sidecar").camera;
+    (scene, camera)
+}
+
+/// `target/mlt-bench`, in the target directory cargo uses.
+fn output_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
+    target.join("mlt-bench")
+}
+
+/// The two reference halves, read from the cache or rendered (and cached) when missing.
+fn reference(name: &str, scene: &Scene, camera: &Camera, spp: u32, dir: &Path) -> Reference {
+    let half_spp = (spp / 2).max(1);
+    let halves: Vec<Vec<f32>> = REFERENCE_SEEDS
+        .iter()
+        .zip(["a", "b"])
+        .map(|(&seed, half)| {
+            let path = dir.join(format!(
+                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{half}.pfm"
+            ));
+            if let Ok((WIDTH, HEIGHT, image)) = mlt::io::read_pfm(&path) {
+                return image;
+            }
+            println!(
+                "rendering reference half {half} of {name}: path tracer, {half_spp} spp, all threads"
+            );
+            let settings = RenderSettings {
+                width: WIDTH,
+                height: HEIGHT,
+                max_depth: MAX_DEPTH,
+                algorithm: Algorithm::Path,
+                samples_per_pixel: half_spp,
+                threads: 0,
+                seed,
+                ..Default::default()
+            };
+            let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
+            let stats = render(scene, camera, &settings, &mut image, None).expect("renders");
+            assert_eq!(stats.stop, StopReason::Completed);
+            mlt::io::write_pfm(&path, WIDTH, HEIGHT, &image).expect("reference cache writes");
+            println!("  {:.1} s, cached in {}", stats.seconds, path.display());
+            image
+        })
+        .collect();
+    let image = halves[0]
+        .iter()
+        .zip(&halves[1])
+        .map(|(&a, &b)| 0.5 * (a + b))
+        .collect();
+    // Each half has variance σ² per float, their difference 2σ² and their mean σ²/2: the
+    // mean's RMSE is half the RMSE between the halves.
+    Reference {
+        image,
+        rmse: rmse(&halves[0], &halves[1]) / 2.0,
+        spp: half_spp * 2,
+    }
+}
+
+/// Renders with `algorithm` until `budget_seconds` pass and compares with the reference.
+fn measure(
+    scene: &Scene,
+    camera: &Camera,
+    reference: &Reference,
+    (name, algorithm): (&'static str, Algorithm),
+    threads: u32,
+    budget_seconds: f64,
+    seed: u64,
+) -> Measurement {
+    // Everything else stays at the defaults: they are what is being judged.
+    let settings = RenderSettings {
+        width: WIDTH,
+        height: HEIGHT,
+        max_depth: MAX_DEPTH,
+        algorithm,
+        threads,
+        seed,
+        time_limit_seconds: budget_seconds,
+        // 0: until the time limit.
+        samples_per_pixel: 0,
+        mutations_per_pixel: 0,
+        ..Default::default()
+    };
+    let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
+    let stats = render(scene, camera, &settings, &mut image, None)
+        .unwrap_or_else(|e| panic!("{name} fails to render: {e}"));
+    // With no sample count the render always ends at the time limit.
+    assert_eq!(stats.stop, StopReason::TimeLimitReached, "{name}");
+    let rmse = rmse(&image, &reference.image);
+    let means = channel_means(&image);
+    let reference_means = channel_means(&reference.image);
+    Measurement {
+        algorithm: name,
+        threads,
+        budget_seconds,
+        stats,
+        rmse,
+        corrected_rmse: (rmse * rmse - reference.rmse * reference.rmse)
+            .max(0.0)
+            .sqrt(),
+        mean_difference_percent: std::array::from_fn(|c| {
+            (means[c] / reference_means[c] - 1.0) * 100.0
+        }),
+    }
+}
+
+fn print_header() {
+    println!(
+        "{:<14} {:<8} {:>7} {:>7} {:>8} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
+        "scene", "algo", "threads", "budget", "seconds", "samples/s", "RMSE", "corrected",
+    );
+}
+
+/// How far past its budget a render may run before the table points it out: a stop waits for
+/// the current band or round of work to finish.
+const OVERRUN_TOLERANCE_SECONDS: f64 = 0.1;
+
+fn print_row(scene: &str, m: &Measurement) {
+    let [r, g, b] = m.mean_difference_percent;
+    let mut notes = String::new();
+    if m.stats.samples == 0 {
+        notes.push_str("  no sample finished: black image, not plotted");
+    }
+    if m.stats.seconds > m.budget_seconds * 1.1 + OVERRUN_TOLERANCE_SECONDS {
+        notes.push_str("  over budget");
+    }
+    println!(
+        "{scene:<14} {:<8} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
+        m.algorithm,
+        m.threads,
+        m.budget_seconds,
+        m.stats.seconds,
+        m.stats.samples as f64 / m.stats.seconds,
+        m.rmse,
+        m.corrected_rmse,
+    );
+    // Rows appear as they are measured: a full run takes many minutes.
+    let _ = std::io::stdout().flush();
+}
+
+/// Registers the first readable font of `MLT_BENCH_FONT` or the usual system paths; returns
+/// its path, or `None` when there is none and the plot must do without text.
+fn register_plot_font() -> Option<PathBuf> {
+    let candidates: Vec<PathBuf> = match std::env::var_os("MLT_BENCH_FONT") {
+        Some(path) => vec![PathBuf::from(path)],
+        None => FONT_CANDIDATES.iter().map(PathBuf::from).collect(),
+    };
+    candidates.into_iter().find(|path| {
+        let Ok(bytes) = std::fs::read(path) else {
+            return false;
+        };
+        // plotters keeps fonts for the life of the program and takes only 'static bytes.
+        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+        plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, bytes).is_ok()
+    })
+}
+
+/// Tick values of a log axis over `min..max`: labelled ones on the 1-2-5 series and unlabelled
+/// grid lines at every multiple of a power of ten. (plotters' own log ticks start at the first
+/// power of ten inside the range, which leaves a range like 0.2..2 with a single label.)
+fn log_ticks(min: f64, max: f64) -> (Vec<f64>, Vec<f64>) {
+    let mut labelled = Vec::new();
+    let mut grid = Vec::new();
+    for exponent in min.log10().floor() as i32..=max.log10().ceil() as i32 {
+        for mantissa in 1..=9 {
+            let value = mantissa as f64 * 10f64.powi(exponent);
+            if value < min || value > max {
+                continue;
+            }
+            if [1, 2, 5].contains(&mantissa) {
+                labelled.push(value);
+            } else {
+                grid.push(value);
+            }
+        }
+    }
+    (labelled, grid)
+}
+
+/// A tick label with as many decimals as its size needs (0.05, 0.2, 2, 10).
+fn tick_label(value: f64) -> String {
+    let decimals = (-value.log10().floor()).max(0.0) as usize;
+    format!("{value:.decimals$}")
+}
+
+/// Log-log RMSE against seconds of the one-thread runs, one panel per scene. Renders that
+/// finished no sample are left out: they are black and say nothing about convergence. Without
+/// a font every text element (title, labels, legend) is left out, since drawing text would fail.
+fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box<dyn Error>> {
+    let root = BitMapBackend::new(path, (640 * results.len() as u32, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let root = if with_text {
+        root.titled(
+            &format!(
+                "Equal-time convergence: {WIDTH}×{HEIGHT}, max depth {MAX_DEPTH}, 1 thread, default settings"
+            ),
+            (FONT_FAMILY, 22),
+        )?
+    } else {
+        root
+    };
+    for (panel, result) in root.split_evenly((1, results.len())).iter().zip(results) {
+        let plotted: Vec<&Measurement> = result
+            .measurements
+            .iter()
+            .filter(|m| m.threads == 1 && m.stats.samples > 0 && m.rmse > 0.0)
+            .collect();
+        if plotted.is_empty() {
+            continue;
+        }
+        let (mut x_min, mut x_max, mut y_min, mut y_max) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+        for m in &plotted {
+            x_min = x_min.min(m.stats.seconds);
+            x_max = x_max.max(m.stats.seconds);
+            y_min = y_min.min(m.rmse);
+            y_max = y_max.max(m.rmse);
+        }
+        if result.reference_rmse > 0.0 {
+            y_min = y_min.min(result.reference_rmse);
+        }
+        // A margin so markers at the ends are not cut by the axes.
+        let (x_min, x_max, y_min, y_max) = (x_min / 1.25, x_max * 1.25, y_min / 1.25, y_max * 1.25);
+        let (x_labelled, x_grid) = log_ticks(x_min, x_max);
+        let (y_labelled, y_grid) = log_ticks(y_min, y_max);
+        let mut builder = ChartBuilder::on(panel);
+        builder.margin(16);
+        if with_text {
+            builder
+                .caption(&result.scene, (FONT_FAMILY, 20))
+                .x_label_area_size(44)
+                .y_label_area_size(64);
+        }
+        let mut chart = builder.build_cartesian_2d(
+            (x_min..x_max)
+                .log_scale()
+                .with_key_points(x_labelled)
+                .with_light_points(x_grid),
+            (y_min..y_max)
+                .log_scale()
+                .with_key_points(y_labelled)
+                .with_light_points(y_grid),
+        )?;
+        let mut mesh = chart.configure_mesh();
+        mesh.bold_line_style(BLACK.mix(0.25))
+            .light_line_style(BLACK.mix(0.08));
+        if with_text {
+            mesh.x_desc("seconds (actual, 1 thread)")
+                .y_desc("RMSE vs reference")
+                .x_label_formatter(&|&x| tick_label(x))
+                .y_label_formatter(&|&y| tick_label(y))
+                .label_style((FONT_FAMILY, 14));
+        } else {
+            mesh.x_labels(0).y_labels(0);
+        }
+        mesh.draw()?;
+
+        // The reference's own error: differences much below this line are not measurable.
+        let noise_style = BLACK.mix(0.6).stroke_width(1);
+        let floor = chart.draw_series(DashedLineSeries::new(
+            [
+                (x_min, result.reference_rmse),
+                (x_max, result.reference_rmse),
+            ],
+            6,
+            4,
+            noise_style,
+        ))?;
+        if with_text {
+            floor
+                .label("reference noise")
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], noise_style));
+        }
+        for (index, &(name, _)) in ALGORITHMS.iter().enumerate() {
+            let mut points: Vec<(f64, f64)> = plotted
+                .iter()
+                .filter(|m| m.algorithm == name)
+                .map(|m| (m.stats.seconds, m.rmse))
+                .collect();
+            // By actual time: short budgets can overrun past longer ones.
+            points.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if points.is_empty() {
+                continue;
+            }
+            let color = line_color(index);
+            let series =
+                chart.draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))?;
+            if with_text {
+                series.label(name).legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+            }
+        }
+        if with_text {
+            // Upper right: the curves fall from upper left to lower right.
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font((FONT_FAMILY, 14))
+                .draw()?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
+
+fn main() {
+    let max_seconds = env_value("MLT_BENCH_SECONDS", DEFAULT_MAX_SECONDS);
+    let reference_spp = env_value("MLT_BENCH_REFERENCE_SPP", DEFAULT_REFERENCE_SPP);
+    let scenes = env_names("MLT_BENCH_SCENES", DEFAULT_SCENES);
+    let all_algorithms: Vec<&str> = ALGORITHMS.iter().map(|&(name, _)| name).collect();
+    let algorithms: Vec<(&'static str, Algorithm)> =
+        env_names("MLT_BENCH_ALGORITHMS", &all_algorithms)
+            .iter()
+            .map(|wanted| {
+                *ALGORITHMS
+                    .iter()
+                    .find(|(name, _)| name == wanted)
+                    .unwrap_or_else(|| {
+                        panic!(
+                            "MLT_BENCH_ALGORITHMS: unknown {wanted:?}; known: {all_algorithms:?}"
+                        )
+                    })
+            })
+            .collect();
+    let budgets = time_budgets(max_seconds);
+    let dir = output_dir();
+    std::fs::create_dir_all(&dir).expect("output directory");
+    println!(
+        "equal time: {WIDTH}x{HEIGHT}, max depth {MAX_DEPTH}, budgets {budgets:?} s on 1 thread and {max_seconds} s on 2 threads"
+    );
+
+    let mut results = Vec::new();
+    for name in &scenes {
+        let (scene, camera) = load_scene(name);
+        let reference = reference(name, &scene, &camera, reference_spp, &dir);
+        let [r, g, b] = channel_means(&reference.image);
+        println!(
+            "{name}: reference {} spp (two halves), mean RGB {r:.4} {g:.4} {b:.4}, its own RMSE ≈ {:.5}",
+            reference.spp, reference.rmse
+        );
+        print_header();
+        let mut measurements = Vec::new();
+        for &algorithm in &algorithms {
+            let runs = budgets
+                .iter()
+                .map(|&budget| (1, budget))
+                .chain([(2, max_seconds)]);
+            for (seed, (threads, budget)) in runs.enumerate() {
+                let m = measure(
+                    &scene,
+                    &camera,
+                    &reference,
+                    algorithm,
+                    threads,
+                    budget,
+                    seed as u64,
+                );
+                print_row(name, &m);
+                measurements.push(m);
+            }
+        }
+        results.push(SceneResult {
+            scene: name.clone(),
+            reference_rmse: reference.rmse,
+            measurements,
+        });
+    }
+
+    let font = register_plot_font();
+    if font.is_none() {
+        println!(
+            "no font found (set MLT_BENCH_FONT to a .ttf file): the plot has no title, labels or legend"
+        );
+        for (index, &(name, _)) in ALGORITHMS.iter().enumerate() {
+            let RGBColor(r, g, b) = line_color(index);
+            println!("  {name}: line color #{r:02x}{g:02x}{b:02x}");
+        }
+    }
+    let plot_path = dir.join("convergence.png");
+    match plot(&plot_path, &results, font.is_some()) {
+        Ok(()) => println!("plot: {}", plot_path.display()),
+        Err(e) => println!("plot failed: {e}"),
+    }
+}
