@@ -35,12 +35,18 @@ use std::error::Error;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// The algorithms compared, by the name the table, the plot and `MLT_BENCH_ALGORITHMS` use.
-/// A new algorithm is one more line here.
-const ALGORITHMS: &[(&str, Algorithm)] = &[
-    ("path", Algorithm::Path),
-    ("bdpt", Algorithm::Bdpt),
-    ("pssmlt", Algorithm::Pssmlt),
+/// The algorithms compared, by the name the table, the plot and `MLT_BENCH_ALGORITHMS` use,
+/// with their `direct_samples_per_mutation` (Metropolis: the default direct pass, or 0 for
+/// chains over every depth). A new algorithm is one more line here.
+const DIRECT: u32 = RenderSettings::DEFAULT_DIRECT_SAMPLES_PER_MUTATION;
+const ALGORITHMS: &[(&str, Algorithm, u32)] = &[
+    ("path", Algorithm::Path, 0),
+    ("bdpt", Algorithm::Bdpt, 0),
+    ("pssmlt", Algorithm::Pssmlt, DIRECT),
+    ("pssmlt-bdpt", Algorithm::PssmltBdpt, DIRECT),
+    ("mmlt", Algorithm::Mmlt, DIRECT),
+    ("mmlt-no-direct", Algorithm::Mmlt, 0),
+    ("pssmlt-no-direct", Algorithm::Pssmlt, 0),
 ];
 
 const DEFAULT_SCENES: &[&str] = &["cornell-box", "cornell-glass"];
@@ -244,7 +250,7 @@ fn measure(
     scene: &Scene,
     camera: &Camera,
     reference: &Reference,
-    (name, algorithm): (&'static str, Algorithm),
+    (name, algorithm, direct_samples_per_mutation): (&'static str, Algorithm, u32),
     threads: u32,
     budget_seconds: f64,
     seed: u64,
@@ -261,6 +267,7 @@ fn measure(
         // 0: until the time limit.
         samples_per_pixel: 0,
         mutations_per_pixel: 0,
+        direct_samples_per_mutation,
         ..Default::default()
     };
     let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
@@ -452,7 +459,7 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
                 .label("reference noise")
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], noise_style));
         }
-        for (index, &(name, _)) in ALGORITHMS.iter().enumerate() {
+        for (index, &(name, _, _)) in ALGORITHMS.iter().enumerate() {
             let mut points: Vec<(f64, f64)> = plotted
                 .iter()
                 .filter(|m| m.algorithm == name)
@@ -491,14 +498,14 @@ fn main() {
     let max_seconds = env_value("MLT_BENCH_SECONDS", DEFAULT_MAX_SECONDS);
     let reference_spp = env_value("MLT_BENCH_REFERENCE_SPP", DEFAULT_REFERENCE_SPP);
     let scenes = env_names("MLT_BENCH_SCENES", DEFAULT_SCENES);
-    let all_algorithms: Vec<&str> = ALGORITHMS.iter().map(|&(name, _)| name).collect();
-    let algorithms: Vec<(&'static str, Algorithm)> =
+    let all_algorithms: Vec<&str> = ALGORITHMS.iter().map(|&(name, _, _)| name).collect();
+    let algorithms: Vec<(&'static str, Algorithm, u32)> =
         env_names("MLT_BENCH_ALGORITHMS", &all_algorithms)
             .iter()
             .map(|wanted| {
                 *ALGORITHMS
                     .iter()
-                    .find(|(name, _)| name == wanted)
+                    .find(|(name, _, _)| name == wanted)
                     .unwrap_or_else(|| {
                         panic!(
                             "MLT_BENCH_ALGORITHMS: unknown {wanted:?}; known: {all_algorithms:?}"
@@ -555,7 +562,7 @@ fn main() {
         println!(
             "no font found (set MLT_BENCH_FONT to a .ttf file): the plot has no title, labels or legend"
         );
-        for (index, &(name, _)) in ALGORITHMS.iter().enumerate() {
+        for (index, &(name, _, _)) in ALGORITHMS.iter().enumerate() {
             let RGBColor(r, g, b) = line_color(index);
             println!("  {name}: line color #{r:02x}{g:02x}{b:02x}");
         }

@@ -125,6 +125,11 @@
 #define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
 
 /**
+ * The default `direct_samples_per_mutation`.
+ */
+#define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 8
+
+/**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
  */
 typedef enum MltStatus {

@@ -86,7 +86,9 @@ impl Estimator<'_> {
         });
         let mut keep_pace = |film: &mut Film, mutations_per_pixel: f64| {
             if let Some(job) = direct_job.as_mut() {
-                let target = (ratio as f64 * mutations_per_pixel).ceil().min(u32::MAX as f64);
+                let target = (ratio as f64 * mutations_per_pixel)
+                    .ceil()
+                    .min(u32::MAX as f64);
                 job.run_until(film, control, target as u32);
             }
         };
@@ -171,17 +173,20 @@ impl Default for RenderSettings {
             seed: 0,
             threads: 0,
             time_limit_seconds: 0.0,
-            mutations_per_pixel: 64,
-            bootstrap_samples: 1 << 20,
+            mutations_per_pixel: 32,
+            bootstrap_samples: 1 << 18,
             chains: 1024,
             large_step_probability: 0.3,
             small_step_sigma: 0.01,
-            direct_samples_per_mutation: 8,
+            direct_samples_per_mutation: Self::DEFAULT_DIRECT_SAMPLES_PER_MUTATION,
         }
     }
 }
 
 impl RenderSettings {
+    /// The default `direct_samples_per_mutation`.
+    pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 8;
+
     pub fn validate(&self) -> Result<()> {
         for (name, side) in [("width", self.width), ("height", self.height)] {
             if side == 0 || side > MLT_MAX_IMAGE_SIDE {

@@ -1070,7 +1070,7 @@ fn zero_samples_without_time_limit() {
 #[test]
 fn unknown_algorithm() {
     let scene = HostScene::floor_and_light().create();
-    for bad in [3, -1, i32::MAX] {
+    for bad in [5, -1, i32::MAX] {
         let s = MltRenderSettings {
             algorithm: bad,
             ..small_settings(4, 4, 1)
@@ -1080,6 +1080,120 @@ fn unknown_algorithm() {
             &s,
             &["algorithm", &bad.to_string(), "MLT_ALGORITHM_PATH"],
         );
+    }
+}
+
+#[test]
+fn metropolis_settings_out_of_range() {
+    let scene = HostScene::floor_and_light().create();
+    let metropolis = MltRenderSettings {
+        algorithm: MLT_ALGORITHM_MMLT,
+        mutations_per_pixel: 1,
+        bootstrap_samples: 64,
+        chains: 4,
+        ..small_settings(4, 4, 1)
+    };
+    let cases: [(MltRenderSettings, &[&str]); 10] = [
+        (
+            MltRenderSettings {
+                mutations_per_pixel: 0,
+                ..metropolis
+            },
+            &["mutations_per_pixel is 0", "time limit"],
+        ),
+        (
+            MltRenderSettings {
+                mutations_per_pixel: MLT_MAX_SAMPLES_PER_PIXEL + 1,
+                direct_samples_per_mutation: 0,
+                ..metropolis
+            },
+            &["mutations_per_pixel", "16777217"],
+        ),
+        (
+            MltRenderSettings {
+                mutations_per_pixel: 1 << 20,
+                direct_samples_per_mutation: 17,
+                ..metropolis
+            },
+            &["direct_samples_per_mutation is 17", "mutations_per_pixel"],
+        ),
+        (
+            MltRenderSettings {
+                bootstrap_samples: 0,
+                ..metropolis
+            },
+            &["bootstrap_samples is 0"],
+        ),
+        (
+            MltRenderSettings {
+                chains: 0,
+                ..metropolis
+            },
+            &["chains is 0"],
+        ),
+        (
+            MltRenderSettings {
+                chains: 65,
+                ..metropolis
+            },
+            &["chains is 65", "bootstrap_samples (64)"],
+        ),
+        (
+            MltRenderSettings {
+                large_step_probability: f32::NAN,
+                ..metropolis
+            },
+            &["large_step_probability is NaN"],
+        ),
+        (
+            MltRenderSettings {
+                large_step_probability: 1.5,
+                ..metropolis
+            },
+            &["large_step_probability is 1.5"],
+        ),
+        (
+            MltRenderSettings {
+                small_step_sigma: 0.0,
+                ..metropolis
+            },
+            &["small_step_sigma is 0"],
+        ),
+        (
+            MltRenderSettings {
+                small_step_sigma: f32::INFINITY,
+                ..metropolis
+            },
+            &["small_step_sigma is inf"],
+        ),
+    ];
+    for (settings, needles) in &cases {
+        scene.render_fails(&floor_camera(), settings, needles);
+    }
+    // The same settings in range render, with every Metropolis algorithm.
+    for algorithm in [
+        MLT_ALGORITHM_PSSMLT,
+        MLT_ALGORITHM_MMLT,
+        MLT_ALGORITHM_PSSMLT_BDPT,
+    ] {
+        let settings = MltRenderSettings {
+            algorithm,
+            ..metropolis
+        };
+        let mut rgb = vec![0.0f32; 4 * 4 * 3];
+        // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
+        let status = unsafe {
+            mlt_render(
+                scene.0,
+                &floor_camera(),
+                &settings,
+                rgb.as_mut_ptr(),
+                rgb.len(),
+                None,
+                null_mut(),
+            )
+        };
+        assert_eq!(status, MLT_STATUS_OK, "algorithm {algorithm}");
     }
 }
 

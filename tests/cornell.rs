@@ -34,7 +34,7 @@ fn cornell_box_agrees_with_a_long_render() {
     let (scene, camera) = load_canonical("cornell-box");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
     let test = estimate(&scene, &camera, 64, 0..4);
-    assert_estimates_agree("cornell-box", &test, &reference, 4, 4.0);
+    assert_estimates_agree("cornell-box", &test, &reference, 4, 4.0, 4.0);
 }
 
 #[test]
@@ -42,7 +42,7 @@ fn cornell_glass_agrees_with_a_long_render() {
     let (scene, camera) = load_canonical("cornell-glass");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
     let test = estimate(&scene, &camera, 64, 0..4);
-    assert_estimates_agree("cornell-glass", &test, &reference, 4, 4.0);
+    assert_estimates_agree("cornell-glass", &test, &reference, 4, 4.0, 4.0);
 }
 
 #[test]

@@ -263,16 +263,23 @@ impl Estimate {
     }
 }
 
-/// Asserts that two independent estimates of the same image agree: the image mean and the
-/// mean of every cell of a `grid` × `grid` partition within `sigmas` combined standard
-/// errors. Also asserts the comparison is sharp enough that a 2% brightness error of the
-/// whole image would fail it. `label` names the comparison in failure messages.
+/// Asserts that two independent estimates of the same image agree: the image mean within
+/// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
+/// partition within `region_sigmas`. Also asserts the comparison is sharp enough that a 2%
+/// brightness error of the whole image would fail it. `label` names the comparison in
+/// failure messages.
+///
+/// Choose the multiples for the number of comparisons (3 channels × (1 + grid²)) and how
+/// the variances were estimated: per-pixel variances over many samples are near-exact, but a
+/// variance from the spread of k whole renders (Markov chains) has k − 1 degrees of freedom
+/// and Student's t tails; with 16 renders, |t| > 6 has probability 2·10⁻⁵ per comparison.
 pub fn assert_estimates_agree(
     label: &str,
     test: &Estimate,
     reference: &Estimate,
     grid: usize,
     sigmas: f64,
+    region_sigmas: f64,
 ) {
     assert_eq!(
         (test.width, test.height),
@@ -305,7 +312,7 @@ pub fn assert_estimates_agree(
             let (tm, tv) = test.region(x0, y0, x1, y1);
             let (rm, rv) = reference.region(x0, y0, x1, y1);
             for c in 0..3 {
-                let tolerance = sigmas * (tv[c] + rv[c]).sqrt();
+                let tolerance = region_sigmas * (tv[c] + rv[c]).sqrt();
                 assert!(
                     (tm[c] - rm[c]).abs() <= tolerance,
                     "{label}: region ({gx}, {gy}) channel {c} is {} but the reference is {} (tolerance {tolerance})",

@@ -7,13 +7,25 @@
 
 use crate::sampling::{Rng, Sampler};
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct PrimarySample {
     value: f32,
-    /// Iteration at which `value` was last brought up to date.
+    /// Iteration at which `value` was last brought up to date (`UNREAD`: never).
     modified: u64,
     backup_value: f32,
     backup_modified: u64,
+}
+
+/// `PrimarySample::modified` of a coordinate no evaluation has read.
+const UNREAD: u64 = u64::MAX;
+
+impl PrimarySample {
+    const UNREAD: PrimarySample = PrimarySample {
+        value: 0.0,
+        modified: UNREAD,
+        backup_value: 0.0,
+        backup_modified: UNREAD,
+    };
 }
 
 pub struct PssSampler {
@@ -96,6 +108,17 @@ impl PssSampler {
         self.samples[i].value = value;
     }
 
+    /// Begins an iteration that reads the current state unchanged (a small step of size 0),
+    /// to check that a state evaluates as it did.
+    #[cfg(test)]
+    pub(crate) fn start_replay(&mut self) {
+        self.sigma = 0.0;
+        self.iteration += 1;
+        self.large_step = false;
+        self.stream = 0;
+        self.next = 0;
+    }
+
     /// Begins a proposal.
     pub fn start_iteration(&mut self) {
         self.iteration += 1;
@@ -131,15 +154,19 @@ impl PssSampler {
         self.iteration -= 1;
     }
 
-    /// Brings coordinate `i` up to the current iteration.
+    /// Brings coordinate `i` up to the current iteration. A coordinate read again in the same
+    /// iteration keeps its value (BDPT reads its connection stream once per strategy).
     fn ensure_ready(&mut self, i: usize) {
         if i >= self.samples.len() {
-            self.samples.resize(i + 1, PrimarySample::default());
+            self.samples.resize(i + 1, PrimarySample::UNREAD);
         }
         let x = &mut self.samples[i];
-        // Coordinates not read since the last accepted large step are independent of
-        // the state: draw them afresh as that large step would have.
-        if x.modified < self.last_large_step {
+        if x.modified == self.iteration {
+            return;
+        }
+        // Coordinates never read, or not read since the last accepted large step, are
+        // independent of the state: draw them afresh as that large step would have.
+        if x.modified == UNREAD || x.modified < self.last_large_step {
             x.value = self.rng.uniform();
             x.modified = self.last_large_step;
         }
@@ -211,6 +238,33 @@ mod tests {
         for (i, &v) in first.iter().enumerate() {
             s.ensure_ready(i);
             assert_eq!(s.samples[i].backup_value, v, "coordinate {i}");
+        }
+    }
+
+    #[test]
+    fn a_coordinate_read_twice_in_an_iteration_keeps_its_value() {
+        let mut s = PssSampler::new(5, 6, 0.5, 0.01, 2, 8);
+        let read = |s: &mut PssSampler| {
+            s.start_stream(1);
+            let first = s.uniform2();
+            s.start_stream(1);
+            assert_eq!(first, s.uniform2());
+            first
+        };
+        let mut current = read(&mut s);
+        for k in 0..200 {
+            s.start_iteration();
+            let proposal = read(&mut s);
+            if k % 2 == 0 {
+                s.accept();
+                current = proposal;
+            } else {
+                s.reject();
+                // The rejected proposal's second reading did not become the backup.
+                s.start_replay();
+                assert_eq!(read(&mut s), current);
+                s.reject();
+            }
         }
     }
 

@@ -352,6 +352,19 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
     let b: Vec<f64> = boot.sums.iter().map(|&s| s / n as f64).collect();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
+        // No light reaches the camera along the chains' paths: their image is black and
+        // their mutations are done; another pass still takes its share.
+        let pixels = camera.width as u64 * camera.height as u64;
+        control.samples_done.fetch_add(
+            settings.mutations_per_pixel as u64 * pixels,
+            Ordering::Relaxed,
+        );
+        let mutations_per_pixel = if settings.mutations_per_pixel > 0 {
+            settings.mutations_per_pixel as f64
+        } else {
+            f64::INFINITY
+        };
+        after_round(film, mutations_per_pixel);
         return PssmltOutcome::default();
     }
 

@@ -390,3 +390,110 @@ impl PrimarySpaceTarget for BdptMultiplexed<'_> {
         *rays += counters.rays;
     }
 }
+
+#[cfg(all(test, feature = "cli"))]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    #[test]
+    fn strategies_cover_each_depth_once() {
+        assert_eq!(strategy(0, 0.7), (0, 2, 1));
+        for depth in 1..6 {
+            let count = depth + 2;
+            let mut seen = vec![false; count];
+            for k in 0..1000 {
+                let (s, t, n) = strategy(depth, k as f32 / 1000.0);
+                assert_eq!((s + t, n), (count, count));
+                seen[s] = true;
+            }
+            assert!(seen.iter().all(|&x| x), "depth {depth}");
+        }
+        assert_eq!(strategy(3, 0.999_999_9).0, 4);
+    }
+
+    /// A multiplexed chain's first state, picked from a bootstrap sample that evaluated all
+    /// strategies on full-length subpaths, evaluates to the same value when the chain reads
+    /// it with subpaths cut to the strategy's lengths: the per-depth normalizations the
+    /// bootstrap estimates are then integrals of the very function the chains sample.
+    #[test]
+    fn seeded_states_evaluate_as_the_bootstrap_saw_them() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/cornell-glass.obj");
+        let data = crate::io::load_scene(&path).unwrap();
+        let scene = Scene::new(&data.desc(crate::scene::Backend::Bvh)).unwrap();
+        let camera = data.camera.unwrap().camera.model(32, 32);
+        for min_depth in [0, 2] {
+            let target = BdptMultiplexed(Bdpt {
+                scene: &scene,
+                max_depth: 5,
+                min_depth,
+            });
+            let mut scratch = target.scratch();
+            let mut seeded = PathSample::with_capacity(1);
+            let mut replayed = PathSample::with_capacity(1);
+            let mut strategies_seen = std::collections::BTreeSet::new();
+            let mut rays = 0;
+            for i in 0..3000u64 {
+                let group = i as usize % target.groups();
+                let mut sampler =
+                    PssSampler::new(1, 0, 0.3, 0.01, target.streams(), target.dimensions());
+                let position = [(i % 97) as f32 / 97.0, (i % 89) as f32 / 89.0];
+                sampler.restart_at(1, i, position);
+                seeded.clear();
+                let choice = (i % 101) as f32 / 101.0;
+                target.seed(
+                    &camera,
+                    &mut sampler,
+                    &mut scratch,
+                    group,
+                    choice,
+                    &mut seeded,
+                    &mut rays,
+                );
+                if seeded.target == 0.0 {
+                    continue;
+                }
+                sampler.start_replay();
+                replayed.clear();
+                target.evaluate(
+                    &camera,
+                    &mut sampler,
+                    &mut scratch,
+                    group,
+                    &mut replayed,
+                    &mut rays,
+                );
+                let (a, b) = (seeded.entries[0], replayed.entries.first().copied());
+                let b = b.unwrap_or_else(|| panic!("sample {i} group {group}: replay is black"));
+                assert_eq!(a.pixel, b.pixel, "sample {i} group {group}");
+                let difference = (a.value - b.value).abs().max_element();
+                assert!(
+                    difference <= 1e-5 * a.value.abs().max_element(),
+                    "sample {i} group {group}: {:?} vs {:?}",
+                    a.value,
+                    b.value
+                );
+                // The strategy the state holds.
+                let mut replay = sampler;
+                replay.start_replay();
+                let (_, _, _, u) = start_camera_stream(&camera, &mut replay);
+                let (s, t, _) = strategy(group + min_depth as usize, u);
+                strategies_seen.insert((s.min(2), t.min(2)));
+            }
+            // Emitters hit (s = 0; weighted low beyond depth 1, so rarely picked there),
+            // light sampling (s = 1), light tracing (t = 1) and connections in between.
+            let kinds: &[(usize, usize)] = if min_depth == 0 {
+                &[(0, 2), (1, 2), (2, 1), (2, 2)]
+            } else {
+                &[(1, 2), (2, 1), (2, 2)]
+            };
+            for &kind in kinds {
+                assert!(
+                    strategies_seen.contains(&kind),
+                    "min depth {min_depth}: no state of kind {kind:?} in {strategies_seen:?}"
+                );
+            }
+        }
+    }
+}
