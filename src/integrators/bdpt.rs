@@ -481,6 +481,33 @@ impl Bdpt<'_> {
         (n_camera, n_light)
     }
 
+    /// One BDPT sample through film position (x, y): full-length subpaths, then
+    /// `visit(s, t, contribution)` for every strategy (see `for_each_strategy`).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn sample_all_strategies<S: Sampler>(
+        &self,
+        camera_model: &CameraModel,
+        x: f32,
+        y: f32,
+        sampler: &mut S,
+        scratch: &mut BdptScratch,
+        counters: &mut SampleCounters,
+        visit: impl FnMut(usize, usize, Contribution),
+    ) {
+        let max_depth = self.max_depth as usize;
+        let lengths = self.trace_subpaths(
+            camera_model,
+            x,
+            y,
+            max_depth + 2,
+            max_depth + 1,
+            sampler,
+            scratch,
+            counters,
+        );
+        self.for_each_strategy(camera_model, lengths, sampler, scratch, counters, visit);
+    }
+
     /// Calls `visit(s, t, contribution)` for every strategy of the traced subpaths with a
     /// nonzero MIS-weighted contribution, in a fixed order.
     pub(crate) fn for_each_strategy<S: Sampler>(
@@ -671,21 +698,11 @@ impl PixelEstimator for Bdpt<'_> {
         scratch: &mut BdptScratch,
         splats: &mut Vec<Splat>,
     ) -> Vec3A {
-        let max_depth = self.max_depth as usize;
-        let lengths = self.trace_subpaths(
+        let mut radiance = Vec3A::ZERO;
+        self.sample_all_strategies(
             camera_model,
             x,
             y,
-            max_depth + 2,
-            max_depth + 1,
-            rng,
-            scratch,
-            counters,
-        );
-        let mut radiance = Vec3A::ZERO;
-        self.for_each_strategy(
-            camera_model,
-            lengths,
             rng,
             scratch,
             counters,

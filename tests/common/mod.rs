@@ -92,6 +92,30 @@ pub fn furnace_scene(albedo: [f32; 3], emission: [f32; 3]) -> Scene {
 }
 
 /// A camera at the furnace's centre.
+/// Radiance in the furnace with a depth limit: Le · Σ_{k ≤ depth} albedoᵏ per channel.
+pub fn furnace_truth(albedo: [f32; 3], emission: [f32; 3], depth: u32) -> [f64; 3] {
+    std::array::from_fn(|c| {
+        let a = albedo[c] as f64;
+        emission[c] as f64 * (0..=depth).map(|k| a.powi(k as i32)).sum::<f64>()
+    })
+}
+
+/// Asserts `got` is within `tolerance` of `truth`, and that the check is sharp enough that a
+/// ±2% error would fail it. `label` names the value in failure messages.
+pub fn assert_within_and_sharp(label: &str, got: f64, truth: f64, tolerance: f64) {
+    assert!(
+        (got - truth).abs() <= tolerance,
+        "{label}: {got} vs {truth} ± {tolerance}"
+    );
+    for factor in [1.02, 0.98] {
+        assert!(
+            (got - truth * factor).abs() > tolerance,
+            "{label}: a {:+.0}% error would pass (tolerance {tolerance} of {truth})",
+            (factor - 1.0) * 100.0
+        );
+    }
+}
+
 pub fn furnace_camera() -> Camera {
     Camera {
         eye: [0.0, 0.0, 0.0],

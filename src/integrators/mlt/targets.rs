@@ -135,18 +135,7 @@ fn trace_all_strategies(
 ) -> u32 {
     let mut counters = SampleCounters::default();
     let (x, y, pixel, _) = start_camera_stream(camera, sampler);
-    let max_depth = bdpt.max_depth as usize;
-    let lengths = bdpt.trace_subpaths(
-        camera,
-        x,
-        y,
-        max_depth + 2,
-        max_depth + 1,
-        sampler,
-        paths,
-        &mut counters,
-    );
-    bdpt.for_each_strategy(camera, lengths, sampler, paths, &mut counters, visit);
+    bdpt.sample_all_strategies(camera, x, y, sampler, paths, &mut counters, visit);
     *rays += counters.rays;
     pixel
 }
