@@ -39,6 +39,7 @@ fn main() {
             let settings = RenderSettings {
                 width: 256,
                 height: 256,
+                algorithm: mlt::Algorithm::Path,
                 samples_per_pixel: spp,
                 max_depth: 5,
                 threads,

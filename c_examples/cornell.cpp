@@ -6,7 +6,7 @@
 // instead of pointer + length pairs. It builds the Cornell box from quads, renders it to a
 // PFM file, and asks the scene a few ray queries (mlt_intersect / mlt_occluded).
 //
-// Usage:  cornell [out.pfm] [width height spp]      (defaults: cornell.pfm 256 256 16)
+// Usage:  cornell [out.pfm] [width height mutations-per-pixel]   (defaults: cornell.pfm 256 256 32)
 //
 // Build (from the crate root, after `cargo build --release`):
 //   c++ -std=c++17 -Wall -Wextra -I include c_examples/cornell.cpp
@@ -261,7 +261,7 @@ static mltxx::Mesh cornellBox() {
 int main(int argc, char **argv) try {
     using mltxx::Vec3;
     if (argc != 1 && argc != 2 && argc != 5) {
-        std::cerr << "usage: " << argv[0] << " [out.pfm] [width height spp]\n";
+        std::cerr << "usage: " << argv[0] << " [out.pfm] [width height mutations-per-pixel]\n";
         return 2;
     }
     const std::string outPath = argc > 1 ? argv[1] : "cornell.pfm";
@@ -308,14 +308,13 @@ int main(int argc, char **argv) try {
     }
 
     // Render.
+    // Render with the default algorithm (Metropolis light transport); its quality knob is
+    // mutations per pixel.
     MltRenderSettings settings = mltxx::defaultSettings();
-    settings.width = 256;
-    settings.height = 256;
-    settings.samples_per_pixel = 16;
     if (argc == 5) {
         settings.width = static_cast<std::uint32_t>(std::strtoul(argv[2], nullptr, 10));
         settings.height = static_cast<std::uint32_t>(std::strtoul(argv[3], nullptr, 10));
-        settings.samples_per_pixel = static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10));
+        settings.mutations_per_pixel = static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10));
     }
     int lastPercent = -1;
     MltRenderStats stats;
@@ -329,7 +328,7 @@ int main(int argc, char **argv) try {
         },
         &stats);
     std::cerr << "\n";
-    std::cout << "rendered " << stats.samples << " samples, " << stats.rays << " rays in "
+    std::cout << "rendered " << stats.samples << " mutations, " << stats.rays << " rays in "
               << stats.seconds << " s on " << stats.threads << " threads\n";
     image.writePfm(outPath);
     std::cout << "wrote " << outPath << "\n";

@@ -1,12 +1,13 @@
 /*
  * minimal.c: the smallest complete mlt host.
  *
- * This program builds the Cornell box in code, renders it with the path tracer and writes
+ * This program builds the Cornell box in code, renders it with mlt's default algorithm
+ * (primary-sample-space Metropolis light transport) and writes
  * the result as a PFM image (a linear, floating-point format most image viewers and
  * tools such as ImageMagick or GIMP can open). Read it top to bottom: every mlt call is
  * explained where it is used.
  *
- * Usage:  minimal [out.pfm] [width height spp]      (defaults: cornell.pfm 256 256 16)
+ * Usage:  minimal [out.pfm] [width height mutations-per-pixel]   (defaults: cornell.pfm 256 256 32)
  *
  * Build (from the crate root, after `cargo build --release`):
  *   cc -std=c99 -Wall -Wextra -I include c_examples/minimal.c \
@@ -173,7 +174,7 @@ int main(int argc, char **argv) {
     int q, m, ok = 0;
 
     if (argc != 1 && argc != 2 && argc != 5) {
-        fprintf(stderr, "usage: %s [out.pfm] [width height spp]\n", argv[0]);
+        fprintf(stderr, "usage: %s [out.pfm] [width height mutations-per-pixel]\n", argv[0]);
         return 2;
     }
     printf("mlt %s\n", mlt_version_string());
@@ -232,17 +233,17 @@ int main(int argc, char **argv) {
     camera.up[0] = 0.0f;       camera.up[1] = 1.0f;       camera.up[2] = 0.0f;
     camera.fov_y_deg = 39.307648f; /* vertical field of view, in degrees */
 
-    /* 5. Render settings: start from the defaults, then pick size and samples per pixel.
-     *    The seed makes the render reproducible: same seed, same image, whatever the
-     *    number of threads (threads = 0 uses every core). */
+    /* 5. Render settings: start from the defaults (Metropolis light transport, 256 x 256,
+     *    32 mutations per pixel), then pick size and mutations per pixel, the quality knob
+     *    of the Metropolis algorithms (settings.algorithm = MLT_ALGORITHM_PATH with
+     *    settings.samples_per_pixel would path-trace instead). The seed makes the render
+     *    reproducible: same seed, same image, whatever the number of threads (threads = 0
+     *    uses every core). */
     if (!check(mlt_render_settings_default(&settings), "mlt_render_settings_default")) goto done;
-    settings.width = 256;
-    settings.height = 256;
-    settings.samples_per_pixel = 16;
     if (argc == 5) {
         settings.width = (uint32_t)strtoul(argv[2], NULL, 10);
         settings.height = (uint32_t)strtoul(argv[3], NULL, 10);
-        settings.samples_per_pixel = (uint32_t)strtoul(argv[4], NULL, 10);
+        settings.mutations_per_pixel = (uint32_t)strtoul(argv[4], NULL, 10);
     }
 
     /* 6. Render. The image is width x height x 3 floats of linear RGB radiance, rows from
@@ -259,8 +260,8 @@ int main(int argc, char **argv) {
 
     /* 7. Save. */
     if (!write_pfm(out_path, image, settings.width, settings.height)) goto done;
-    printf("wrote %s (%u x %u, %u samples per pixel)\n", out_path, (unsigned)settings.width,
-           (unsigned)settings.height, (unsigned)settings.samples_per_pixel);
+    printf("wrote %s (%u x %u, %u mutations per pixel)\n", out_path, (unsigned)settings.width,
+           (unsigned)settings.height, (unsigned)settings.mutations_per_pixel);
     ok = 1;
 
 done:

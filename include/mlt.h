@@ -276,11 +276,12 @@ typedef struct MltRenderSettings {
   uint32_t width;
   uint32_t height;
   /**
-   * One of `MLT_ALGORITHM_*`.
+   * One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_PSSMLT`.
    */
   int32_t algorithm;
   /**
-   * Samples per pixel, at most 2^24. 0 renders until `time_limit_seconds`.
+   * Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
+   * `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.
    */
   uint32_t samples_per_pixel;
   /**
@@ -365,7 +366,8 @@ typedef bool (*MltProgressCallback)(float fraction, void *user_data);
  */
 typedef struct MltRenderStats {
   /**
-   * Camera samples taken over the whole image.
+   * Camera samples taken over the whole image (path tracing, BDPT, the direct pass of a
+   * Metropolis render).
    */
   uint64_t samples;
   /**
@@ -385,7 +387,7 @@ typedef struct MltRenderStats {
    */
   uint32_t threads;
   /**
-   * Metropolis: accepted mutations (`samples` counts all mutations).
+   * Metropolis: accepted mutations, of `mutations`.
    */
   uint64_t accepted_mutations;
   /**
@@ -393,6 +395,10 @@ typedef struct MltRenderStats {
    * was scaled by.
    */
   double normalization;
+  /**
+   * Metropolis: mutations made by all chains.
+   */
+  uint64_t mutations;
 } MltRenderStats;
 
 /**
@@ -484,8 +490,10 @@ enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
 enum MltStatus mlt_camera_default(struct MltCamera *out);
 
 /**
- * Fills `out` with the default settings: 256 x 256, path tracing, 64 samples per pixel,
- * max depth 5, seed 0, all cores, no time limit.
+ * Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
+ * pass (32 mutations and 8 direct samples per pixel, 2^18 bootstrap samples, 1024 chains,
+ * large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and BDPT, max
+ * depth 5, seed 0, all cores, no time limit.
  *
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltRenderSettings`.

@@ -123,9 +123,10 @@ pub struct MltRenderSettings {
     /// Image size in pixels, each in [1, 65536].
     pub width: u32,
     pub height: u32,
-    /// One of `MLT_ALGORITHM_*`.
+    /// One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_PSSMLT`.
     pub algorithm: i32,
-    /// Samples per pixel, at most 2^24. 0 renders until `time_limit_seconds`.
+    /// Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
+    /// `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.
     pub samples_per_pixel: u32,
     /// Most scattering vertices between camera and light (0: only directly visible
     /// emitters), at most 1024.
@@ -160,7 +161,8 @@ pub struct MltRenderSettings {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MltRenderStats {
-    /// Camera samples taken over the whole image.
+    /// Camera samples taken over the whole image (path tracing, BDPT, the direct pass of a
+    /// Metropolis render).
     pub samples: u64,
     /// Rays traced, closest-hit and shadow.
     pub rays: u64,
@@ -170,11 +172,13 @@ pub struct MltRenderStats {
     pub seconds: f64,
     /// Worker threads used.
     pub threads: u32,
-    /// Metropolis: accepted mutations (`samples` counts all mutations).
+    /// Metropolis: accepted mutations, of `mutations`.
     pub accepted_mutations: u64,
     /// Metropolis: the normalization b (mean luminance of the path contribution) the image
     /// was scaled by.
     pub normalization: f64,
+    /// Metropolis: mutations made by all chains.
+    pub mutations: u64,
 }
 
 /// Facts about a created scene.
@@ -373,6 +377,16 @@ impl From<&MltCamera> for Camera {
     }
 }
 
+fn algorithm_to_c(algorithm: Algorithm) -> i32 {
+    match algorithm {
+        Algorithm::Path => MLT_ALGORITHM_PATH,
+        Algorithm::Bdpt => MLT_ALGORITHM_BDPT,
+        Algorithm::Pssmlt => MLT_ALGORITHM_PSSMLT,
+        Algorithm::Mmlt => MLT_ALGORITHM_MMLT,
+        Algorithm::PssmltBdpt => MLT_ALGORITHM_PSSMLT_BDPT,
+    }
+}
+
 fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
     let algorithm = match s.algorithm {
         MLT_ALGORITHM_PATH => Algorithm::Path,
@@ -510,8 +524,10 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
     })
 }
 
-/// Fills `out` with the default settings: 256 x 256, path tracing, 64 samples per pixel,
-/// max depth 5, seed 0, all cores, no time limit.
+/// Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
+/// pass (32 mutations and 8 direct samples per pixel, 2^18 bootstrap samples, 1024 chains,
+/// large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and BDPT, max
+/// depth 5, seed 0, all cores, no time limit.
 ///
 /// # Safety
 /// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
@@ -522,7 +538,7 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
         let value = MltRenderSettings {
             width: d.width,
             height: d.height,
-            algorithm: MLT_ALGORITHM_PATH,
+            algorithm: algorithm_to_c(d.algorithm),
             samples_per_pixel: d.samples_per_pixel,
             max_depth: d.max_depth,
             threads: d.threads,
@@ -725,6 +741,7 @@ pub unsafe extern "C" fn mlt_render_ex(
                 threads: stats.threads,
                 accepted_mutations: stats.accepted_mutations,
                 normalization: stats.normalization,
+                mutations: stats.mutations,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };
@@ -733,15 +750,15 @@ pub unsafe extern "C" fn mlt_render_ex(
             StopReason::Completed => MLT_STATUS_OK,
             StopReason::Cancelled => {
                 set_last_error(&format!(
-                    "the progress callback cancelled the render after {} samples",
-                    stats.samples
+                    "the progress callback cancelled the render after {} samples and {} mutations",
+                    stats.samples, stats.mutations
                 ));
                 MLT_STATUS_CANCELLED
             }
             StopReason::TimeLimitReached => {
                 set_last_error(&format!(
-                    "the time limit of {} s was reached after {} samples",
-                    settings.time_limit_seconds, stats.samples
+                    "the time limit of {} s was reached after {} samples and {} mutations",
+                    settings.time_limit_seconds, stats.samples, stats.mutations
                 ));
                 MLT_STATUS_TIME_LIMIT_REACHED
             }

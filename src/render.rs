@@ -20,11 +20,12 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Algorithm {
     /// Unidirectional path tracing with next-event estimation and MIS.
-    #[default]
     Path,
     /// Bidirectional path tracing: every connection strategy, combined by MIS.
     Bdpt,
-    /// Primary-sample-space Metropolis light transport (Kelemen) over the path tracer.
+    /// Primary-sample-space Metropolis light transport (Kelemen) over the path tracer. The
+    /// default: lowest error at equal time on the benchmark scenes (`benches/equal_time.rs`).
+    #[default]
     Pssmlt,
     /// Multiplexed MLT (Hachisuka): primary-sample-space chains over BDPT that also pick the
     /// path depth and one connection strategy.
@@ -167,7 +168,7 @@ impl Default for RenderSettings {
         RenderSettings {
             width: 256,
             height: 256,
-            algorithm: Algorithm::Path,
+            algorithm: Algorithm::default(),
             samples_per_pixel: 64,
             max_depth: 5,
             seed: 0,
@@ -297,8 +298,11 @@ pub enum StopReason {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderStats {
     pub stop: StopReason,
-    /// Camera samples taken over the whole image (Metropolis: mutations).
+    /// Camera samples taken over the whole image (path tracing, BDPT, a Metropolis render's
+    /// direct pass).
     pub samples: u64,
+    /// Metropolis: mutations made by all chains.
+    pub mutations: u64,
     /// Rays traced (closest-hit and shadow).
     pub rays: u64,
     /// Samples whose radiance was not finite and were dropped (counted in `samples`).
@@ -365,6 +369,7 @@ pub fn render(
         cancelled: AtomicBool::new(false),
         deadline,
         samples_done: AtomicU64::new(0),
+        mutations_done: AtomicU64::new(0),
         rays: AtomicU64::new(0),
         invalid: AtomicU64::new(0),
     };
@@ -461,10 +466,9 @@ pub fn render(
         ));
     };
     film.write_rgb(&mut rgb_out[..needed]);
-    let samples = control.samples_done.load(Ordering::Relaxed);
     let stop = if control.cancelled.load(Ordering::Relaxed) {
         StopReason::Cancelled
-    } else if planned == 0 || samples < planned {
+    } else if planned == 0 || control.work_done() < planned {
         StopReason::TimeLimitReached
     } else {
         StopReason::Completed
@@ -475,7 +479,8 @@ pub fn render(
     }
     Ok(RenderStats {
         stop,
-        samples,
+        samples: control.samples_done.load(Ordering::Relaxed),
+        mutations: control.mutations_done.load(Ordering::Relaxed),
         rays: control.rays.load(Ordering::Relaxed),
         invalid_samples: control.invalid.load(Ordering::Relaxed),
         seconds: start.elapsed().as_secs_f64(),
@@ -536,6 +541,7 @@ pub(crate) struct Control {
     cancelled: AtomicBool,
     deadline: Option<Instant>,
     pub(crate) samples_done: AtomicU64,
+    pub(crate) mutations_done: AtomicU64,
     pub(crate) rays: AtomicU64,
     invalid: AtomicU64,
 }
@@ -552,10 +558,15 @@ impl Control {
         false
     }
 
+    /// Camera samples and mutations: the units of a render's plan.
+    fn work_done(&self) -> u64 {
+        self.samples_done.load(Ordering::Relaxed) + self.mutations_done.load(Ordering::Relaxed)
+    }
+
     /// Fraction done: by samples when a count was asked for, else by time.
     fn fraction(&self, planned: u64, start: Instant) -> f32 {
         let by_samples = if planned > 0 {
-            self.samples_done.load(Ordering::Relaxed) as f64 / planned as f64
+            self.work_done() as f64 / planned as f64
         } else {
             0.0
         };

@@ -17,7 +17,8 @@ use std::sync::OnceLock;
 
 const WIDTH: u32 = 64;
 const HEIGHT: u32 = 64;
-const SPP: u32 = 8;
+/// Mutations per pixel of the default algorithm (Metropolis), the examples' fourth argument.
+const MUTATIONS: u32 = 4;
 
 fn crate_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -212,7 +213,7 @@ fn reference() -> &'static [f32] {
         let settings = mlt::RenderSettings {
             width: WIDTH,
             height: HEIGHT,
-            samples_per_pixel: SPP,
+            mutations_per_pixel: MUTATIONS,
             ..Default::default()
         };
         let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
@@ -234,7 +235,7 @@ fn run_and_check(exe: &Path, name: &str) -> String {
     let _ = std::fs::remove_file(&pfm_path);
     let output = Command::new(exe)
         .arg(&pfm_path)
-        .args([WIDTH, HEIGHT, SPP].map(|v| v.to_string()))
+        .args([WIDTH, HEIGHT, MUTATIONS].map(|v| v.to_string()))
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout).to_string();

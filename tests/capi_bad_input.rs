@@ -100,6 +100,7 @@ fn small_settings(width: u32, height: u32, spp: u32) -> MltRenderSettings {
     MltRenderSettings {
         width,
         height,
+        algorithm: MLT_ALGORITHM_PATH,
         samples_per_pixel: spp,
         ..default_settings()
     }
@@ -340,7 +341,19 @@ fn defaults_are_valid_and_documented() {
     assert_eq!((s.max_depth, s.seed, s.threads), (5, 0, 0));
     assert_eq!(
         (s.algorithm, s.time_limit_seconds),
-        (MLT_ALGORITHM_PATH, 0.0)
+        (MLT_ALGORITHM_PSSMLT, 0.0)
+    );
+    assert_eq!(
+        (s.mutations_per_pixel, s.bootstrap_samples, s.chains),
+        (32, 1 << 18, 1024)
+    );
+    assert_eq!(
+        (
+            s.large_step_probability,
+            s.small_step_sigma,
+            s.direct_samples_per_mutation
+        ),
+        (0.3, 0.01, 8)
     );
 }
 
@@ -1181,9 +1194,10 @@ fn metropolis_settings_out_of_range() {
             ..metropolis
         };
         let mut rgb = vec![0.0f32; 4 * 4 * 3];
+        let mut stats = MltRenderStats::default();
         // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
         let status = unsafe {
-            mlt_render(
+            mlt_render_ex(
                 scene.0,
                 &floor_camera(),
                 &settings,
@@ -1191,9 +1205,21 @@ fn metropolis_settings_out_of_range() {
                 rgb.len(),
                 None,
                 null_mut(),
+                &mut stats,
             )
         };
         assert_eq!(status, MLT_STATUS_OK, "algorithm {algorithm}");
+        // One mutation per pixel by the chains, 8 direct-pass camera samples per mutation.
+        assert_eq!(stats.mutations, 16, "algorithm {algorithm}");
+        assert_eq!(stats.samples, 16 * 8, "algorithm {algorithm}");
+        // Nothing reaches the camera after two bounces here: the chains' b is 0 and the
+        // direct pass alone makes the image.
+        assert_eq!(
+            (stats.accepted_mutations, stats.normalization),
+            (0, 0.0),
+            "algorithm {algorithm}"
+        );
+        assert!(rgb.iter().any(|&v| v > 0.0), "algorithm {algorithm}");
     }
 }
 

@@ -41,6 +41,8 @@ fn renders_the_cornell_box_to_pfm_and_prints_a_summary() {
     let out = temp_path("cornell.pfm");
     let output = mlt_render(&[
         &scene("cornell-box.obj"),
+        &"--algorithm",
+        &"path",
         &"--spp",
         &"2",
         &"--width",
@@ -91,10 +93,49 @@ fn renders_the_cornell_box_to_pfm_and_prints_a_summary() {
 }
 
 #[test]
+fn the_default_algorithm_is_metropolis_and_its_summary_counts_mutations() {
+    let out = temp_path("default.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--mutations-per-pixel",
+        &"2",
+        &"--bootstrap",
+        &"4096",
+        &"--chains",
+        &"64",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    for needle in [
+        "Pssmlt",
+        // The direct pass: 8 camera samples per mutation.
+        "samples    16384 (16.00 per pixel)",
+        "mutations  2048 (2.00 per pixel)",
+        "mutations/s",
+        "metropolis b = ",
+        "completed",
+    ] {
+        assert!(stdout.contains(needle), "missing {needle:?} in:\n{stdout}");
+    }
+    let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
+    assert_eq!((w, h), (32, 32));
+    assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+    std::fs::remove_file(&out).unwrap();
+}
+
+#[test]
 fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
     let out = temp_path("timed.png");
     let output = mlt_render(&[
         &scene("cornell-box.obj"),
+        &"--algorithm",
+        &"path",
         &"--spp",
         &"0",
         &"--time-limit",

@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use mlt::{Camera, RenderSettings, Scene, render};
+use mlt::{Algorithm, Camera, RenderSettings, Scene, render};
 
 const SIZE: u32 = 64;
 
@@ -14,6 +14,7 @@ fn render_image(scene: &Scene, camera: &Camera, spp: u32, seed: u64) -> Vec<f32>
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
+        algorithm: Algorithm::Path,
         samples_per_pixel: spp,
         max_depth: 5,
         seed,
@@ -33,7 +34,7 @@ fn estimate(scene: &Scene, camera: &Camera, spp: u32, seeds: std::ops::Range<u64
 fn cornell_box_agrees_with_a_long_render() {
     let (scene, camera) = load_canonical("cornell-box");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
-    let test = estimate(&scene, &camera, 64, 0..4);
+    let test = estimate(&scene, &camera, 128, 0..4);
     assert_estimates_agree("cornell-box", &test, &reference, 4, 4.0, 4.0);
 }
 
@@ -41,7 +42,7 @@ fn cornell_box_agrees_with_a_long_render() {
 fn cornell_glass_agrees_with_a_long_render() {
     let (scene, camera) = load_canonical("cornell-glass");
     let reference = estimate(&scene, &camera, 256, 1000..1004);
-    let test = estimate(&scene, &camera, 64, 0..4);
+    let test = estimate(&scene, &camera, 128, 0..4);
     assert_estimates_agree("cornell-glass", &test, &reference, 4, 4.0, 4.0);
 }
 

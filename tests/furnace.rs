@@ -6,7 +6,7 @@
 mod common;
 
 use common::*;
-use mlt::{Camera, RenderSettings, render};
+use mlt::{Algorithm, Camera, RenderSettings, render};
 
 const ALBEDO: [f32; 3] = [0.5, 0.7, 0.9];
 const EMISSION: [f32; 3] = [1.0, 0.5, 2.0];
@@ -24,6 +24,7 @@ fn render_furnace_with(camera: &Camera, depth: u32, spp: u32, seed: u64, size: u
     let settings = RenderSettings {
         width: size,
         height: size,
+        algorithm: Algorithm::Path,
         samples_per_pixel: spp,
         max_depth: depth,
         seed,
@@ -51,9 +52,8 @@ fn furnace_matches_the_geometric_series() {
         let (mean, error) = mean_and_standard_error(&image);
         let truth = expected(depth);
         for c in 0..3 {
-            let tolerance = 4.0 * error[c];
             let label = format!("depth {depth} channel {c}");
-            assert_within_and_sharp(&label, mean[c], truth[c], tolerance);
+            assert_within_and_sharp(&label, mean[c], truth[c], error[c], 4.0);
         }
     }
 }
@@ -104,6 +104,7 @@ fn image_is_identical_for_any_thread_count() {
             let settings = RenderSettings {
                 width: 48,
                 height: 40,
+                algorithm: Algorithm::Path,
                 samples_per_pixel: 3,
                 threads,
                 seed: 42,

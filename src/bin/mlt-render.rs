@@ -24,6 +24,31 @@ enum AlgorithmArg {
     PssmltBdpt,
 }
 
+// The kernel's `Algorithm` has no clap dependency; exhaustive matches keep the two in step.
+impl From<AlgorithmArg> for mlt::Algorithm {
+    fn from(arg: AlgorithmArg) -> Self {
+        match arg {
+            AlgorithmArg::Path => mlt::Algorithm::Path,
+            AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
+            AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
+            AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
+            AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
+        }
+    }
+}
+
+impl From<mlt::Algorithm> for AlgorithmArg {
+    fn from(algorithm: mlt::Algorithm) -> Self {
+        match algorithm {
+            mlt::Algorithm::Path => AlgorithmArg::Path,
+            mlt::Algorithm::Bdpt => AlgorithmArg::Bdpt,
+            mlt::Algorithm::Pssmlt => AlgorithmArg::Pssmlt,
+            mlt::Algorithm::Mmlt => AlgorithmArg::Mmlt,
+            mlt::Algorithm::PssmltBdpt => AlgorithmArg::PssmltBdpt,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum BackendArg {
     /// The built-in BVH.
@@ -46,7 +71,7 @@ struct Args {
     #[arg(long, value_name = "FILE.json")]
     camera: Option<PathBuf>,
     /// Light-transport algorithm.
-    #[arg(long, value_enum, default_value = "path")]
+    #[arg(long, value_enum, default_value_t = AlgorithmArg::from(RenderSettings::default().algorithm))]
     algorithm: AlgorithmArg,
     /// Samples per pixel (0: until the time limit).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().samples_per_pixel)]
@@ -188,13 +213,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
     RenderSettings {
         width: args.width.unwrap_or(camera.width),
         height: args.height.unwrap_or(camera.height),
-        algorithm: match args.algorithm {
-            AlgorithmArg::Path => mlt::Algorithm::Path,
-            AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
-            AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
-            AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
-            AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
-        },
+        algorithm: args.algorithm.into(),
         samples_per_pixel: args.spp,
         max_depth: args.max_depth,
         seed: args.seed,
@@ -287,6 +306,17 @@ fn print_summary(
         stats.samples as f64 / pixels
     );
     println!("  samples/s  {:.3} M", stats.samples as f64 / seconds / 1e6);
+    if settings.algorithm.is_metropolis() {
+        println!(
+            "  mutations  {} ({:.2} per pixel)",
+            stats.mutations,
+            stats.mutations as f64 / pixels
+        );
+        println!(
+            "  mutations/s {:.3} M",
+            stats.mutations as f64 / seconds / 1e6
+        );
+    }
     println!(
         "  rays       {} ({:.3} Mrays/s)",
         stats.rays,
@@ -297,7 +327,7 @@ fn print_summary(
         println!(
             "  metropolis b = {:.6}, {:.1}% of mutations accepted",
             stats.normalization,
-            100.0 * stats.accepted_mutations as f64 / stats.samples.max(1) as f64
+            100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
         );
     }
     if stats.invalid_samples > 0 {

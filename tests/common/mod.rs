@@ -100,20 +100,31 @@ pub fn furnace_truth(albedo: [f32; 3], emission: [f32; 3], depth: u32) -> [f64; 
     })
 }
 
-/// Asserts `got` is within `tolerance` of `truth`, and that the check is sharp enough that a
-/// ±2% error would fail it. `label` names the value in failure messages.
-pub fn assert_within_and_sharp(label: &str, got: f64, truth: f64, tolerance: f64) {
+/// Asserts `got` is within `sigmas` standard errors of `truth`, and that the check is sharp:
+/// a ±2% error would land at least two more standard errors outside the tolerance, so it
+/// fails whatever the noise did. `label` names the value in failure messages.
+pub fn assert_within_and_sharp(
+    label: &str,
+    got: f64,
+    truth: f64,
+    standard_error: f64,
+    sigmas: f64,
+) {
+    let tolerance = sigmas * standard_error;
     assert!(
         (got - truth).abs() <= tolerance,
         "{label}: {got} vs {truth} ± {tolerance}"
     );
-    for factor in [1.02, 0.98] {
-        assert!(
-            (got - truth * factor).abs() > tolerance,
-            "{label}: a {:+.0}% error would pass (tolerance {tolerance} of {truth})",
-            (factor - 1.0) * 100.0
-        );
-    }
+    assert_sharp(label, truth, standard_error, sigmas);
+}
+
+/// Asserts that a comparison within `sigmas` standard errors of `truth` would fail a ±2% error
+/// by at least two more standard errors.
+pub fn assert_sharp(label: &str, truth: f64, standard_error: f64, sigmas: f64) {
+    assert!(
+        (sigmas + 2.0) * standard_error <= 0.02 * truth.abs(),
+        "{label}: a 2% error would not reliably fail: {sigmas} + 2 standard errors of {standard_error} exceed 2% of {truth}"
+    );
 }
 
 pub fn furnace_camera() -> Camera {
@@ -289,8 +300,8 @@ impl Estimate {
 
 /// Asserts that two independent estimates of the same image agree: the image mean within
 /// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
-/// partition within `region_sigmas`. Also asserts the comparison is sharp enough that a 2%
-/// brightness error of the whole image would fail it. `label` names the comparison in
+/// partition within `region_sigmas`. Also asserts the comparison is sharp: a 2% brightness
+/// error of the whole image would fail it (see `assert_sharp`). `label` names the comparison in
 /// failure messages.
 ///
 /// Choose the multiples for the number of comparisons (3 channels × (1 + grid²)) and how
@@ -319,14 +330,12 @@ pub fn assert_estimates_agree(
             tm[c],
             rm[c]
         );
-        for factor in [1.02, 0.98] {
-            assert!(
-                (tm[c] * factor - rm[c]).abs() > tolerance,
-                "{label}: channel {c}: a {:+.0}% bias would pass (tolerance {tolerance} of {})",
-                (factor - 1.0) * 100.0,
-                rm[c]
-            );
-        }
+        assert_sharp(
+            &format!("{label}: image mean channel {c}"),
+            rm[c],
+            (tv[c] + rv[c]).sqrt(),
+            sigmas,
+        );
     }
     let (w, h) = (test.width, test.height);
     for gy in 0..grid {

@@ -4,7 +4,8 @@
 //!
 //! 1. Bootstrap: N samples, stratified over the film, estimate b_g = ∫ f for every chain group
 //!    g (MMLT: one group per path depth, each estimated with all of BDPT's strategies; the
-//!    others: a single group).
+//!    others: a single group). They run in passes that each cover the whole film, so a stop
+//!    (time limit, cancel) after any pass still leaves an unbiased b.
 //! 2. Chains are allotted to the groups in proportion to b_g (largest remainder, at least one
 //!    per group with light) and start from bootstrap samples resampled in proportion to their
 //!    value (systematic resampling), which removes start-up bias up to the resampling's own
@@ -34,10 +35,14 @@ use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 
 /// Deposits recorded per round over all chains: bounds the round's memory (16 bytes each)
-/// and how long a stop takes.
-const DEPOSITS_PER_ROUND: u64 = 1 << 20;
+/// and how long a stop takes (about 0.03 s of one core for PSSMLT on cornell-box). Fixed,
+/// not scaled with the thread count, because the round boundaries set the order in which
+/// deposits reach the film and so the image's last bits.
+const DEPOSITS_PER_ROUND: u64 = 1 << 16;
 /// Bootstrap samples evaluated by one parallel work unit with one sampler.
 const BOOTSTRAP_CHUNK: u64 = 1024;
+/// Fewest bootstrap samples of a pass (see `bootstrap_pass_size`).
+const MIN_BOOTSTRAP_PASS: u64 = 1 << 16;
 /// Most per-sample, per-group values the bootstrap keeps for resampling chain seeds; the
 /// normalization always uses every bootstrap sample.
 const BOOTSTRAP_KEPT_VALUES: u64 = 1 << 23;
@@ -180,11 +185,22 @@ struct Chain<T: PrimarySpaceTarget> {
     rays: u64,
 }
 
-/// The stratified film position of bootstrap sample `i` of `n`: the samples sweep the pixels
-/// in order, each covering 1/n of the film.
+/// Bootstrap samples per pass: a pass covers the film once, stratified, so b from any
+/// number of whole passes is unbiased and a stop during the bootstrap costs only precision.
+/// Passes span at least `MIN_BOOTSTRAP_PASS` samples to keep every worker busy.
+fn bootstrap_pass_size(n: u64, camera: &CameraModel) -> u64 {
+    let pixels = camera.width as u64 * camera.height as u64;
+    n.min(pixels.max(MIN_BOOTSTRAP_PASS))
+}
+
+/// The stratified film position of bootstrap sample `i` of `n`: within its pass, the samples
+/// sweep the pixels in order, each covering an equal share of the film.
 fn bootstrap_film_position(i: u64, n: u64, camera: &CameraModel, rng: &mut Rng) -> [f32; 2] {
     let pixels = camera.width as u64 * camera.height as u64;
-    let t = (i as f64 + rng.uniform() as f64) / n as f64 * pixels as f64;
+    let pass_size = bootstrap_pass_size(n, camera);
+    let pass_start = i / pass_size * pass_size;
+    let in_pass = (n - pass_start).min(pass_size);
+    let t = ((i - pass_start) as f64 + rng.uniform() as f64) / in_pass as f64 * pixels as f64;
     let pixel = (t.floor() as u64).min(pixels - 1);
     let x = (pixel % camera.width as u64) as f64 + (t - pixel as f64);
     let y = (pixel / camera.width as u64) as f32 + rng.uniform();
@@ -208,10 +224,12 @@ fn restart_as_bootstrap(
     sampler.restart_at(settings.seed, i + (1 << 40), position);
 }
 
-/// The bootstrap: per group, the sum of the target over all samples, and the values of the
-/// first samples (sample-major) for resampling.
+/// The bootstrap: per group, the sum of the target over the samples taken, and the values of
+/// the first samples (sample-major) for resampling.
 struct Bootstrap {
     sums: Vec<f64>,
+    /// Samples taken: all asked for, or the whole passes done before a stop.
+    samples: u64,
     kept: Vec<f32>,
     kept_samples: u64,
 }
@@ -224,56 +242,66 @@ fn bootstrap<T: PrimarySpaceTarget>(
 ) -> Bootstrap {
     let groups = target.groups();
     let n = settings.bootstrap_samples as u64;
-    let kept_samples = n.min(BOOTSTRAP_KEPT_VALUES / groups as u64).max(1);
-    let chunks = n.div_ceil(BOOTSTRAP_CHUNK);
-    let results: Vec<(Vec<f64>, Vec<f32>, u64)> = (0..chunks)
-        .into_par_iter()
-        .map(|chunk| {
-            let mut sampler = PssSampler::new(
-                settings.seed,
-                0,
-                settings.large_step_probability,
-                settings.small_step_sigma,
-                target.streams(),
-                target.dimensions(),
-            );
-            let mut scratch = target.scratch();
-            let mut sums = vec![0.0f64; groups];
-            let mut values = vec![0.0f32; groups];
-            let first = chunk * BOOTSTRAP_CHUNK;
-            let end = (first + BOOTSTRAP_CHUNK).min(n);
-            let mut kept =
-                Vec::with_capacity((end.min(kept_samples).saturating_sub(first)) as usize * groups);
-            let mut rays = 0;
-            for i in first..end {
-                restart_as_bootstrap(&mut sampler, settings, camera, i, n);
-                values.fill(0.0);
-                target.bootstrap(camera, &mut sampler, &mut scratch, &mut values, &mut rays);
-                for (sum, &v) in sums.iter_mut().zip(&values) {
-                    *sum += v as f64;
-                }
-                if i < kept_samples {
-                    kept.extend_from_slice(&values);
-                }
-            }
-            (sums, kept, rays)
-        })
-        .collect();
+    let kept_limit = n.min(BOOTSTRAP_KEPT_VALUES / groups as u64).max(1);
+    let pass_size = bootstrap_pass_size(n, camera);
     let mut sums = vec![0.0f64; groups];
-    let mut kept = Vec::with_capacity(kept_samples as usize * groups);
+    let mut kept = Vec::with_capacity(kept_limit as usize * groups);
     let mut rays = 0;
-    for (chunk_sums, chunk_kept, chunk_rays) in results {
-        for (sum, s) in sums.iter_mut().zip(chunk_sums) {
-            *sum += s;
+    let mut done = 0;
+    // The first pass always runs: the chains need a normalization.
+    while done < n && (done == 0 || !control.should_stop()) {
+        let end = (done + pass_size).min(n);
+        let results: Vec<(Vec<f64>, Vec<f32>, u64)> = (done..end)
+            .step_by(BOOTSTRAP_CHUNK as usize)
+            .collect::<Vec<u64>>()
+            .into_par_iter()
+            .map(|first| {
+                let mut sampler = PssSampler::new(
+                    settings.seed,
+                    0,
+                    settings.large_step_probability,
+                    settings.small_step_sigma,
+                    target.streams(),
+                    target.dimensions(),
+                );
+                let mut scratch = target.scratch();
+                let mut sums = vec![0.0f64; groups];
+                let mut values = vec![0.0f32; groups];
+                let last = (first + BOOTSTRAP_CHUNK).min(end);
+                let mut kept = Vec::with_capacity(
+                    (last.min(kept_limit).saturating_sub(first)) as usize * groups,
+                );
+                let mut rays = 0;
+                for i in first..last {
+                    restart_as_bootstrap(&mut sampler, settings, camera, i, n);
+                    values.fill(0.0);
+                    target.bootstrap(camera, &mut sampler, &mut scratch, &mut values, &mut rays);
+                    for (sum, &v) in sums.iter_mut().zip(&values) {
+                        *sum += v as f64;
+                    }
+                    if i < kept_limit {
+                        kept.extend_from_slice(&values);
+                    }
+                }
+                (sums, kept, rays)
+            })
+            .collect();
+        // Merged in sample order, whatever the scheduling.
+        for (chunk_sums, chunk_kept, chunk_rays) in results {
+            for (sum, s) in sums.iter_mut().zip(chunk_sums) {
+                *sum += s;
+            }
+            kept.extend_from_slice(&chunk_kept);
+            rays += chunk_rays;
         }
-        kept.extend_from_slice(&chunk_kept);
-        rays += chunk_rays;
+        done = end;
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
     Bootstrap {
         sums,
+        samples: done,
+        kept_samples: done.min(kept_limit),
         kept,
-        kept_samples,
     }
 }
 
@@ -349,13 +377,13 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
     // 1. Bootstrap.
     let n = settings.bootstrap_samples as u64;
     let boot = bootstrap(target, camera, settings, control);
-    let b: Vec<f64> = boot.sums.iter().map(|&s| s / n as f64).collect();
+    let b: Vec<f64> = boot.sums.iter().map(|&s| s / boot.samples as f64).collect();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
         // No light reaches the camera along the chains' paths: their image is black and
         // their mutations are done; another pass still takes its share.
         let pixels = camera.width as u64 * camera.height as u64;
-        control.samples_done.fetch_add(
+        control.mutations_done.fetch_add(
             settings.mutations_per_pixel as u64 * pixels,
             Ordering::Relaxed,
         );
@@ -441,7 +469,7 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
             for _ in 0..steps {
                 mutate(target, camera, chain);
             }
-            control.samples_done.fetch_add(steps, Ordering::Relaxed);
+            control.mutations_done.fetch_add(steps, Ordering::Relaxed);
         });
         mutations_done += steps;
         for chain in &chains {
@@ -535,5 +563,23 @@ mod tests {
             counts[pixel as usize] += 1;
         }
         assert_eq!(counts, [5; 8]);
+    }
+
+    #[test]
+    fn every_bootstrap_pass_covers_each_pixel_equally() {
+        // 64 pixels: passes of MIN_BOOTSTRAP_PASS samples, the last one half as long.
+        let camera = crate::scene::Camera::default().model(8, 8);
+        let n = 3 * MIN_BOOTSTRAP_PASS + MIN_BOOTSTRAP_PASS / 2;
+        assert_eq!(bootstrap_pass_size(n, &camera), MIN_BOOTSTRAP_PASS);
+        let mut counts = vec![[0u32; 64]; 4];
+        let mut rng = Rng::new(1, 2);
+        for i in 0..n {
+            let p = bootstrap_film_position(i, n, &camera, &mut rng);
+            let (_, _, pixel) = film_position(&camera, p);
+            counts[(i / MIN_BOOTSTRAP_PASS) as usize][pixel as usize] += 1;
+        }
+        let per_pixel = (MIN_BOOTSTRAP_PASS / 64) as u32;
+        assert_eq!(counts[..3], [[per_pixel; 64]; 3]);
+        assert_eq!(counts[3], [per_pixel / 2; 64]);
     }
 }
