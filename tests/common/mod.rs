@@ -378,12 +378,16 @@ impl Mesh {
     }
 
     pub fn scene(&self) -> Scene {
+        self.scene_with(Backend::Bvh)
+    }
+
+    pub fn scene_with(&self, backend: Backend) -> Scene {
         Scene::new(&SceneDesc {
             positions: &self.positions,
             indices: &self.indices,
             material_ids: &self.material_ids,
             materials: &self.materials,
-            backend: Backend::Bvh,
+            backend,
         })
         .expect("a valid scene")
     }
@@ -395,14 +399,12 @@ pub fn scenes_dir() -> std::path::PathBuf {
 
 /// A canonical scene of tests/scenes (`NAME.obj` with its camera sidecar), built.
 pub fn load_canonical(name: &str) -> (Scene, Camera) {
-    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).expect("loads");
-    let scene = Scene::new(&data.desc(Backend::Bvh)).expect("a valid scene");
-    (scene, data.camera.expect("a camera sidecar").camera)
+    (canonical_mesh(name).scene(), canonical_camera(name))
 }
 
-/// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
-pub fn cornell_box() -> Mesh {
-    let data = mlt::io::load_scene(&scenes_dir().join("cornell-box.obj")).expect("loads");
+/// A canonical scene of tests/scenes (`NAME.obj`) as arrays.
+pub fn canonical_mesh(name: &str) -> Mesh {
+    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).expect("loads");
     Mesh {
         positions: data.positions,
         indices: data.indices,
@@ -411,11 +413,21 @@ pub fn cornell_box() -> Mesh {
     }
 }
 
-/// The Cornell box's camera (tests/scenes/cornell-box.camera.json).
-pub fn cornell_camera() -> Camera {
-    mlt::io::load_camera_json(&scenes_dir().join("cornell-box.camera.json"))
+/// A canonical scene's camera (tests/scenes/NAME.camera.json).
+pub fn canonical_camera(name: &str) -> Camera {
+    mlt::io::load_camera_json(&scenes_dir().join(format!("{name}.camera.json")))
         .expect("loads")
         .camera
+}
+
+/// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
+pub fn cornell_box() -> Mesh {
+    canonical_mesh("cornell-box")
+}
+
+/// The Cornell box's camera (tests/scenes/cornell-box.camera.json).
+pub fn cornell_camera() -> Camera {
+    canonical_camera("cornell-box")
 }
 
 /// Per-channel mean of an RGB image.
