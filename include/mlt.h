@@ -396,7 +396,8 @@ typedef struct MltRenderStats {
 } MltRenderStats;
 
 /**
- * A ray for the batch queries: points origin + t·direction with t in [tmin, tmax].
+ * A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
+ * `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
  * `direction` need not be unit length; t is measured in multiples of it.
  */
 typedef struct MltRay {

@@ -192,7 +192,8 @@ pub struct MltSceneInfo {
     pub backend: i32,
 }
 
-/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax].
+/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
+/// `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
 /// `direction` need not be unit length; t is measured in multiples of it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]

@@ -7,11 +7,11 @@
 //! polls it. Queries report nothing: with valid rays on a committed scene Embree has nothing
 //! to complain about.
 //!
-//! Semantics match the BVH backend (see [`super::Accel`]): `tmin` and `tmax` go to `tnear`
-//! and `tfar` as they are, and the scene is built with `RTC_SCENE_FLAG_ROBUST`, whose
-//! triangle test accepts t in [tnear, tfar] like the BVH (Embree's default test excludes
-//! tnear). Embree's `u`, `v` are the barycentrics of vertices 1 and 2, the convention of
-//! [`Hit`].
+//! Semantics match the BVH backend (see [`super::Accel`]) up to one end of the interval:
+//! `tmin` and `tmax` go to `tnear` and `tfar` as they are, and Embree accepts t in
+//! (tnear, tfar] where the BVH accepts [tmin, tmax], so the two differ only for a hit at
+//! exactly t = tmin. Embree's `u`, `v` are the barycentrics of vertices 1 and 2, the
+//! convention of [`Hit`].
 
 #[doc(hidden)]
 pub mod ffi;
@@ -26,10 +26,14 @@ use glam::Vec3A;
 use std::ffi::{CStr, c_char, c_void};
 use std::sync::{Mutex, PoisonError};
 
-/// The build quality of the (static) scenes.
+/// The build quality of the (static) scenes: high (spatial splits) traces camera rays about
+/// 20% faster than medium on a 130k-triangle mesh, for twice the build time.
 const BUILD_QUALITY: RTCBuildQuality = RTC_BUILD_QUALITY_HIGH;
-/// Scene flags.
-const SCENE_FLAGS: RTCSceneFlags = RTC_SCENE_FLAG_ROBUST;
+/// No `RTC_SCENE_FLAG_ROBUST`: it would make edges watertight and tnear inclusive (exactly
+/// the BVH's interval), but costs 15-30% of the ray rate on a 130k-triangle mesh (where the
+/// high build quality then gains nothing over medium). Neither backend is watertight without it: a ray through the
+/// exact edge shared by two triangles may pass between them, in either backend.
+const SCENE_FLAGS: RTCSceneFlags = RTC_SCENE_FLAG_NONE;
 
 /// The first error Embree reported since it was last taken.
 #[derive(Default)]
