@@ -25,7 +25,7 @@ use common::*;
 use glam::{DVec3, Vec3A};
 use mlt::accel::{Hit, Ray};
 use mlt::sampling::{OrthonormalBasis, Rng, cosine_hemisphere};
-use mlt::{Backend, Camera, Material, RenderSettings, Scene};
+use mlt::{Backend, Camera, Material, Scene};
 
 const RAYS_PER_KIND: usize = 100_000;
 /// Relative agreement of t between backends, and the closeness of two t that makes a tie.
@@ -346,6 +346,21 @@ struct Tally {
     unexplained: Vec<String>,
     /// Explained disagreements with their reasons.
     examples: Vec<String>,
+    judged: usize,
+}
+
+impl Tally {
+    /// Files a disagreement described by `what` as explained (with the reason `explain`
+    /// finds) or unexplained. Only the first `MAX_JUDGED` are judged: explaining is slow.
+    fn judge(&mut self, what: String, explain: impl FnOnce() -> Option<String>) {
+        self.judged += 1;
+        if self.judged <= MAX_JUDGED {
+            match explain() {
+                Some(reason) => self.examples.push(format!("{what}: {reason}")),
+                None => self.unexplained.push(what),
+            }
+        }
+    }
 }
 
 /// At most this many disagreements per kind of ray get the (slow) brute-force explanation.
@@ -356,7 +371,6 @@ fn compare(pair: &Pair, kind: Kind) -> Tally {
     let mut tally = Tally::default();
     let mut tmax_rng = Rng::new(7, kind as u64 + 10);
     let diagonal = (pair.bounds.1 - pair.bounds.0).length();
-    let mut judged = 0;
     for ray in rays(pair, kind, 1) {
         tally.queries += 1;
         let a = pair.bvh.intersect(&ray);
@@ -382,17 +396,10 @@ fn compare(pair: &Pair, kind: Kind) -> Tally {
                     tally.embree_farther += 1;
                 }
             }
-            judged += 1;
-            if judged <= MAX_JUDGED {
-                match judge.intersect(&ray, a, b) {
-                    Some(reason) => tally
-                        .examples
-                        .push(format!("{ray:?}: {a:?} vs {b:?}: {reason}")),
-                    None => tally
-                        .unexplained
-                        .push(format!("intersect {ray:?}: bvh {a:?}, embree {b:?}")),
-                }
-            }
+            tally.judge(
+                format!("intersect {ray:?}: bvh {a:?}, embree {b:?}"),
+                || judge.intersect(&ray, a, b),
+            );
         }
         // Occlusion up to a random distance around the hit (or within the scene).
         let reach = a.map_or(diagonal, |h| h.t);
@@ -406,17 +413,10 @@ fn compare(pair: &Pair, kind: Kind) -> Tally {
         tally.blocked += oa as usize;
         if oa != ob {
             tally.occluded_disagreements += 1;
-            judged += 1;
-            if judged <= MAX_JUDGED {
-                match judge.occluded(&shadow) {
-                    Some(reason) => tally
-                        .examples
-                        .push(format!("{shadow:?}: {oa} vs {ob}: {reason}")),
-                    None => tally
-                        .unexplained
-                        .push(format!("occluded {shadow:?}: bvh {oa}, embree {ob}")),
-                }
-            }
+            tally.judge(
+                format!("occluded {shadow:?}: bvh {oa}, embree {ob}"),
+                || judge.occluded(&shadow),
+            );
         }
     }
     tally
@@ -590,34 +590,14 @@ fn generated_mesh() -> Mesh {
 /// the backend's internal triangle order, which differs.)
 #[test]
 fn rendered_images_agree() {
-    const SIZE: u32 = 64;
     let mesh = cornell_box();
     let camera = cornell_camera();
-    let render = |scene: &Scene, seed: u64| {
-        let settings = RenderSettings {
-            width: SIZE,
-            height: SIZE,
-            samples_per_pixel: 128,
-            max_depth: 5,
-            seed,
-            ..Default::default()
-        };
-        let mut image = vec![0.0; (SIZE * SIZE * 3) as usize];
-        mlt::render(scene, &camera, &settings, &mut image, None).unwrap();
-        image
-    };
-    let bvh = mesh.scene_with(Backend::Bvh);
-    let embree = mesh.scene_with(Backend::Embree);
-    let renders = |scene: &Scene, seeds: std::ops::Range<u64>| -> Vec<Vec<f32>> {
-        seeds.map(|seed| render(scene, seed)).collect()
-    };
-    let bvh_renders = renders(&bvh, 0..4);
-    let embree_renders = renders(&embree, 100..104);
-    let estimate = |r: &[Vec<f32>]| Estimate::from_renders(SIZE as usize, SIZE as usize, r);
+    let estimate =
+        |backend, seeds| path_traced_estimate(&mesh.scene_with(backend), &camera, 64, 128, seeds);
     assert_estimates_agree(
         "cornell-box, embree vs bvh",
-        &estimate(&embree_renders),
-        &estimate(&bvh_renders),
+        &estimate(Backend::Embree, 100..104),
+        &estimate(Backend::Bvh, 0..4),
         4,
         4.0,
         4.0,

@@ -287,6 +287,41 @@ impl Estimate {
     }
 }
 
+/// A `size` × `size` path-traced image (max depth 5) with `spp` samples per pixel.
+pub fn path_traced_image(
+    scene: &Scene,
+    camera: &Camera,
+    size: u32,
+    spp: u32,
+    seed: u64,
+) -> Vec<f32> {
+    let settings = mlt::RenderSettings {
+        width: size,
+        height: size,
+        samples_per_pixel: spp,
+        max_depth: 5,
+        seed,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; (size * size * 3) as usize];
+    mlt::render(scene, camera, &settings, &mut image, None).unwrap();
+    image
+}
+
+/// `path_traced_image` averaged over independent renders, one per seed.
+pub fn path_traced_estimate(
+    scene: &Scene,
+    camera: &Camera,
+    size: u32,
+    spp: u32,
+    seeds: std::ops::Range<u64>,
+) -> Estimate {
+    let renders: Vec<Vec<f32>> = seeds
+        .map(|seed| path_traced_image(scene, camera, size, spp, seed))
+        .collect();
+    Estimate::from_renders(size as usize, size as usize, &renders)
+}
+
 /// Asserts that two independent estimates of the same image agree: the image mean within
 /// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
 /// partition within `region_sigmas`. Also asserts the comparison is sharp enough that a 2%
