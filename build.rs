@@ -1,5 +1,8 @@
 //! Generates `include/mlt.h` from the C ABI with cbindgen. The header is committed; CI
-//! rebuilds it and fails if `git diff` shows it changed.
+//! rebuilds it and fails if `git diff` shows it changed. The header is the same with and
+//! without the `embree` feature: the C ABI has no feature-dependent items.
+//!
+//! With the `embree` feature, links the system's Embree 3 (`libembree3`).
 
 use std::path::PathBuf;
 
@@ -8,6 +11,9 @@ fn main() {
     println!("cargo:rerun-if-changed=src");
     println!("cargo:rerun-if-changed=cbindgen.toml");
     println!("cargo:rerun-if-changed=build.rs");
+    if std::env::var_os("CARGO_FEATURE_EMBREE").is_some() {
+        println!("cargo:rustc-link-lib=embree3");
+    }
 
     let config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml"))
         .expect("cbindgen.toml is readable and valid");

@@ -402,7 +402,8 @@ typedef struct MltRenderStats {
 } MltRenderStats;
 
 /**
- * A ray for the batch queries: points origin + t·direction with t in [tmin, tmax].
+ * A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
+ * `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
  * `direction` need not be unit length; t is measured in multiples of it.
  */
 typedef struct MltRay {
@@ -461,7 +462,10 @@ const char *mlt_status_string(int32_t status);
 const char *mlt_last_error_message(void);
 
 /**
- * Whether scenes can be built with this backend in this build (`MLT_BACKEND_*`).
+ * Whether `mlt_scene_create` can build scenes with `backend` (one of `MLT_BACKEND_*`) in
+ * this build of the library: true for `MLT_BACKEND_BVH`; for `MLT_BACKEND_EMBREE` only if
+ * mlt was compiled with the `embree` feature (otherwise scene creation with it returns
+ * `MLT_STATUS_UNSUPPORTED`); false for any other value.
  */
 bool mlt_backend_supported(int32_t backend);
 

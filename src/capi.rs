@@ -196,7 +196,8 @@ pub struct MltSceneInfo {
     pub backend: i32,
 }
 
-/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax].
+/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
+/// `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
 /// `direction` need not be unit length; t is measured in multiples of it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
@@ -453,10 +454,13 @@ pub extern "C" fn mlt_last_error_message() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())
 }
 
-/// Whether scenes can be built with this backend in this build (`MLT_BACKEND_*`).
+/// Whether `mlt_scene_create` can build scenes with `backend` (one of `MLT_BACKEND_*`) in
+/// this build of the library: true for `MLT_BACKEND_BVH`; for `MLT_BACKEND_EMBREE` only if
+/// mlt was compiled with the `embree` feature (otherwise scene creation with it returns
+/// `MLT_STATUS_UNSUPPORTED`); false for any other value.
 #[unsafe(no_mangle)]
 pub extern "C" fn mlt_backend_supported(backend: i32) -> bool {
-    backend == MLT_BACKEND_BVH
+    self::backend(backend).is_ok_and(Backend::is_available)
 }
 
 /// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).

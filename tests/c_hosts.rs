@@ -73,46 +73,6 @@ fn build_static_lib() -> PathBuf {
     panic!("cargo build --lib did not report a libmlt.a; output:\n{stdout}");
 }
 
-/// The C (or C++) compiler the `cc` crate would use for this platform: honours CC / CXX and
-/// friends. `cc` normally reads TARGET, HOST and OPT_LEVEL from a build script's environment;
-/// here they are set explicitly. If cc cannot decide, fall back to `cc` / `c++` on PATH.
-fn compiler(cpp: bool) -> Command {
-    let triple = host_triple();
-    let tool = triple.and_then(|t| {
-        cc::Build::new()
-            .cargo_metadata(false)
-            .cargo_warnings(false)
-            .emit_rerun_if_env_changed(false)
-            .opt_level(0)
-            .debug(false)
-            .target(t)
-            .host(t)
-            .cpp(cpp)
-            .try_get_compiler()
-            .ok()
-    });
-    match tool {
-        Some(tool) => tool.to_command(),
-        None => Command::new(if cpp { "c++" } else { "cc" }),
-    }
-}
-
-/// The target triple this test was compiled for, for the common platforms.
-fn host_triple() -> Option<&'static str> {
-    use std::env::consts::{ARCH, OS};
-    let env_gnu = cfg!(target_env = "gnu");
-    Some(match (ARCH, OS) {
-        ("x86_64", "linux") if env_gnu => "x86_64-unknown-linux-gnu",
-        ("aarch64", "linux") if env_gnu => "aarch64-unknown-linux-gnu",
-        ("x86_64", "linux") => "x86_64-unknown-linux-musl",
-        ("aarch64", "linux") => "aarch64-unknown-linux-musl",
-        ("x86_64", "macos") => "x86_64-apple-darwin",
-        ("aarch64", "macos") => "aarch64-apple-darwin",
-        ("x86_64", "freebsd") => "x86_64-unknown-freebsd",
-        _ => return None,
-    })
-}
-
 fn scratch_dir() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
     let dir = exe
@@ -129,7 +89,7 @@ fn scratch_dir() -> PathBuf {
 fn build(source: &str, exe_name: &str, as_cpp: bool, extra: &[&str]) -> PathBuf {
     let out = scratch_dir().join(exe_name);
     let _ = std::fs::remove_file(&out);
-    let mut cmd = compiler(as_cpp);
+    let mut cmd = common::compiler(as_cpp);
     cmd.args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
         .arg("-I")
         .arg(crate_dir().join("include"))
@@ -138,10 +98,12 @@ fn build(source: &str, exe_name: &str, as_cpp: bool, extra: &[&str]) -> PathBuf 
         // Whatever follows is a library, not source in the language given by `-x`.
         .arg("-x")
         .arg("none")
-        .arg(static_lib())
-        .args(["-lpthread", "-ldl", "-lm"])
-        .arg("-o")
-        .arg(&out);
+        .arg(static_lib());
+    if cfg!(feature = "embree") {
+        // The static library's own native dependency in this build.
+        cmd.arg("-lembree3");
+    }
+    cmd.args(["-lpthread", "-ldl", "-lm"]).arg("-o").arg(&out);
     if cfg!(target_os = "macos") {
         cmd.args(["-framework", "Security", "-framework", "CoreFoundation"]);
     }

@@ -394,9 +394,28 @@ fn release_null_is_a_no_op() {
 #[test]
 fn backend_supported() {
     assert!(mlt_backend_supported(MLT_BACKEND_BVH));
-    assert!(!mlt_backend_supported(MLT_BACKEND_EMBREE));
+    assert_eq!(
+        mlt_backend_supported(MLT_BACKEND_EMBREE),
+        cfg!(feature = "embree")
+    );
+    assert!(!mlt_backend_supported(2));
     assert!(!mlt_backend_supported(7));
     assert!(!mlt_backend_supported(-1));
+    assert!(!mlt_backend_supported(i32::MIN));
+    for (c, rust) in [
+        (MLT_BACKEND_BVH, mlt::Backend::Bvh),
+        (MLT_BACKEND_EMBREE, mlt::Backend::Embree),
+    ] {
+        assert_eq!(mlt_backend_supported(c), rust.is_available());
+    }
+}
+
+/// The backends `mlt_backend_supported` says this build has.
+fn supported_backends() -> Vec<i32> {
+    [MLT_BACKEND_BVH, MLT_BACKEND_EMBREE]
+        .into_iter()
+        .filter(|&b| mlt_backend_supported(b))
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------
@@ -772,6 +791,7 @@ fn unknown_backend() {
 }
 
 #[test]
+#[cfg(not(feature = "embree"))]
 fn embree_backend_is_unsupported_without_the_feature() {
     let mut host = HostScene::floor_and_light();
     host.backend = MLT_BACKEND_EMBREE;
@@ -780,6 +800,21 @@ fn embree_backend_is_unsupported_without_the_feature() {
         MLT_STATUS_UNSUPPORTED,
         &["Embree", "`embree` feature"],
     );
+}
+
+#[test]
+#[cfg(feature = "embree")]
+fn embree_backend_builds_with_the_feature() {
+    let mut host = HostScene::floor_and_light();
+    host.backend = MLT_BACKEND_EMBREE;
+    let scene = host.create();
+    let info = scene.info();
+    assert_eq!(info.backend, MLT_BACKEND_EMBREE);
+    assert_eq!((info.triangle_count, info.emitter_count), (4, 2));
+    let (status, hits) = scene.intersect(&[ray([0.5, 1.0, 0.25], [0.0, 2.0, 0.0])]);
+    assert_ok(status);
+    assert!(hits[0].triangle_id >= 2, "the upward ray hits the light");
+    assert_eq!(hits[0].t, 0.5, "t in multiples of the direction");
 }
 
 // ---------------------------------------------------------------------------------------
@@ -814,7 +849,14 @@ fn degenerate_triangles_are_accepted_and_counted() {
 
 #[test]
 fn degenerate_triangles_are_never_hit() {
-    let scene = with_degenerates().create();
+    for backend in supported_backends() {
+        let mut host = with_degenerates();
+        host.backend = backend;
+        degenerate_triangles_are_never_hit_with(host.create());
+    }
+}
+
+fn degenerate_triangles_are_never_hit_with(scene: Handle) {
     // Rays through the degenerate triangles' line, from several directions.
     let rays = [
         ray([0.0, 1.0, -3.0], [0.0, 0.0, 1.0]), // along z, through the midpoint

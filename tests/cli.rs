@@ -157,6 +157,38 @@ fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
     std::fs::remove_file(&out).unwrap();
 }
 
+/// `--backend embree` renders in builds with the `embree` feature and is a one-line error
+/// naming the feature in builds without.
+#[test]
+fn embree_backend_renders_or_names_the_missing_feature() {
+    let out = temp_path("embree.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--backend",
+        &"embree",
+        &"--spp",
+        &"1",
+        &"--width",
+        &"8",
+        &"--height",
+        &"8",
+        &"--out",
+        &out,
+    ]);
+    if cfg!(feature = "embree") {
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{output:?}");
+        assert!(stdout.contains("embree backend"), "{stdout}");
+        let (w, h, _) = mlt::io::read_pfm(&out).unwrap();
+        assert_eq!((w, h), (8, 8));
+        let _ = std::fs::remove_file(&out);
+    } else {
+        let line = assert_one_line_error(&output);
+        assert!(line.contains("unsupported"), "{line}");
+        assert!(line.contains("`embree` feature"), "{line}");
+    }
+}
+
 #[test]
 fn missing_scene_file_is_a_one_line_error() {
     let missing = temp_path("missing.obj");

@@ -6,28 +6,12 @@
 mod common;
 
 use common::*;
-use mlt::{Algorithm, Camera, RenderSettings, Scene, render};
+use mlt::{Camera, Scene};
 
 const SIZE: u32 = 64;
 
-fn render_image(scene: &Scene, camera: &Camera, spp: u32, seed: u64) -> Vec<f32> {
-    let settings = RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        algorithm: Algorithm::Path,
-        samples_per_pixel: spp,
-        max_depth: 5,
-        seed,
-        ..Default::default()
-    };
-    let mut image = vec![0.0; (SIZE * SIZE * 3) as usize];
-    render(scene, camera, &settings, &mut image, None).unwrap();
-    image
-}
-
 fn estimate(scene: &Scene, camera: &Camera, spp: u32, seeds: std::ops::Range<u64>) -> Estimate {
-    let renders: Vec<Vec<f32>> = seeds.map(|s| render_image(scene, camera, spp, s)).collect();
-    Estimate::from_renders(SIZE as usize, SIZE as usize, &renders)
+    path_traced_estimate(scene, camera, SIZE, spp, seeds)
 }
 
 #[test]
@@ -55,7 +39,13 @@ fn cornell_error_falls_like_one_over_square_root_of_samples() {
     let rms_error = |spp: u32, seeds: std::ops::Range<u64>| {
         let renders = (seeds.end - seeds.start) as f64;
         let mse: f64 = seeds
-            .map(|seed| rmse(&render_image(&scene, &camera, spp, seed), &reference).powi(2))
+            .map(|seed| {
+                rmse(
+                    &path_traced_image(&scene, &camera, SIZE, spp, seed),
+                    &reference,
+                )
+                .powi(2)
+            })
             .sum::<f64>()
             / renders;
         mse.sqrt()

@@ -42,20 +42,7 @@ fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Ve
 }
 
 fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
-    let renders: Vec<Vec<f32>> = (1000..1008)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: 64,
-                height: 64,
-                algorithm: Algorithm::Path,
-                samples_per_pixel: 256,
-                seed,
-                ..Default::default()
-            };
-            render_image(scene, camera, &settings)
-        })
-        .collect();
-    Estimate::from_renders(64, 64, &renders)
+    path_traced_estimate(scene, camera, 64, 256, 1000..1008)
 }
 
 /// The luminance of a Metropolis image's mean is exactly its normalization b, so the image
@@ -239,26 +226,12 @@ metropolis_tests!(mmlt_without_direct_pass, Algorithm::Mmlt, 0);
 fn default_settings_get_the_cornell_box_brightness_within_half_a_percent() {
     let (scene, camera) = load_canonical("cornell-box");
     // With a box filter the image mean is the film integral at any resolution, so the
-    // reference spends its samples on fewer pixels. Its standard error comes from the spread
-    // of independent renders' means.
-    let renders: Vec<Vec<f32>> = (100..108)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: 128,
-                height: 128,
-                algorithm: Algorithm::Path,
-                samples_per_pixel: 256,
-                seed,
-                ..Default::default()
-            };
-            render_image(&scene, &camera, &settings)
-        })
-        .collect();
-    let (truth, truth_variance) = Estimate::from_correlated_renders(128, 128, &renders).mean();
+    // reference spends its samples on fewer pixels.
+    let (truth, truth_variance) = path_traced_estimate(&scene, &camera, 128, 256, 100..108).mean();
     let truth_error = truth_variance.map(f64::sqrt);
     for c in 0..3 {
-        // The reference itself must be good to well under the 0.5% asked for: Student's t
-        // with 7 degrees of freedom exceeds 5 with probability 0.0016.
+        // The reference itself must be good to well under the 0.5% asked for (its variance
+        // sums per-pixel variances of independent path-traced pixels: near-exact).
         assert!(
             5.0 * truth_error[c] < 0.0015 * truth[c],
             "the reference is too noisy: channel {c} {} ± {}",

@@ -3,10 +3,27 @@
 //! Triangles are addressed by their *internal* index, the order the backend stores them in
 //! (for the BVH: leaf order, so a hit needs no indirection). The scene maps internal indices
 //! back to the host's triangle ids.
+//!
+//! Every backend answers the same queries the same way, up to floating-point rounding: the
+//! same closest triangle and t, the same occlusion, except for rays that pass within rounding
+//! of an edge, graze a triangle or hit two triangles at (nearly) the same t;
+//! `tests/backends.rs` measures how rare those are. Two differences by definition: the BVH
+//! accepts hits with t in [tmin, tmax], Embree in (tmin, tmax] (tmin is passed as is, so they
+//! differ only for a hit at exactly t = tmin; the integrators use tmin = 0 from origins moved
+//! off the surface); and obvhs culls boxes that end before t = 1e-4, so the BVH can miss a
+//! hit closer than that to the ray origin, which Embree finds.
 
 mod bvh;
+/// cbindgen:ignore
+#[cfg(feature = "embree")]
+pub mod embree;
 
 pub use bvh::BvhAccel;
+#[cfg(feature = "embree")]
+pub use embree::EmbreeAccel;
+
+use crate::error::Result;
+use crate::scene::Backend;
 use glam::Vec3A;
 
 /// A ray with a parametric interval: points `origin + t * direction` for t in [tmin, tmax].
@@ -43,22 +60,44 @@ pub struct Hit {
 /// The backends. An enum, not a trait object, so the hot path dispatches without a vtable.
 pub enum Accel {
     Bvh(BvhAccel),
+    #[cfg(feature = "embree")]
+    Embree(EmbreeAccel),
 }
 
 impl Accel {
-    /// The closest hit with t in [tmin, tmax], if any.
+    /// Builds `backend`'s structure over triangles given as vertex triples, none degenerate.
+    /// Fails with `MLT_STATUS_UNSUPPORTED` for a backend this build lacks (see
+    /// [`Backend::is_available`]), and with Embree's error if Embree fails.
+    pub fn build(backend: Backend, triangles: &[[Vec3A; 3]]) -> Result<Accel> {
+        match backend {
+            Backend::Bvh => Ok(Accel::Bvh(BvhAccel::build(triangles))),
+            #[cfg(feature = "embree")]
+            Backend::Embree => Ok(Accel::Embree(EmbreeAccel::build(triangles)?)),
+            #[cfg(not(feature = "embree"))]
+            Backend::Embree => Err(crate::error::Error::new(
+                crate::error::MLT_STATUS_UNSUPPORTED,
+                "backend Embree was requested but this build of mlt was compiled without the `embree` feature",
+            )),
+        }
+    }
+
+    /// The closest hit with t in [tmin, tmax] (Embree: (tmin, tmax]), if any.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         match self {
             Accel::Bvh(bvh) => bvh.intersect(ray),
+            #[cfg(feature = "embree")]
+            Accel::Embree(embree) => embree.intersect(ray),
         }
     }
 
-    /// Whether anything lies on the ray with t in [tmin, tmax].
+    /// Whether anything lies on the ray with t in [tmin, tmax] (Embree: (tmin, tmax]).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         match self {
             Accel::Bvh(bvh) => bvh.occluded(ray),
+            #[cfg(feature = "embree")]
+            Accel::Embree(embree) => embree.occluded(ray),
         }
     }
 
@@ -67,6 +106,71 @@ impl Accel {
     pub fn internal_to_build_order(&self) -> &[u32] {
         match self {
             Accel::Bvh(bvh) => bvh.internal_to_build_order(),
+            #[cfg(feature = "embree")]
+            Accel::Embree(embree) => embree.internal_to_build_order(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn available_backends() -> impl Iterator<Item = Backend> {
+        [Backend::Bvh, Backend::Embree]
+            .into_iter()
+            .filter(|b| b.is_available())
+    }
+
+    /// Barycentrics and the ends of the t interval: tmax is included by every backend, tmin
+    /// only by the BVH.
+    #[test]
+    fn hit_barycentrics_and_interval_ends() {
+        for backend in available_backends() {
+            let accel = Accel::build(
+                backend,
+                &[[
+                    Vec3A::new(-1.0, -1.0, 1.0),
+                    Vec3A::new(1.0, -1.0, 1.0),
+                    Vec3A::new(0.0, 1.0, 1.0),
+                ]],
+            )
+            .unwrap();
+            let ray = |tmin, tmax| Ray::new(Vec3A::ZERO, Vec3A::Z, tmin, tmax);
+            // The origin's projection (0, 0) is 0.25·v0 + 0.25·v1 + 0.5·v2.
+            let expected = Hit {
+                triangle: 0,
+                t: 1.0,
+                u: 0.25,
+                v: 0.5,
+            };
+            assert_eq!(accel.intersect(&ray(0.0, f32::INFINITY)), Some(expected));
+            let tmin_included = backend == Backend::Bvh;
+            for (tmin, tmax, hit) in [
+                (0.0, 1.0, true),
+                (1.0f32.next_down(), 2.0, true),
+                (1.0, 2.0, tmin_included),
+                (1.0, 1.0, tmin_included),
+                (0.0, 1.0f32.next_down(), false),
+                (1.0f32.next_up(), 2.0, false),
+            ] {
+                let what = format!("{backend:?}, t in [{tmin}, {tmax}]");
+                assert_eq!(accel.intersect(&ray(tmin, tmax)).is_some(), hit, "{what}");
+                assert_eq!(accel.occluded(&ray(tmin, tmax)), hit, "{what}");
+            }
+        }
+    }
+
+    #[test]
+    fn unavailable_backend_is_unsupported() {
+        for backend in [Backend::Bvh, Backend::Embree] {
+            match Accel::build(backend, &[]) {
+                Ok(_) => assert!(backend.is_available()),
+                Err(e) => {
+                    assert!(!backend.is_available());
+                    assert_eq!(e.status, crate::error::MLT_STATUS_UNSUPPORTED);
+                }
+            }
         }
     }
 }

@@ -296,8 +296,11 @@ fn print_summary(
         settings.max_depth
     );
     println!(
-        "  scene      {} triangles, {} emitters, loaded in {:.3} s",
-        info.triangle_count, info.emitter_count, load_seconds
+        "  scene      {} triangles, {} emitters, {} backend, loaded in {:.3} s",
+        info.triangle_count,
+        info.emitter_count,
+        format!("{:?}", args.backend).to_lowercase(),
+        load_seconds
     );
     println!("  wall time  {:.3} s", stats.seconds);
     println!(

@@ -6,8 +6,8 @@ mod material;
 pub use camera::{Camera, CameraModel};
 pub use material::{Material, MaterialKind};
 
-use crate::accel::{Accel, BvhAccel, Hit, Ray};
-use crate::error::{Error, MLT_STATUS_UNSUPPORTED, Result};
+use crate::accel::{Accel, Hit, Ray};
+use crate::error::{Error, Result};
 use crate::sampling::Distribution1D;
 use glam::Vec3A;
 
@@ -19,6 +19,16 @@ pub enum Backend {
     Bvh,
     /// Intel Embree 3 (only with the `embree` cargo feature).
     Embree,
+}
+
+impl Backend {
+    /// Whether scenes can be built with this backend in this build of mlt.
+    pub const fn is_available(self) -> bool {
+        match self {
+            Backend::Bvh => true,
+            Backend::Embree => cfg!(feature = "embree"),
+        }
+    }
 }
 
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
@@ -89,12 +99,6 @@ impl Scene {
     /// Validates the description and builds the acceleration structure.
     pub fn new(desc: &SceneDesc) -> Result<Scene> {
         validate_arrays(desc)?;
-        if desc.backend == Backend::Embree {
-            return Err(Error::new(
-                MLT_STATUS_UNSUPPORTED,
-                "backend Embree was requested but this build of mlt was compiled without the `embree` feature",
-            ));
-        }
         let vertex = |i: u32| {
             let i = i as usize * 3;
             Vec3A::new(
@@ -127,7 +131,7 @@ impl Scene {
             bounds_max = Vec3A::ZERO;
         }
 
-        let accel = Accel::Bvh(BvhAccel::build(&kept_vertices));
+        let accel = Accel::build(desc.backend, &kept_vertices)?;
         let order = accel.internal_to_build_order();
 
         let material_of = |id: u32| {

@@ -298,6 +298,42 @@ impl Estimate {
     }
 }
 
+/// A `size` × `size` path-traced image (max depth 5) with `spp` samples per pixel.
+pub fn path_traced_image(
+    scene: &Scene,
+    camera: &Camera,
+    size: u32,
+    spp: u32,
+    seed: u64,
+) -> Vec<f32> {
+    let settings = mlt::RenderSettings {
+        width: size,
+        height: size,
+        algorithm: mlt::Algorithm::Path,
+        samples_per_pixel: spp,
+        max_depth: 5,
+        seed,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; (size * size * 3) as usize];
+    mlt::render(scene, camera, &settings, &mut image, None).unwrap();
+    image
+}
+
+/// `path_traced_image` averaged over independent renders, one per seed.
+pub fn path_traced_estimate(
+    scene: &Scene,
+    camera: &Camera,
+    size: u32,
+    spp: u32,
+    seeds: std::ops::Range<u64>,
+) -> Estimate {
+    let renders: Vec<Vec<f32>> = seeds
+        .map(|seed| path_traced_image(scene, camera, size, spp, seed))
+        .collect();
+    Estimate::from_renders(size as usize, size as usize, &renders)
+}
+
 /// Asserts that two independent estimates of the same image agree: the image mean within
 /// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
 /// partition within `region_sigmas`. Also asserts the comparison is sharp: a 2% brightness
@@ -387,12 +423,16 @@ impl Mesh {
     }
 
     pub fn scene(&self) -> Scene {
+        self.scene_with(Backend::Bvh)
+    }
+
+    pub fn scene_with(&self, backend: Backend) -> Scene {
         Scene::new(&SceneDesc {
             positions: &self.positions,
             indices: &self.indices,
             material_ids: &self.material_ids,
             materials: &self.materials,
-            backend: Backend::Bvh,
+            backend,
         })
         .expect("a valid scene")
     }
@@ -404,14 +444,12 @@ pub fn scenes_dir() -> std::path::PathBuf {
 
 /// A canonical scene of tests/scenes (`NAME.obj` with its camera sidecar), built.
 pub fn load_canonical(name: &str) -> (Scene, Camera) {
-    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).expect("loads");
-    let scene = Scene::new(&data.desc(Backend::Bvh)).expect("a valid scene");
-    (scene, data.camera.expect("a camera sidecar").camera)
+    (canonical_mesh(name).scene(), canonical_camera(name))
 }
 
-/// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
-pub fn cornell_box() -> Mesh {
-    let data = mlt::io::load_scene(&scenes_dir().join("cornell-box.obj")).expect("loads");
+/// A canonical scene of tests/scenes (`NAME.obj`) as arrays.
+pub fn canonical_mesh(name: &str) -> Mesh {
+    let data = mlt::io::load_scene(&scenes_dir().join(format!("{name}.obj"))).expect("loads");
     Mesh {
         positions: data.positions,
         indices: data.indices,
@@ -420,11 +458,21 @@ pub fn cornell_box() -> Mesh {
     }
 }
 
-/// The Cornell box's camera (tests/scenes/cornell-box.camera.json).
-pub fn cornell_camera() -> Camera {
-    mlt::io::load_camera_json(&scenes_dir().join("cornell-box.camera.json"))
+/// A canonical scene's camera (tests/scenes/NAME.camera.json).
+pub fn canonical_camera(name: &str) -> Camera {
+    mlt::io::load_camera_json(&scenes_dir().join(format!("{name}.camera.json")))
         .expect("loads")
         .camera
+}
+
+/// The canonical Cornell box (tests/scenes/cornell-box.obj) as arrays.
+pub fn cornell_box() -> Mesh {
+    canonical_mesh("cornell-box")
+}
+
+/// The Cornell box's camera (tests/scenes/cornell-box.camera.json).
+pub fn cornell_camera() -> Camera {
+    canonical_camera("cornell-box")
 }
 
 /// Per-channel mean of an RGB image.
@@ -437,4 +485,44 @@ pub fn mean(image: &[f32]) -> [f64; 3] {
     }
     let n = (image.len() / 3).max(1) as f64;
     sum.map(|s| s / n)
+}
+
+/// The C (or C++) compiler the `cc` crate would use for this platform: honours CC / CXX and
+/// friends. `cc` normally reads TARGET, HOST and OPT_LEVEL from a build script's environment;
+/// here they are set explicitly. If cc cannot decide, fall back to `cc` / `c++` on PATH.
+pub fn compiler(cpp: bool) -> std::process::Command {
+    let triple = host_triple();
+    let tool = triple.and_then(|t| {
+        cc::Build::new()
+            .cargo_metadata(false)
+            .cargo_warnings(false)
+            .emit_rerun_if_env_changed(false)
+            .opt_level(0)
+            .debug(false)
+            .target(t)
+            .host(t)
+            .cpp(cpp)
+            .try_get_compiler()
+            .ok()
+    });
+    match tool {
+        Some(tool) => tool.to_command(),
+        None => std::process::Command::new(if cpp { "c++" } else { "cc" }),
+    }
+}
+
+/// The target triple this test was compiled for, for the common platforms.
+pub fn host_triple() -> Option<&'static str> {
+    use std::env::consts::{ARCH, OS};
+    let env_gnu = cfg!(target_env = "gnu");
+    Some(match (ARCH, OS) {
+        ("x86_64", "linux") if env_gnu => "x86_64-unknown-linux-gnu",
+        ("aarch64", "linux") if env_gnu => "aarch64-unknown-linux-gnu",
+        ("x86_64", "linux") => "x86_64-unknown-linux-musl",
+        ("aarch64", "linux") => "aarch64-unknown-linux-musl",
+        ("x86_64", "macos") => "x86_64-apple-darwin",
+        ("aarch64", "macos") => "aarch64-apple-darwin",
+        ("x86_64", "freebsd") => "x86_64-unknown-freebsd",
+        _ => return None,
+    })
 }

@@ -1,0 +1,186 @@
+//! The part of the Embree 3 C API (`embree3/rtcore.h`, 3.13) that the backend uses, declared
+//! by hand. Layouts and constants are checked against the installed header by
+//! `tests/embree_layout.rs`.
+//!
+//! Enums that come back from Embree (`RTCError`) are plain integers: an unexpected value in a
+//! Rust enum would be undefined behaviour. Debian's build has `RTC_MAX_INSTANCE_LEVEL_COUNT`
+//! 1 and `RTC_MIN_WIDTH` 0, which shape `RTCHit` and `RTCIntersectContext`; the layout test
+//! fails if the installed header differs.
+
+#![allow(non_camel_case_types, non_snake_case)]
+
+use std::ffi::{c_char, c_int, c_uint, c_void};
+
+/// Opaque handles.
+#[repr(C)]
+pub struct RTCDeviceTy {
+    _private: [u8; 0],
+}
+#[repr(C)]
+pub struct RTCSceneTy {
+    _private: [u8; 0],
+}
+#[repr(C)]
+pub struct RTCGeometryTy {
+    _private: [u8; 0],
+}
+pub type RTCDevice = *mut RTCDeviceTy;
+pub type RTCScene = *mut RTCSceneTy;
+pub type RTCGeometry = *mut RTCGeometryTy;
+
+/// `enum RTCError`.
+pub type RTCError = c_int;
+pub const RTC_ERROR_NONE: RTCError = 0;
+pub const RTC_ERROR_UNKNOWN: RTCError = 1;
+pub const RTC_ERROR_INVALID_ARGUMENT: RTCError = 2;
+pub const RTC_ERROR_INVALID_OPERATION: RTCError = 3;
+pub const RTC_ERROR_OUT_OF_MEMORY: RTCError = 4;
+pub const RTC_ERROR_UNSUPPORTED_CPU: RTCError = 5;
+pub const RTC_ERROR_CANCELLED: RTCError = 6;
+
+/// `enum RTCBuildQuality`.
+pub type RTCBuildQuality = c_int;
+pub const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
+pub const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
+
+/// `enum RTCSceneFlags`.
+pub type RTCSceneFlags = c_int;
+pub const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
+pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
+
+/// `enum RTCGeometryType`.
+pub type RTCGeometryType = c_int;
+pub const RTC_GEOMETRY_TYPE_TRIANGLE: RTCGeometryType = 0;
+
+/// `enum RTCBufferType`.
+pub type RTCBufferType = c_int;
+pub const RTC_BUFFER_TYPE_INDEX: RTCBufferType = 0;
+pub const RTC_BUFFER_TYPE_VERTEX: RTCBufferType = 1;
+
+/// `enum RTCFormat`.
+pub type RTCFormat = c_int;
+pub const RTC_FORMAT_UINT3: RTCFormat = 0x5003;
+pub const RTC_FORMAT_FLOAT3: RTCFormat = 0x9003;
+
+/// `enum RTCIntersectContextFlags`.
+pub type RTCIntersectContextFlags = c_int;
+pub const RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT: RTCIntersectContextFlags = 0;
+
+/// `RTC_INVALID_GEOMETRY_ID`: `hit.geomID` of a miss.
+pub const RTC_INVALID_GEOMETRY_ID: c_uint = c_uint::MAX;
+
+/// `RTC_MAX_INSTANCE_LEVEL_COUNT` of the Debian build.
+pub const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
+
+/// `RTCErrorFunction`.
+pub type RTCErrorFunction =
+    Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, message: *const c_char)>;
+
+/// `RTCFilterFunctionN` (never set: always NULL).
+pub type RTCFilterFunctionN = Option<unsafe extern "C" fn(args: *const c_void)>;
+
+/// `struct RTCRay`: a single ray.
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCRay {
+    pub org_x: f32,
+    pub org_y: f32,
+    pub org_z: f32,
+    pub tnear: f32,
+    pub dir_x: f32,
+    pub dir_y: f32,
+    pub dir_z: f32,
+    pub time: f32,
+    pub tfar: f32,
+    pub mask: c_uint,
+    pub id: c_uint,
+    pub flags: c_uint,
+}
+
+/// `struct RTCHit`: the hit of a single ray.
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCHit {
+    pub Ng_x: f32,
+    pub Ng_y: f32,
+    pub Ng_z: f32,
+    pub u: f32,
+    pub v: f32,
+    pub primID: c_uint,
+    pub geomID: c_uint,
+    pub instID: [c_uint; RTC_MAX_INSTANCE_LEVEL_COUNT],
+}
+
+/// `struct RTCRayHit`: ray and hit, as `rtcIntersect1` takes them.
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCRayHit {
+    pub ray: RTCRay,
+    pub hit: RTCHit,
+}
+
+/// `struct RTCIntersectContext` (with `RTC_MAX_INSTANCE_LEVEL_COUNT` 1 and `RTC_MIN_WIDTH` 0:
+/// no `instStackSize`, no `minWidthDistanceFactor`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct RTCIntersectContext {
+    pub flags: RTCIntersectContextFlags,
+    pub filter: RTCFilterFunctionN,
+    pub instID: [c_uint; RTC_MAX_INSTANCE_LEVEL_COUNT],
+}
+
+impl RTCIntersectContext {
+    /// What the header's inline `rtcInitIntersectContext` does: incoherent rays, no filter,
+    /// an empty instance stack.
+    pub fn new() -> Self {
+        RTCIntersectContext {
+            flags: RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT,
+            filter: None,
+            instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
+        }
+    }
+}
+
+impl Default for RTCIntersectContext {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+// Linked by build.rs (`cargo:rustc-link-lib=embree3`).
+unsafe extern "C" {
+    pub fn rtcNewDevice(config: *const c_char) -> RTCDevice;
+    pub fn rtcReleaseDevice(device: RTCDevice);
+    pub fn rtcGetDeviceError(device: RTCDevice) -> RTCError;
+    pub fn rtcSetDeviceErrorFunction(
+        device: RTCDevice,
+        error: RTCErrorFunction,
+        user_ptr: *mut c_void,
+    );
+
+    pub fn rtcNewScene(device: RTCDevice) -> RTCScene;
+    pub fn rtcSetSceneBuildQuality(scene: RTCScene, quality: RTCBuildQuality);
+    pub fn rtcSetSceneFlags(scene: RTCScene, flags: RTCSceneFlags);
+    pub fn rtcAttachGeometry(scene: RTCScene, geometry: RTCGeometry) -> c_uint;
+    pub fn rtcCommitScene(scene: RTCScene);
+    pub fn rtcReleaseScene(scene: RTCScene);
+
+    pub fn rtcNewGeometry(device: RTCDevice, kind: RTCGeometryType) -> RTCGeometry;
+    pub fn rtcSetNewGeometryBuffer(
+        geometry: RTCGeometry,
+        kind: RTCBufferType,
+        slot: c_uint,
+        format: RTCFormat,
+        byte_stride: usize,
+        item_count: usize,
+    ) -> *mut c_void;
+    pub fn rtcCommitGeometry(geometry: RTCGeometry);
+    pub fn rtcReleaseGeometry(geometry: RTCGeometry);
+
+    pub fn rtcIntersect1(
+        scene: RTCScene,
+        context: *mut RTCIntersectContext,
+        rayhit: *mut RTCRayHit,
+    );
+    pub fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
+}
