@@ -2,7 +2,7 @@
 //! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings.
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
-//! actual seconds, samples or mutations per second, RMSE, RMSE corrected for the reference's
+//! actual seconds, camera samples and chain mutations per second, RMSE, RMSE corrected for the reference's
 //! own noise, and the per-channel mean brightness difference to the reference) and writes a
 //! log-log plot of RMSE against seconds, one line per algorithm and one panel per scene, to
 //! `target/mlt-bench/convergence.png`. Numbers are reported, never asserted.
@@ -295,8 +295,16 @@ fn measure(
 
 fn print_header() {
     println!(
-        "{:<14} {:<8} {:>7} {:>7} {:>8} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
-        "scene", "algo", "threads", "budget", "seconds", "samples/s", "RMSE", "corrected",
+        "{:<14} {:<14} {:>7} {:>7} {:>8} {:>12} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
+        "scene",
+        "algo",
+        "threads",
+        "budget",
+        "seconds",
+        "samples/s",
+        "mutations/s",
+        "RMSE",
+        "corrected",
     );
 }
 
@@ -307,19 +315,20 @@ const OVERRUN_TOLERANCE_SECONDS: f64 = 0.1;
 fn print_row(scene: &str, m: &Measurement) {
     let [r, g, b] = m.mean_difference_percent;
     let mut notes = String::new();
-    if m.stats.samples == 0 {
+    if m.stats.samples == 0 && m.stats.mutations == 0 {
         notes.push_str("  no sample finished: black image, not plotted");
     }
     if m.stats.seconds > m.budget_seconds * 1.1 + OVERRUN_TOLERANCE_SECONDS {
         notes.push_str("  over budget");
     }
     println!(
-        "{scene:<14} {:<8} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
+        "{scene:<14} {:<14} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
         m.algorithm,
         m.threads,
         m.budget_seconds,
         m.stats.seconds,
         m.stats.samples as f64 / m.stats.seconds,
+        m.stats.mutations as f64 / m.stats.seconds,
         m.rmse,
         m.corrected_rmse,
     );
@@ -392,7 +401,9 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
         let plotted: Vec<&Measurement> = result
             .measurements
             .iter()
-            .filter(|m| m.threads == 1 && m.stats.samples > 0 && m.rmse > 0.0)
+            .filter(|m| {
+                m.threads == 1 && (m.stats.samples > 0 || m.stats.mutations > 0) && m.rmse > 0.0
+            })
             .collect();
         if plotted.is_empty() {
             continue;
