@@ -144,8 +144,6 @@ impl Scene {
         let mut shading = Vec::with_capacity(order.len());
         let mut internal_to_input = Vec::with_capacity(order.len());
         let mut lights = Vec::new();
-        let mut light_power = Vec::new();
-        let mut light_of_internal = Vec::new();
         for (internal, &build) in order.iter().enumerate() {
             let [v0, v1, v2] = kept_vertices[build as usize];
             let id = kept_ids[build as usize];
@@ -154,9 +152,6 @@ impl Scene {
             let normal = cross.normalize();
             let emission = Vec3A::from(desc.materials[material as usize].emission);
             if emission.max_element() > 0.0 {
-                let area = 0.5 * cross.length();
-                light_of_internal.push((internal, area));
-                light_power.push(luminance(emission) * area);
                 lights.push(AreaLight {
                     v0,
                     edge1: v1 - v0,
@@ -174,12 +169,19 @@ impl Scene {
             });
             internal_to_input.push(id);
         }
+        // Lights in the host's triangle order, not the backend's: the same seed then picks
+        // the same lights with either backend.
+        lights.sort_by_key(|light| internal_to_input[light.triangle as usize]);
         // Lights are picked in proportion to their emitted power.
+        let area = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
+        let light_power: Vec<f32> = lights
+            .iter()
+            .map(|light| luminance(light.emission) * area(light))
+            .collect();
         let light_distribution = Distribution1D::new(&light_power);
-        for (light, &(internal, area)) in light_of_internal.iter().enumerate() {
-            let area_pdf = light_distribution.discrete_pdf(light) / area;
-            shading[internal].light_area_pdf = area_pdf;
-            lights[light].area_pdf = area_pdf;
+        for (index, light) in lights.iter_mut().enumerate() {
+            light.area_pdf = light_distribution.discrete_pdf(index) / area(light);
+            shading[light.triangle as usize].light_area_pdf = light.area_pdf;
         }
         let magnitude = bounds_min
             .abs()
