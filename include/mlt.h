@@ -49,7 +49,7 @@
 #define MLT_MATERIAL_DIELECTRIC 2
 
 /**
- * `MltSceneDesc.backend`: obvhs compressed wide BVH, always available.
+ * `MltSceneDesc.backend`: mlt's own 4-wide BVH (built with obvhs), always available.
  */
 #define MLT_BACKEND_BVH 0
 

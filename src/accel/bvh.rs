@@ -1,172 +1,384 @@
-//! The default backend: an obvhs compressed wide BVH (CWBVH, 8-wide) with triangles stored
-//! in leaf order, traversed with obvhs's node test and our own triangle test.
+//! The default backend: a 4-wide BVH with its triangles packed four to a leaf block, both in
+//! structure-of-arrays layout, so one SSE instruction tests a ray against four boxes or four
+//! triangles (glam's `Vec4` is an SSE register on x86-64). obvhs builds the binary tree (PLOC
+//! with reinsertion and leaf collapsing, leaves of at most four triangles); we collapse it to
+//! four children per node and traverse it ourselves, nearest child first.
 //!
-//! obvhs 0.4 notes: traversal reports positions in `primitive_indices` (leaf order), which is
-//! why triangles are permuted into that order here; its node test clips at a fixed t of 1e-4,
-//! so geometry closer than that to a ray origin may be missed (integrators offset origins far
-//! more than that); the `slow` build presets split triangles, so they are not used.
+//! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
+//! block hold a zero triangle, whose test yields NaN and fails every comparison.
 
 use super::{Hit, Ray};
-use glam::{UVec2, Vec3A};
+use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, Result};
+use glam::{BVec4A, Vec3A, Vec4};
 use obvhs::{
-    BvhBuildParams, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle,
+    BvhBuildParams,
+    bvh2::{Bvh2, builder::build_bvh2_from_tris},
+    triangle::Triangle,
 };
 use std::time::Duration;
 
-/// A triangle laid out for the intersection test (Möller–Trumbore with the normal precomputed).
+/// Children of a node, and triangles of a leaf block.
+const WIDTH: usize = 4;
+/// A child reference with this bit set is a leaf block index; otherwise a node index.
+const LEAF_BIT: u32 = 1 << 31;
+/// The reference of an empty child slot (its box is empty, so it is never entered).
+const EMPTY: u32 = u32::MAX;
+/// Entries of the traversal stack: each level of the tree adds at most WIDTH - 1, so trees
+/// up to 85 levels deep fit (PLOC trees over real scenes are a few dozen levels deep).
+const STACK_SIZE: usize = 256;
+/// Deepest tree the stack can traverse.
+const MAX_DEPTH: usize = (STACK_SIZE - 1) / (WIDTH - 1);
+
+/// Four child boxes: `bounds[2 * axis]` their minima along the axis, `bounds[2 * axis + 1]`
+/// their maxima. Empty slots have min = +inf, max = -inf.
 #[derive(Clone, Copy, Debug)]
-struct IntersectionTriangle {
-    v0: Vec3A,
-    /// v0 - v1
-    e1: Vec3A,
-    /// v2 - v0
-    e2: Vec3A,
-    /// e1 × e2
-    ng: Vec3A,
+struct Node {
+    bounds: [Vec4; 6],
+    children: [u32; WIDTH],
 }
 
-impl IntersectionTriangle {
-    fn new(v0: Vec3A, v1: Vec3A, v2: Vec3A) -> Self {
-        let e1 = v0 - v1;
-        let e2 = v2 - v0;
-        IntersectionTriangle {
-            v0,
-            e1,
-            e2,
-            ng: e1.cross(e2),
+/// Four triangles for the Möller–Trumbore test with the normal precomputed: v0, e1 = v0 - v1,
+/// e2 = v2 - v0 and ng = e1 × e2, each as x, y, z lanes.
+#[derive(Clone, Copy, Debug)]
+struct TriangleBlock {
+    v0: [Vec4; 3],
+    e1: [Vec4; 3],
+    e2: [Vec4; 3],
+    ng: [Vec4; 3],
+    /// Leaf-order index of lane 0; lane i is `first + i`.
+    first: u32,
+}
+
+/// A ray prepared for the box test: which bound is near on each axis, the origin and the
+/// reciprocal direction.
+///
+/// A zero direction component gives an infinite reciprocal, and the slab (bound − o) · inv is
+/// then ±inf (the ray is inside or outside the slab forever) or, for an origin exactly on the
+/// bound, NaN. The slabs are combined with the running value as the *second* operand of
+/// `max`/`min`, which SSE's maxps/minps (and `f32::max`) return when the first is NaN: a NaN
+/// slab then leaves the interval unconstrained, as a ray lying in the slab's plane should.
+struct BoxRay {
+    near: [usize; 3],
+    far: [usize; 3],
+    origin: [Vec4; 3],
+    inv_direction: [Vec4; 3],
+}
+
+impl BoxRay {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        let inv = Vec3A::ONE / ray.direction;
+        // The sign bit, so -0 (inv = -inf) counts as negative.
+        let near = |axis: usize| 2 * axis + inv[axis].is_sign_negative() as usize;
+        BoxRay {
+            near: [near(0), near(1), near(2)],
+            far: [near(0) ^ 1, near(1) ^ 1, near(2) ^ 1],
+            origin: splat3(ray.origin),
+            inv_direction: splat3(inv),
         }
     }
 
-    /// Returns (t, u, v) when the ray hits within [tmin, tmax].
+    /// Entry distances of the four children and which of them the ray enters in [tmin, tmax].
     #[inline(always)]
-    fn intersect(
-        &self,
-        origin: Vec3A,
-        direction: Vec3A,
-        tmin: f32,
-        tmax: f32,
-    ) -> Option<(f32, f32, f32)> {
-        let c = self.v0 - origin;
-        let r = direction.cross(c);
-        let det = self.ng.dot(direction);
-        let inv_det = 1.0 / det;
-        let u = r.dot(self.e2) * inv_det;
-        let v = r.dot(self.e1) * inv_det;
-        let t = self.ng.dot(c) * inv_det;
-        // Written so NaN (det = 0) fails every comparison.
-        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= tmin && t <= tmax {
-            Some((t, u, v))
-        } else {
-            None
-        }
+    fn intersect(&self, node: &Node, tmin: f32, tmax: f32) -> (Vec4, u32) {
+        let slab = |bound: usize, axis: usize| {
+            (node.bounds[bound] - self.origin[axis]) * self.inv_direction[axis]
+        };
+        let t_near = slab(self.near[2], 2).max(
+            slab(self.near[1], 1).max(slab(self.near[0], 0).max(Vec4::splat(tmin))),
+        );
+        let t_far = slab(self.far[2], 2)
+            .min(slab(self.far[1], 1).min(slab(self.far[0], 0).min(Vec4::splat(tmax))));
+        (t_near, t_near.cmple(t_far).bitmask())
     }
+}
+
+/// The ray against four triangles: (t, u, v) per lane and the lanes hit within [tmin, tmax].
+#[inline(always)]
+fn intersect_block(
+    block: &TriangleBlock,
+    origin: &[Vec4; 3],
+    direction: &[Vec4; 3],
+    tmin: f32,
+    tmax: f32,
+) -> (Vec4, Vec4, Vec4, BVec4A) {
+    let dot = |a: &[Vec4; 3], b: &[Vec4; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let c = [
+        block.v0[0] - origin[0],
+        block.v0[1] - origin[1],
+        block.v0[2] - origin[2],
+    ];
+    let r = [
+        direction[1] * c[2] - direction[2] * c[1],
+        direction[2] * c[0] - direction[0] * c[2],
+        direction[0] * c[1] - direction[1] * c[0],
+    ];
+    let inv_det = Vec4::ONE / dot(&block.ng, direction);
+    let u = dot(&r, &block.e2) * inv_det;
+    let v = dot(&r, &block.e1) * inv_det;
+    let t = dot(&block.ng, &c) * inv_det;
+    // Comparisons written so NaN (a zero lane, or det = 0) fails them all.
+    let hit = u.cmpge(Vec4::ZERO)
+        & v.cmpge(Vec4::ZERO)
+        & (u + v).cmple(Vec4::ONE)
+        & t.cmpge(Vec4::splat(tmin))
+        & t.cmple(Vec4::splat(tmax));
+    (t, u, v, hit)
+}
+
+fn splat3(v: Vec3A) -> [Vec4; 3] {
+    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
 }
 
 pub struct BvhAccel {
-    bvh: CwBvh,
-    triangles: Vec<IntersectionTriangle>,
+    nodes: Vec<Node>,
+    blocks: Vec<TriangleBlock>,
+    /// The root: a node index, a leaf block (`LEAF_BIT`) or `EMPTY`.
+    root: u32,
     /// For each leaf-order triangle, its index in the list the BVH was built from.
     build_order: Vec<u32>,
 }
 
 impl BvhAccel {
     /// Builds over triangles given as vertex triples. None of them may be degenerate.
-    pub fn build(vertices: &[[Vec3A; 3]]) -> Self {
+    pub fn build(vertices: &[[Vec3A; 3]]) -> Result<Self> {
+        let mut accel = BvhAccel {
+            nodes: Vec::new(),
+            blocks: Vec::new(),
+            root: EMPTY,
+            build_order: Vec::with_capacity(vertices.len()),
+        };
         if vertices.is_empty() {
-            return BvhAccel {
-                bvh: CwBvh::default(),
-                triangles: Vec::new(),
-                build_order: Vec::new(),
-            };
+            return Ok(accel);
         }
         let tris: Vec<Triangle> = vertices
             .iter()
             .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut Duration::default(),
-        );
-        let build_order = bvh.primitive_indices.clone();
-        let triangles = build_order
-            .iter()
-            .map(|&i| {
-                let [v0, v1, v2] = vertices[i as usize];
-                IntersectionTriangle::new(v0, v1, v2)
-            })
-            .collect();
-        BvhAccel {
-            bvh,
-            triangles,
-            build_order,
+        let params = BvhBuildParams {
+            max_prims_per_leaf: WIDTH as u32,
+            ..BvhBuildParams::medium_build()
+        };
+        let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
+        let mut depth = 0;
+        accel.root = accel.collapse(&bvh2, 0, vertices, 1, &mut depth);
+        if depth > MAX_DEPTH {
+            return Err(Error::new(
+                MLT_STATUS_INTERNAL_ERROR,
+                format!(
+                    "the BVH over these {} triangles is {depth} levels deep; at most {MAX_DEPTH} are supported",
+                    vertices.len()
+                ),
+            ));
         }
+        Ok(accel)
+    }
+
+    /// The wide subtree of binary node `index` at `level` (the root's is 1); returns its
+    /// reference and raises `depth` to the deepest level it reaches.
+    fn collapse(
+        &mut self,
+        bvh2: &Bvh2,
+        index: usize,
+        vertices: &[[Vec3A; 3]],
+        level: usize,
+        depth: &mut usize,
+    ) -> u32 {
+        *depth = (*depth).max(level);
+        let node = &bvh2.nodes[index];
+        if node.prim_count > 0 {
+            return self.leaf_block(bvh2, index, vertices);
+        }
+        // Open the binary children with the largest surface area until there are WIDTH.
+        let mut open = vec![node.first_index as usize, node.first_index as usize + 1];
+        while open.len() < WIDTH {
+            let widest = open
+                .iter()
+                .enumerate()
+                .filter(|&(_, &i)| bvh2.nodes[i].prim_count == 0)
+                .max_by(|&(_, &a), &(_, &b)| {
+                    let area = |i: usize| bvh2.nodes[i].aabb.half_area();
+                    area(a).total_cmp(&area(b))
+                })
+                .map(|(slot, _)| slot);
+            let Some(slot) = widest else { break };
+            let first = bvh2.nodes[open[slot]].first_index as usize;
+            open[slot] = first;
+            open.push(first + 1);
+        }
+        let me = self.nodes.len();
+        self.nodes.push(Node {
+            bounds: [
+                Vec4::INFINITY,
+                Vec4::NEG_INFINITY,
+                Vec4::INFINITY,
+                Vec4::NEG_INFINITY,
+                Vec4::INFINITY,
+                Vec4::NEG_INFINITY,
+            ],
+            children: [EMPTY; WIDTH],
+        });
+        for (slot, &child) in open.iter().enumerate() {
+            let reference = self.collapse(bvh2, child, vertices, level + 1, depth);
+            let aabb = bvh2.nodes[child].aabb;
+            let node = &mut self.nodes[me];
+            for axis in 0..3 {
+                node.bounds[2 * axis][slot] = aabb.min[axis];
+                node.bounds[2 * axis + 1][slot] = aabb.max[axis];
+            }
+            node.children[slot] = reference;
+        }
+        me as u32
+    }
+
+    /// Packs the triangles of binary leaf `index` into a block; returns its reference.
+    fn leaf_block(&mut self, bvh2: &Bvh2, index: usize, vertices: &[[Vec3A; 3]]) -> u32 {
+        let node = &bvh2.nodes[index];
+        let first = node.first_index as usize;
+        let ids = &bvh2.primitive_indices[first..first + node.prim_count as usize];
+        assert!(ids.len() <= WIDTH, "obvhs made a leaf larger than asked");
+        let mut block = TriangleBlock {
+            v0: [Vec4::ZERO; 3],
+            e1: [Vec4::ZERO; 3],
+            e2: [Vec4::ZERO; 3],
+            ng: [Vec4::ZERO; 3],
+            first: self.build_order.len() as u32,
+        };
+        for (lane, &id) in ids.iter().enumerate() {
+            let [v0, v1, v2] = vertices[id as usize];
+            let e1 = v0 - v1;
+            let e2 = v2 - v0;
+            let ng = e1.cross(e2);
+            for axis in 0..3 {
+                block.v0[axis][lane] = v0[axis];
+                block.e1[axis][lane] = e1[axis];
+                block.e2[axis][lane] = e2[axis];
+                block.ng[axis][lane] = ng[axis];
+            }
+            self.build_order.push(id);
+        }
+        self.blocks.push(block);
+        (self.blocks.len() - 1) as u32 | LEAF_BIT
     }
 
     pub fn internal_to_build_order(&self) -> &[u32] {
         &self.build_order
     }
 
+    /// Bytes of the structure: nodes, triangle blocks and the index map.
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * size_of::<Node>()
+            + self.blocks.len() * size_of::<TriangleBlock>()
+            + self.build_order.len() * size_of::<u32>()
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        if self.triangles.is_empty() {
+        if self.root == EMPTY {
             return None;
         }
-        let mut traverse_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, ray.tmin, ray.tmax);
+        let box_ray = BoxRay::new(ray);
+        let origin = splat3(ray.origin);
+        let direction = splat3(ray.direction);
+        let mut tmax = ray.tmax;
         let mut best: Option<Hit> = None;
-        let mut state = self.bvh.new_traversal(ray.direction);
-        let mut node;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            node.intersect_ray(&traverse_ray, state.oct_inv4),
-            {
-                let id = state.primitive_id;
-                // SAFETY-free: indices come from the BVH built over exactly these triangles.
-                let tri = &self.triangles[id as usize];
-                if let Some((t, u, v)) =
-                    tri.intersect(ray.origin, ray.direction, ray.tmin, traverse_ray.tmax)
-                {
-                    traverse_ray.tmax = t;
-                    best = Some(Hit {
-                        triangle: id,
-                        t,
-                        u,
-                        v,
-                    });
+        let mut stack = [(0u32, 0f32); STACK_SIZE];
+        let mut top = 0;
+        let mut current = self.root;
+        loop {
+            if current & LEAF_BIT == 0 {
+                let node = &self.nodes[current as usize];
+                let (t_near, mut mask) = box_ray.intersect(node, ray.tmin, tmax);
+                if mask != 0 {
+                    // Go on with the nearest child; push the others, farthest first.
+                    let mut hits = [(0u32, 0f32); WIDTH];
+                    let mut count = 0;
+                    while mask != 0 {
+                        let slot = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let entry = (node.children[slot], t_near[slot]);
+                        // Insertion sort, nearest last.
+                        let mut at = count;
+                        while at > 0 && hits[at - 1].1 < entry.1 {
+                            hits[at] = hits[at - 1];
+                            at -= 1;
+                        }
+                        hits[at] = entry;
+                        count += 1;
+                    }
+                    for &entry in &hits[..count - 1] {
+                        stack[top] = entry;
+                        top += 1;
+                    }
+                    current = hits[count - 1].0;
+                    continue;
+                }
+            } else {
+                let block = &self.blocks[(current & !LEAF_BIT) as usize];
+                let (t, u, v, hit) = intersect_block(block, &origin, &direction, ray.tmin, tmax);
+                let mut mask = hit.bitmask();
+                while mask != 0 {
+                    let lane = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    if t[lane] <= tmax {
+                        tmax = t[lane];
+                        best = Some(Hit {
+                            triangle: block.first + lane as u32,
+                            t: t[lane],
+                            u: u[lane],
+                            v: v[lane],
+                        });
+                    }
                 }
             }
-        );
-        best
+            // Next: the nearest pushed entry the ray can still reach.
+            loop {
+                if top == 0 {
+                    return best;
+                }
+                top -= 1;
+                let (reference, t_near) = stack[top];
+                if t_near <= tmax {
+                    current = reference;
+                    break;
+                }
+            }
+        }
     }
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if self.triangles.is_empty() {
+        if self.root == EMPTY {
             return false;
         }
-        let traverse_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, ray.tmin, ray.tmax);
-        let mut state = self.bvh.new_traversal(ray.direction);
-        let mut node;
-        let mut blocked = false;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            node.intersect_ray(&traverse_ray, state.oct_inv4),
-            {
-                let tri = &self.triangles[state.primitive_id as usize];
-                if tri
-                    .intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
-                    .is_some()
-                {
-                    blocked = true;
-                    break;
+        let box_ray = BoxRay::new(ray);
+        let origin = splat3(ray.origin);
+        let direction = splat3(ray.direction);
+        let mut stack = [0u32; STACK_SIZE];
+        stack[0] = self.root;
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let current = stack[top];
+            if current & LEAF_BIT == 0 {
+                let node = &self.nodes[current as usize];
+                let (_, mut mask) = box_ray.intersect(node, ray.tmin, ray.tmax);
+                while mask != 0 {
+                    let slot = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[top] = node.children[slot];
+                    top += 1;
+                }
+            } else {
+                let block = &self.blocks[(current & !LEAF_BIT) as usize];
+                let (_, _, _, hit) =
+                    intersect_block(block, &origin, &direction, ray.tmin, ray.tmax);
+                if hit.any() {
+                    return true;
                 }
             }
-        );
-        blocked
+        }
+        false
     }
 }
 
@@ -179,53 +391,107 @@ mod tests {
         Vec3A::new(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0 - 5.0
     }
 
-    /// The BVH must return exactly what testing every triangle returns.
+    /// The scalar form of the block test, for the brute-force reference.
+    fn intersect_one(tri: &[Vec3A; 3], o: Vec3A, d: Vec3A, tmin: f32, tmax: f32) -> Option<f32> {
+        let [v0, v1, v2] = *tri;
+        let (e1, e2) = (v0 - v1, v2 - v0);
+        let ng = e1.cross(e2);
+        let c = v0 - o;
+        let r = d.cross(c);
+        let inv_det = 1.0 / ng.dot(d);
+        let (u, v, t) = (r.dot(e2) * inv_det, r.dot(e1) * inv_det, ng.dot(c) * inv_det);
+        (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= tmin && t <= tmax).then_some(t)
+    }
+
+    /// The BVH must return what testing every triangle returns, for scenes of every size
+    /// (a lone leaf as root, partly filled nodes and blocks, deep trees).
     #[test]
     fn matches_brute_force() {
         let mut rng = Rng::new(5, 5);
-        let tris: Vec<[Vec3A; 3]> = (0..500)
-            .map(|_| {
-                let c = random_point(&mut rng);
-                [
-                    c,
-                    c + random_point(&mut rng) * 0.2,
-                    c + random_point(&mut rng) * 0.2,
-                ]
-            })
-            .collect();
-        let accel = BvhAccel::build(&tris);
-        let brute: Vec<IntersectionTriangle> = tris
-            .iter()
-            .map(|&[a, b, c]| IntersectionTriangle::new(a, b, c))
-            .collect();
-        let mut hits = 0;
-        for _ in 0..20_000 {
-            let o = random_point(&mut rng) * 1.5;
-            let d = (random_point(&mut rng)).normalize();
-            let ray = Ray::new(o, d, 1e-3, f32::INFINITY);
-            let mut best: Option<(f32, usize)> = None;
-            for (i, tri) in brute.iter().enumerate() {
-                if let Some((t, _, _)) = tri.intersect(o, d, 1e-3, f32::INFINITY)
-                    && best.is_none_or(|(bt, _)| t < bt)
-                {
-                    best = Some((t, i));
+        for count in [1, 3, 5, 17, 500, 5000] {
+            let tris: Vec<[Vec3A; 3]> = (0..count)
+                .map(|_| {
+                    let c = random_point(&mut rng);
+                    [
+                        c,
+                        c + random_point(&mut rng) * 0.2,
+                        c + random_point(&mut rng) * 0.2,
+                    ]
+                })
+                .collect();
+            let accel = BvhAccel::build(&tris).unwrap();
+            let mut sorted = accel.build_order.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..count as u32).collect::<Vec<_>>());
+            let mut hits = 0;
+            for _ in 0..20_000 {
+                let o = random_point(&mut rng) * 1.5;
+                let d = (random_point(&mut rng)).normalize();
+                let ray = Ray::new(o, d, 1e-3, f32::INFINITY);
+                let mut best: Option<(f32, usize)> = None;
+                for (i, tri) in tris.iter().enumerate() {
+                    if let Some(t) = intersect_one(tri, o, d, 1e-3, f32::INFINITY)
+                        && best.is_none_or(|(bt, _)| t < bt)
+                    {
+                        best = Some((t, i));
+                    }
+                }
+                let hit = accel.intersect(&ray);
+                match (best, hit) {
+                    (None, None) => {}
+                    (Some((t, i)), Some(h)) => {
+                        hits += 1;
+                        assert_eq!(accel.build_order[h.triangle as usize] as usize, i);
+                        assert!((h.t - t).abs() <= 1e-4 * t.max(1.0));
+                        let [a, b, c] = tris[i];
+                        let p = a * (1.0 - h.u - h.v) + b * h.u + c * h.v;
+                        assert!((p - (o + d * h.t)).length() < 1e-3);
+                    }
+                    other => panic!("{count} triangles: mismatch {other:?}"),
+                }
+                assert_eq!(accel.occluded(&ray), best.is_some());
+                // A segment that ends before the closest hit is not blocked by it.
+                if let Some((t, _)) = best {
+                    let short = Ray::new(o, d, 1e-3, t * 0.999);
+                    let blocked = accel.occluded(&short);
+                    let expected = tris
+                        .iter()
+                        .any(|tri| intersect_one(tri, o, d, 1e-3, t * 0.999).is_some());
+                    assert_eq!(blocked, expected);
                 }
             }
-            let hit = accel.intersect(&ray);
-            match (best, hit) {
-                (None, None) => {}
-                (Some((t, i)), Some(h)) => {
-                    hits += 1;
-                    assert_eq!(accel.build_order[h.triangle as usize] as usize, i);
-                    assert!((h.t - t).abs() <= 1e-4 * t.max(1.0));
-                    let [a, b, c] = tris[i];
-                    let p = a * (1.0 - h.u - h.v) + b * h.u + c * h.v;
-                    assert!((p - (o + d * h.t)).length() < 1e-3);
-                }
-                other => panic!("mismatch {other:?}"),
+            if count >= 500 {
+                assert!(hits > 1000, "{count} triangles: {hits} hits");
             }
-            assert_eq!(accel.occluded(&ray), best.is_some());
         }
-        assert!(hits > 1000);
+    }
+
+    /// Rays along the axes (zero direction components) from origins on box planes.
+    #[test]
+    fn axis_aligned_rays_from_box_planes() {
+        let square = |z: f32| {
+            [
+                [
+                    Vec3A::new(0.0, 0.0, z),
+                    Vec3A::new(1.0, 0.0, z),
+                    Vec3A::new(1.0, 1.0, z),
+                ],
+                [
+                    Vec3A::new(0.0, 0.0, z),
+                    Vec3A::new(1.0, 1.0, z),
+                    Vec3A::new(0.0, 1.0, z),
+                ],
+            ]
+        };
+        let tris: Vec<[Vec3A; 3]> = (0..8).flat_map(|i| square(i as f32)).collect();
+        let accel = BvhAccel::build(&tris).unwrap();
+        // From x = 0 and y = 0 (the boxes' own planes), straight along +z.
+        let ray = Ray::new(Vec3A::new(0.0, 0.25, -1.0), Vec3A::Z, 0.0, f32::INFINITY);
+        let hit = accel.intersect(&ray).expect("the first square");
+        assert_eq!(hit.t, 1.0);
+        let ray = Ray::new(Vec3A::new(0.5, 0.0, 2.5), -Vec3A::Z, 0.0, f32::INFINITY);
+        assert_eq!(accel.intersect(&ray).map(|h| h.t), Some(0.5));
+        let ray = Ray::new(Vec3A::new(0.5, 0.5, 2.5), -Vec3A::Z, 0.0, 0.4);
+        assert!(!accel.occluded(&ray));
     }
 }

@@ -7,11 +7,10 @@
 //! Every backend answers the same queries the same way, up to floating-point rounding: the
 //! same closest triangle and t, the same occlusion, except for rays that pass within rounding
 //! of an edge, graze a triangle or hit two triangles at (nearly) the same t;
-//! `tests/backends.rs` measures how rare those are. Two differences by definition: the BVH
+//! `tests/backends.rs` measures how rare those are. One difference by definition: the BVH
 //! accepts hits with t in [tmin, tmax], Embree in (tmin, tmax] (tmin is passed as is, so they
 //! differ only for a hit at exactly t = tmin; the integrators use tmin = 0 from origins moved
-//! off the surface); and obvhs culls boxes that end before t = 1e-4, so the BVH can miss a
-//! hit closer than that to the ray origin, which Embree finds.
+//! off the surface).
 
 mod bvh;
 /// cbindgen:ignore
@@ -70,7 +69,7 @@ impl Accel {
     /// [`Backend::is_available`]), and with Embree's error if Embree fails.
     pub fn build(backend: Backend, triangles: &[[Vec3A; 3]]) -> Result<Accel> {
         match backend {
-            Backend::Bvh => Ok(Accel::Bvh(BvhAccel::build(triangles))),
+            Backend::Bvh => Ok(Accel::Bvh(BvhAccel::build(triangles)?)),
             #[cfg(feature = "embree")]
             Backend::Embree => Ok(Accel::Embree(EmbreeAccel::build(triangles)?)),
             #[cfg(not(feature = "embree"))]

@@ -14,7 +14,7 @@ use glam::Vec3A;
 /// Which ray-intersection backend a scene is built with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Backend {
-    /// obvhs compressed wide BVH (always available).
+    /// mlt's own 4-wide BVH, built with obvhs (always available).
     #[default]
     Bvh,
     /// Intel Embree 3 (only with the `embree` cargo feature).
