@@ -67,17 +67,13 @@ impl PathTracer<'_> {
                 break;
             }
 
-            // A light sample here ends a path of depth + 1 scattering vertices. At the last
-            // vertex it is the only strategy: a BSDF-sampled ray would only look for
-            // emission, so it is not traced and the light sample takes the full weight.
+            // A light sample here ends a path of depth + 1 scattering vertices. It is
+            // weighted by MIS against the BSDF-sampled ray even at the last vertex, where that
+            // ray only looks for emission: light sampling alone has unbounded variance near
+            // concave edges (the geometry term's 1/d² where two surfaces meet).
             let diffuse = material.kind == MaterialKind::Diffuse;
-            let last = depth + 1 == self.max_depth;
             if diffuse && depth + 1 >= self.min_depth {
-                radiance +=
-                    throughput * self.sample_light(p, normal, wo, material, !last, rng, rays);
-            }
-            if diffuse && last {
-                break;
+                radiance += throughput * self.sample_light(p, normal, wo, material, rng, rays);
             }
 
             let Some(sample) = bsdf::sample(
@@ -111,17 +107,14 @@ impl PathTracer<'_> {
     }
 
     /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
-    /// against BSDF sampling when `mis` (else the only strategy). Returns the contribution
-    /// before the path throughput.
+    /// against BSDF sampling. Returns the contribution before the path throughput.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn sample_light<S: Sampler>(
         &self,
         p: Vec3A,
         normal: Vec3A,
         wo: Vec3A,
         material: &crate::scene::Material,
-        mis: bool,
         rng: &mut S,
         rays: &mut u64,
     ) -> Vec3A {
@@ -157,11 +150,7 @@ impl PathTracer<'_> {
             return Vec3A::ZERO;
         }
         let light_pdf = light.area_pdf * distance2 / cos_light;
-        let weight = if mis {
-            power_heuristic(light_pdf, bsdf::pdf(material, normal, wo, wi))
-        } else {
-            1.0
-        };
+        let weight = power_heuristic(light_pdf, bsdf::pdf(material, normal, wo, wi));
         f * light.emission * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
