@@ -107,6 +107,21 @@ impl BvhAccel {
         &self.build_order
     }
 
+    /// The bytes of the structure, from the arrays' lengths: the CWBVH's nodes and index
+    /// array (and exact node boxes, if any), the leaf-order triangles and the build order.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(self.bvh.nodes.as_slice())
+            + size_of_val(self.bvh.primitive_indices.as_slice())
+            + self
+                .bvh
+                .exact_node_aabbs
+                .as_ref()
+                .map_or(0, |boxes| size_of_val(boxes.as_slice()))
+            + size_of_val(self.triangles.as_slice())
+            + size_of_val(self.build_order.as_slice())
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         if self.triangles.is_empty() {

@@ -24,6 +24,7 @@ use crate::error::{
 use ffi::*;
 use glam::Vec3A;
 use std::ffi::{CStr, c_char, c_void};
+use std::sync::atomic::{AtomicIsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 /// The build quality of the (static) scenes: high (spatial splits) traces camera rays about
@@ -65,6 +66,16 @@ unsafe extern "C" fn record_error(user_ptr: *mut c_void, code: RTCError, message
         .get_or_insert((code, text));
 }
 
+/// The device's memory monitor: keeps the balance of the bytes Embree allocates and frees
+/// (scene structures and geometry buffers), and allows every allocation.
+unsafe extern "C" fn count_memory(user_ptr: *mut c_void, bytes: isize, _post: bool) -> bool {
+    // SAFETY: `user_ptr` is the counter registered in `Device::new`, which lives until after
+    // `rtcReleaseDevice` (see `Device`).
+    let allocated = unsafe { &*user_ptr.cast::<AtomicIsize>() };
+    allocated.fetch_add(bytes, Ordering::Relaxed);
+    true
+}
+
 fn error_name(code: RTCError) -> &'static str {
     match code {
         RTC_ERROR_NONE => "no error code",
@@ -97,12 +108,15 @@ fn embree_error(call: &str, code: RTCError, detail: &str) -> Error {
     Error::new(status_of(code), message)
 }
 
-/// An Embree device and the log its error callback writes to.
+/// An Embree device, the log its error callback writes to and the balance its memory
+/// monitor keeps.
 struct Device {
     raw: RTCDevice,
     /// Boxed so its address, registered with the device, stays put. Dropped after the
     /// device is released (fields drop after `Drop::drop`).
     errors: Box<ErrorLog>,
+    /// Bytes Embree holds for this device; boxed and dropped like `errors`.
+    allocated: Box<AtomicIsize>,
 }
 
 impl Device {
@@ -117,11 +131,16 @@ impl Device {
         let device = Device {
             raw,
             errors: Box::default(),
+            allocated: Box::default(),
         };
         let log: *const ErrorLog = &*device.errors;
-        // SAFETY: a live device; the log outlives it (see the field's comment) and the
-        // callback only reads it through a shared reference.
-        unsafe { rtcSetDeviceErrorFunction(raw, Some(record_error), log.cast_mut().cast()) };
+        let allocated: *const AtomicIsize = &*device.allocated;
+        // SAFETY: a live device; the log and the counter outlive it (see the fields'
+        // comments) and the callbacks only use them through shared references.
+        unsafe {
+            rtcSetDeviceErrorFunction(raw, Some(record_error), log.cast_mut().cast());
+            rtcSetDeviceMemoryMonitorFunction(raw, Some(count_memory), allocated.cast_mut().cast());
+        }
         device.check("rtcNewDevice")?;
         Ok(device)
     }
@@ -293,6 +312,19 @@ impl EmbreeAccel {
         &self.build_order
     }
 
+    /// The bytes Embree holds for this scene (its BVH and the geometry's vertex and index
+    /// buffers, as its memory monitor counts them) plus our build-order array.
+    pub fn memory_bytes(&self) -> usize {
+        let embree = self.device.allocated.load(Ordering::Relaxed).max(0) as usize;
+        embree + std::mem::size_of_val(self.build_order.as_slice())
+    }
+
+    /// The committed scene, for calling Embree directly (the traversal benchmark's baseline).
+    #[doc(hidden)]
+    pub fn raw_scene(&self) -> RTCScene {
+        self.scene
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut context = RTCIntersectContext::new();
@@ -369,6 +401,26 @@ mod tests {
         assert_eq!(accel.intersect(&ray), None);
         assert!(!accel.occluded(&ray));
         assert!(accel.internal_to_build_order().is_empty());
+    }
+
+    /// The memory monitor counts what a build allocates: at least the vertex and index
+    /// buffers (48 bytes a triangle).
+    #[test]
+    fn memory_monitor_counts_the_build() {
+        let triangles: Vec<[Vec3A; 3]> = (0..1000)
+            .map(|i| {
+                let x = i as f32;
+                [
+                    Vec3A::new(x, 0.0, 0.0),
+                    Vec3A::new(x + 1.0, 0.0, 0.0),
+                    Vec3A::new(x, 1.0, 0.0),
+                ]
+            })
+            .collect();
+        let accel = EmbreeAccel::build(&triangles).unwrap();
+        let bytes = accel.memory_bytes();
+        assert!(bytes >= 1000 * 48, "{bytes}");
+        assert!(bytes < 100 << 20, "{bytes}");
     }
 
     /// An error Embree reports becomes an `Error` naming the call, the code and Embree's
