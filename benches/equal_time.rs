@@ -31,7 +31,10 @@
 
 mod common;
 
-use common::{FONT_FAMILY, env_names, env_value, output_dir, register_plot_font, series_color};
+use common::{
+    FONT_FAMILY, draw_legend, env_names, env_value, output_dir, plot_font_or_color_key,
+    series_color,
+};
 use mlt::{Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render};
 use plotters::prelude::*;
 use std::error::Error;
@@ -419,13 +422,7 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
         }
         if with_text {
             // Upper right: the curves fall from upper left to lower right.
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 14))
-                .draw()?;
+            draw_legend(&mut chart)?;
         }
     }
     root.present()?;
@@ -495,18 +492,9 @@ fn main() {
         });
     }
 
-    let font = register_plot_font();
-    if font.is_none() {
-        println!(
-            "no font found (set MLT_BENCH_FONT to a .ttf file): the plot has no title, labels or legend"
-        );
-        for (index, &(name, _, _)) in ALGORITHMS.iter().enumerate() {
-            let RGBColor(r, g, b) = series_color(index);
-            println!("  {name}: line color #{r:02x}{g:02x}{b:02x}");
-        }
-    }
+    let with_text = plot_font_or_color_key(ALGORITHMS.iter().map(|&(name, _, _)| name));
     let plot_path = dir.join("convergence.png");
-    match plot(&plot_path, &results, font.is_some()) {
+    match plot(&plot_path, &results, with_text) {
         Ok(()) => println!("plot: {}", plot_path.display()),
         Err(e) => println!("plot failed: {e}"),
     }

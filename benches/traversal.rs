@@ -7,7 +7,7 @@
 //! per scene and thread count, to `target/mlt-bench/traversal.png`. Numbers are reported,
 //! never asserted.
 //!
-//! What is traced, on two generated scenes (`room`: ~60k triangles of furniture, shelves of
+//! What is traced, on two generated scenes (`room`: ~70k triangles of furniture, shelves of
 //! books, spheres, vases and overlapping clutter in a closed room; `terrain`: ~1.1M triangles,
 //! a finely tessellated displaced heightfield with scattered rocks, trees and houses):
 //! - camera rays, in 8×8 pixel tiles (coherent), through the scene's camera;
@@ -26,7 +26,8 @@
 //! - `raw embree`: `rtcIntersect1` / `rtcOccluded1` through mlt's FFI declarations on the
 //!   very scene `mlt embree` built, with rays converted beforehand and no hit conversion.
 //!
-//! Rates are medians over runs that trace every tracer back to back; the ratios (mlt's layer
+//! Rates are medians over runs that trace every tracer back to back (after an untimed
+//! warm-up, in alternating order); the ratios (mlt's layer
 //! against its raw library, and the BVH against Embree) are medians of the ratios within each
 //! run. The build table gives the median `Accel::build` time and `Accel::memory_bytes` (BVH:
 //! nodes, triangles and index arrays from their lengths; Embree: what its memory monitor
@@ -48,7 +49,8 @@ mod common;
 mod generate;
 
 use common::{
-    FONT_FAMILY, env_names, env_value, median, output_dir, register_plot_font, series_color,
+    FONT_FAMILY, draw_legend, env_names, env_value, median, output_dir, plot_font_or_color_key,
+    series_color,
 };
 use generate::{MeshBuilder, bounce_ray, bounds, random_ray, uniform_direction};
 use glam::{DAffine3, DQuat, DVec3, Vec3A};
@@ -116,7 +118,7 @@ fn post(mesh: &mut MeshBuilder, base: DVec3, radius: f64, height: f64, segments:
 
 /// An 8 × 3 × 6 m room (y up) with a table and chairs, a sofa, shelves of books, spheres of
 /// several sizes, vases, a window with blinds, a plant of many thin leaves and a heap of
-/// overlapping boxes: ~60k triangles of very different sizes and orientations.
+/// overlapping boxes: ~70k triangles of very different sizes and orientations.
 fn room() -> BenchScene {
     let mut mesh = MeshBuilder::default();
     let mut rng = Rng::new(1, 1);
@@ -313,7 +315,7 @@ fn room() -> BenchScene {
     for _ in 0..600 {
         let at = DVec3::new(
             uniform(&mut rng, 2.2..3.6),
-            uniform(&mut rng, 0.0..0.8),
+            uniform(&mut rng, 0.35..0.9),
             uniform(&mut rng, 1.5..2.6),
         );
         let half = DVec3::new(
@@ -673,8 +675,10 @@ impl Tracer for ObvhsTracer {
 mod raw_embree {
     use super::{KindRays, Query, Range, Tracer};
     use mlt::accel::embree::ffi::*;
+    use mlt::accel::embree::{rtc_ray, rtc_rayhit};
 
-    /// Embree called directly on a committed scene.
+    /// Embree called directly on a committed scene, with the rays converted beforehand (by
+    /// the conversions `mlt embree` makes for each query).
     pub struct EmbreeTracer {
         scene: RTCScene,
         /// Per kind: closest-hit rays (ready to copy and pass) and occlusion rays.
@@ -685,21 +689,6 @@ mod raw_embree {
     // of threads; `mlt embree`'s accel owns it and outlives the tracer.
     unsafe impl Sync for EmbreeTracer {}
 
-    fn rtc_ray(ray: &mlt::accel::Ray) -> RTCRay {
-        RTCRay {
-            org_x: ray.origin.x,
-            org_y: ray.origin.y,
-            org_z: ray.origin.z,
-            tnear: ray.tmin,
-            dir_x: ray.direction.x,
-            dir_y: ray.direction.y,
-            dir_z: ray.direction.z,
-            tfar: ray.tmax,
-            mask: u32::MAX,
-            ..RTCRay::default()
-        }
-    }
-
     impl EmbreeTracer {
         pub fn new(accel: &mlt::accel::Accel, rays: &[KindRays]) -> EmbreeTracer {
             let mlt::accel::Accel::Embree(embree) = accel else {
@@ -708,19 +697,7 @@ mod raw_embree {
             let rays = rays
                 .iter()
                 .map(|k| {
-                    let hits = k
-                        .intersect
-                        .iter()
-                        .map(|r| RTCRayHit {
-                            ray: rtc_ray(r),
-                            hit: RTCHit {
-                                geomID: RTC_INVALID_GEOMETRY_ID,
-                                primID: RTC_INVALID_GEOMETRY_ID,
-                                instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
-                                ..RTCHit::default()
-                            },
-                        })
-                        .collect();
+                    let hits = k.intersect.iter().map(rtc_rayhit).collect();
                     (hits, k.occluded.iter().map(rtc_ray).collect())
                 })
                 .collect();
@@ -833,10 +810,18 @@ fn measure_rates(
             // seconds[tracer][run]
             let mut seconds = vec![Vec::new(); tracers.len()];
             let mut hits = vec![0; tracers.len()];
-            for _ in 0..runs {
-                for (t, tracer) in tracers.iter().enumerate() {
-                    let (s, h) = time_trace(&pool, *tracer, kind_index, query, count);
-                    seconds[t].push(s);
+            // An untimed warm-up, then runs in alternating order, so that no tracer always
+            // finds the caches as another left them.
+            for run in 0..=runs {
+                let mut order: Vec<usize> = (0..tracers.len()).collect();
+                if run % 2 == 0 {
+                    order.reverse();
+                }
+                for t in order {
+                    let (s, h) = time_trace(&pool, tracers[t], kind_index, query, count);
+                    if run > 0 {
+                        seconds[t].push(s);
+                    }
                     hits[t] = h;
                 }
             }
@@ -1078,13 +1063,7 @@ fn plot(path: &Path, rows: &[RateRow], with_text: bool) -> Result<(), Box<dyn Er
             }
         }
         if with_text {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 13))
-                .draw()?;
+            draw_legend(&mut chart)?;
         }
     }
     root.present()?;
@@ -1161,16 +1140,9 @@ fn main() {
 
     let dir = output_dir();
     std::fs::create_dir_all(&dir).expect("output directory");
-    let font = register_plot_font();
-    if font.is_none() {
-        println!("no font found (set MLT_BENCH_FONT to a .ttf file): the chart has no text");
-        for (index, name) in tracer_names().iter().enumerate() {
-            let RGBColor(r, g, b) = series_color(index);
-            println!("  {name}: bar color #{r:02x}{g:02x}{b:02x}");
-        }
-    }
+    let with_text = plot_font_or_color_key(tracer_names());
     let chart_path = dir.join("traversal.png");
-    match plot(&chart_path, &rate_rows, font.is_some()) {
+    match plot(&chart_path, &rate_rows, with_text) {
         Ok(()) => println!("chart: {}", chart_path.display()),
         Err(e) => println!("chart failed: {e}"),
     }

@@ -2,7 +2,8 @@
 //! plots' font and colors. Each bench uses part of them.
 #![allow(dead_code)]
 
-use plotters::style::{FontStyle, RGBColor};
+use plotters::coord::CoordTranslate;
+use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The value of the environment variable `name`, or `default` when it is not set. Panics on
@@ -87,4 +88,37 @@ const SERIES_COLORS: &[RGBColor] = &[
 
 pub fn series_color(index: usize) -> RGBColor {
     SERIES_COLORS[index % SERIES_COLORS.len()]
+}
+
+/// Registers a font for a plot (see `register_plot_font`) and says whether there is one;
+/// without one, prints which color stands for which of `series` (the plot has no legend).
+pub fn plot_font_or_color_key<'a>(series: impl IntoIterator<Item = &'a str>) -> bool {
+    if register_plot_font().is_some() {
+        return true;
+    }
+    println!(
+        "no font found (set MLT_BENCH_FONT to a .ttf file): the plot has no title, labels or legend"
+    );
+    for (index, name) in series.into_iter().enumerate() {
+        let RGBColor(r, g, b) = series_color(index);
+        println!("  {name}: color #{r:02x}{g:02x}{b:02x}");
+    }
+    false
+}
+
+/// The legend of a chart's labelled series, in its upper right corner.
+pub fn draw_legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT_FAMILY, 14))
+        .draw()
 }

@@ -80,7 +80,7 @@ impl MeshBuilder {
             let angle = a * TAU;
             to.transform_point3(DVec3::new(angle.cos(), angle.sin(), z))
         };
-        self.grid(rows, segments, |s, u| at(s, u));
+        self.grid(rows, segments, at);
         if caps {
             for z in [0.0, 1.0] {
                 self.fan(

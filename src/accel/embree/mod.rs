@@ -328,15 +328,7 @@ impl EmbreeAccel {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut context = RTCIntersectContext::new();
-        let mut rayhit = RTCRayHit {
-            ray: rtc_ray(ray),
-            hit: RTCHit {
-                primID: RTC_INVALID_GEOMETRY_ID,
-                geomID: RTC_INVALID_GEOMETRY_ID,
-                instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
-                ..RTCHit::default()
-            },
-        };
+        let mut rayhit = rtc_rayhit(ray);
         // SAFETY: a committed scene (see `build`), alive as long as `self`; `context` and
         // `rayhit` are initialized, correctly aligned locals that Embree writes only during
         // the call.
@@ -363,7 +355,8 @@ impl EmbreeAccel {
 /// Our ray as Embree's: every mask bit set (Debian's Embree is built with ray masks, and a
 /// zero mask would hit nothing), time 0.
 #[inline]
-fn rtc_ray(ray: &Ray) -> RTCRay {
+#[doc(hidden)]
+pub fn rtc_ray(ray: &Ray) -> RTCRay {
     RTCRay {
         org_x: ray.origin.x,
         org_y: ray.origin.y,
@@ -377,6 +370,21 @@ fn rtc_ray(ray: &Ray) -> RTCRay {
         mask: u32::MAX,
         id: 0,
         flags: 0,
+    }
+}
+
+/// Our ray as Embree's closest-hit query: the ray of [`rtc_ray`] and no hit yet.
+#[inline]
+#[doc(hidden)]
+pub fn rtc_rayhit(ray: &Ray) -> RTCRayHit {
+    RTCRayHit {
+        ray: rtc_ray(ray),
+        hit: RTCHit {
+            primID: RTC_INVALID_GEOMETRY_ID,
+            geomID: RTC_INVALID_GEOMETRY_ID,
+            instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
+            ..RTCHit::default()
+        },
     }
 }
 
