@@ -39,6 +39,8 @@
 //! - `MLT_BENCH_RUNS`: runs of every measurement; the median is reported (default 5).
 //! - `MLT_BENCH_BUILDS`: builds per backend and scene for the build time (default 3).
 //! - `MLT_BENCH_SCENES`: comma-separated, of `room`, `terrain` (default both).
+//! - `MLT_BENCH_PREVIEW=1`: also writes a shaded view of each scene through its camera to
+//!   `target/mlt-bench/traversal-SCENE.png`.
 //! - `MLT_BENCH_FONT`: a TrueType font for the chart's text (default: a few usual system
 //!   paths); without one the chart is written without text.
 //!
@@ -311,12 +313,12 @@ fn room() -> BenchScene {
             leaf.transform_point3(DVec3::new(0.12 * s, 0.03 * (u - 0.5) * (1.0 - s), 0.0))
         });
     }
-    // A heap of overlapping boxes in a corner.
+    // A heap of overlapping boxes by the table.
     for _ in 0..600 {
         let at = DVec3::new(
-            uniform(&mut rng, 2.2..3.6),
+            uniform(&mut rng, -1.5..0.5),
             uniform(&mut rng, 0.35..0.9),
-            uniform(&mut rng, 1.5..2.6),
+            uniform(&mut rng, 1.7..2.6),
         );
         let half = DVec3::new(
             uniform(&mut rng, 0.02..0.2),
@@ -418,13 +420,16 @@ fn terrain() -> BenchScene {
             1,
         );
     }
-    let eye = DVec3::new(-420.0, terrain_height(-420.0, -380.0) + 45.0, -380.0);
+    // From 60 m above the ground towards the middle, 24° down: the far hills and a strip of
+    // sky at the top of the image.
+    let eye = DVec3::new(-420.0, terrain_height(-420.0, -380.0) + 60.0, -380.0);
+    let target = eye + DVec3::new(0.74, 0.0, 0.67) * 100.0 - DVec3::Y * 45.0;
     BenchScene {
         name: "terrain",
         triangles: mesh.triangles(),
         camera: Camera {
             eye: eye.as_vec3().to_array(),
-            target: [0.0, terrain_height(0.0, 0.0) as f32 - 20.0, 0.0],
+            target: target.as_vec3().to_array(),
             up: [0.0, 1.0, 0.0],
             fov_y_deg: 60.0,
             ..Camera::default()
@@ -560,6 +565,32 @@ fn generate_rays(scene: &BenchScene, accel: &Accel, count: usize) -> Vec<KindRay
         }
     })
     .collect()
+}
+
+/// A 480×360 view of the scene through its camera, shaded by the cosine between the ray and
+/// the surface, to see what is traced.
+fn write_preview(path: &Path, scene: &BenchScene, accel: &Accel) -> Result<(), Box<dyn Error>> {
+    let (width, height) = (480, 360);
+    let model = scene.camera.model(width, height);
+    let build_order = accel.internal_to_build_order();
+    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
+    for y in 0..height {
+        for x in 0..width {
+            let (origin, direction) = model.generate_ray(x as f32 + 0.5, y as f32 + 0.5, [0.5; 2]);
+            let color = match accel.intersect(&Ray::new(origin, direction, 0.0, f32::INFINITY)) {
+                Some(hit) => {
+                    let [a, b, c] = scene.triangles[build_order[hit.triangle as usize] as usize];
+                    let cos = (b - a).cross(c - a).normalize().dot(direction).abs();
+                    let grey = (40.0 + 200.0 * cos) as u8;
+                    RGBColor(grey, grey, grey)
+                }
+                None => RGBColor(150, 190, 230),
+            };
+            root.draw_pixel((x as i32, y as i32), &color)?;
+        }
+    }
+    root.present()?;
+    Ok(())
 }
 
 // ---------------------------------------------------------------------------------------
@@ -940,12 +971,16 @@ fn print_build_rows(rows: &[BuildRow]) {
         "scene", "triangles", "backend", "build s", "memory MB", "B/tri"
     );
     for r in rows {
+        let seconds = if r.seconds.is_nan() {
+            "-".to_string()
+        } else {
+            format!("{:.3}", r.seconds)
+        };
         println!(
-            "{:<8} {:>10} {:<11} {:>9.3} {:>10.1} {:>9.1}",
+            "{:<8} {:>10} {:<11} {seconds:>9} {:>10.1} {:>9.1}",
             r.scene,
             r.triangles,
             r.backend,
-            r.seconds,
             r.bytes as f64 / 1e6,
             r.bytes as f64 / r.triangles as f64
         );
@@ -1094,6 +1129,14 @@ fn main() {
         let (bvh, row) = measure_build(&scene, Backend::Bvh, builds);
         build_rows.push(row);
         let rays = generate_rays(&scene, &bvh, ray_count);
+        if env_value("MLT_BENCH_PREVIEW", 0) != 0 {
+            let path = output_dir().join(format!("traversal-{}.png", scene.name));
+            std::fs::create_dir_all(output_dir()).expect("output directory");
+            match write_preview(&path, &scene, &bvh) {
+                Ok(()) => println!("preview: {}", path.display()),
+                Err(e) => println!("preview failed: {e}"),
+            }
+        }
         let obvhs = ObvhsTracer::build(&scene.triangles).with_rays(&rays);
         build_rows.push(BuildRow {
             backend: "raw obvhs",
