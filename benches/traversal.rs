@@ -41,6 +41,8 @@
 //! - `MLT_BENCH_SCENES`: comma-separated, of `room`, `terrain` (default both).
 //! - `MLT_BENCH_PREVIEW=1`: also writes a shaded view of each scene through its camera to
 //!   `target/mlt-bench/traversal-SCENE.png`.
+//! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `raw obvhs`, `mlt embree`, `raw embree`
+//!   (default all that the build has), e.g. to profile one.
 //! - `MLT_BENCH_FONT`: a TrueType font for the chart's text (default: a few usual system
 //!   paths); without one the chart is written without text.
 //!
@@ -793,12 +795,21 @@ fn time_trace(
 // Measurement and report
 
 /// The tracers' names, in table and chart order; those without Embree only in builds with it.
+/// `MLT_BENCH_TRACERS` picks some.
 fn tracer_names() -> Vec<&'static str> {
-    let mut names = vec!["mlt bvh", "raw obvhs"];
+    let mut all = vec!["mlt bvh", "raw obvhs"];
     if cfg!(feature = "embree") {
-        names.extend(["mlt embree", "raw embree"]);
+        all.extend(["mlt embree", "raw embree"]);
     }
-    names
+    let wanted = env_names("MLT_BENCH_TRACERS", &all);
+    for name in &wanted {
+        assert!(
+            all.contains(&name.as_str()),
+            "MLT_BENCH_TRACERS: unknown {name:?}; this build has {all:?}"
+        );
+    }
+    all.retain(|name| wanted.iter().any(|w| w == name));
+    all
 }
 
 /// The ratios the table reports: (label, numerator tracer, denominator tracer).
@@ -1166,7 +1177,12 @@ fn main() {
             }));
             tracers.push(Box::new(raw_embree::EmbreeTracer::new(&embree, &rays)));
         }
-        let tracer_refs: Vec<&dyn Tracer> = tracers.iter().map(|t| t.as_ref()).collect();
+        let names = tracer_names();
+        let tracer_refs: Vec<&dyn Tracer> = tracers
+            .iter()
+            .map(|t| t.as_ref())
+            .filter(|t| names.contains(&t.name()))
+            .collect();
         print_rate_header();
         for &threads in &thread_counts {
             rate_rows.extend(measure_rates(
