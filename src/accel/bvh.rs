@@ -164,24 +164,26 @@ impl BvhAccel {
         let traverse_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, ray.tmin, ray.tmax);
         let mut state = self.bvh.new_traversal(ray.direction);
         let mut node;
-        let mut blocked = false;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            node.intersect_ray(&traverse_ray, state.oct_inv4),
-            {
-                let tri = &self.triangles[state.primitive_id as usize];
-                if tri
-                    .intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
-                    .is_some()
+        // A plain `break` in the macro's primitive block would only leave the loop over the
+        // current leaf's triangles and traversal would go on: leave the whole traversal.
+        'traversal: {
+            obvhs::traverse!(
+                self.bvh,
+                node,
+                state,
+                node.intersect_ray(&traverse_ray, state.oct_inv4),
                 {
-                    blocked = true;
-                    break;
+                    let tri = &self.triangles[state.primitive_id as usize];
+                    if tri
+                        .intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
+                        .is_some()
+                    {
+                        break 'traversal true;
+                    }
                 }
-            }
-        );
-        blocked
+            );
+            false
+        }
     }
 }
 
