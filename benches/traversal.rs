@@ -21,8 +21,9 @@
 //! 1024 spread over a rayon pool of 1 thread and of every core. The tracers:
 //! - `mlt bvh`, `mlt embree`: `Accel::intersect` / `Accel::occluded` on `mlt::accel::Ray`;
 //! - `raw obvhs`: obvhs 0.4 used as its examples do, with no mlt code: its own CWBVH build
-//!   (the same `medium_build` preset), its `ray_traverse` / `ray_traverse_miss` and its
-//!   `Triangle::intersect` on its own triangle array in leaf order;
+//!   (the same `medium_build` preset unless `MLT_BENCH_OBVHS_BUILD` says otherwise), its
+//!   `ray_traverse` / `ray_traverse_miss` and its `Triangle::intersect` on its own triangle
+//!   array in leaf order;
 //! - `raw embree`: `rtcIntersect1` / `rtcOccluded1` through mlt's FFI declarations on the
 //!   very scene `mlt embree` built, with rays converted beforehand and no hit conversion.
 //!
@@ -43,6 +44,9 @@
 //!   `target/mlt-bench/traversal-SCENE.png`.
 //! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `raw obvhs`, `mlt embree`, `raw embree`
 //!   (default all that the build has), e.g. to profile one.
+//! - `MLT_BENCH_OBVHS_BUILD`: the obvhs build preset of `raw obvhs` (`fastest`, `very_fast`,
+//!   `fast`, `medium`, `slow`, `very_slow`; default `medium`, mlt's), to see what a preset
+//!   would change; `slow` and `very_slow` split triangles, which mlt's BVH does not support.
 //! - `MLT_BENCH_FONT`: a TrueType font for the chart's text (default: a few usual system
 //!   paths); without one the chart is written without text.
 //!
@@ -630,23 +634,44 @@ impl Tracer for MltTracer<'_> {
     }
 }
 
+/// The obvhs build preset of the raw baseline: `MLT_BENCH_OBVHS_BUILD`, default `medium`
+/// (mlt's). The `slow` ones split triangles (a triangle may be in several leaves), which mlt's
+/// BVH does not support; raw obvhs does.
+fn obvhs_build_params() -> obvhs::BvhBuildParams {
+    use obvhs::BvhBuildParams as P;
+    match std::env::var("MLT_BENCH_OBVHS_BUILD").as_deref() {
+        Ok("fastest") => P::fastest_build(),
+        Ok("very_fast") => P::very_fast_build(),
+        Ok("fast") => P::fast_build(),
+        Ok("medium") | Err(_) => P::medium_build(),
+        Ok("slow") => P::slow_build(),
+        Ok("very_slow") => P::very_slow_build(),
+        Ok(other) => panic!(
+            "MLT_BENCH_OBVHS_BUILD={other:?}: one of fastest, very_fast, fast, medium, slow, very_slow"
+        ),
+    }
+}
+
 /// obvhs on its own: its build, traversal and triangle test, on its triangles in leaf order.
 struct ObvhsTracer {
     bvh: obvhs::cwbvh::CwBvh,
     triangles: Vec<obvhs::triangle::Triangle>,
     /// Per kind: closest-hit and occlusion rays.
     rays: Vec<[Vec<obvhs::ray::Ray>; 2]>,
+    /// Seconds of the build (one build, from the triangles to the leaf-order array).
+    build_seconds: f64,
 }
 
 impl ObvhsTracer {
     fn build(triangles: &[[Vec3A; 3]]) -> ObvhsTracer {
+        let start = Instant::now();
         let triangles: Vec<obvhs::triangle::Triangle> = triangles
             .iter()
             .map(|&[v0, v1, v2]| obvhs::triangle::Triangle { v0, v1, v2 })
             .collect();
         let bvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
             &triangles,
-            obvhs::BvhBuildParams::medium_build(),
+            obvhs_build_params(),
             &mut std::time::Duration::default(),
         );
         let triangles = bvh
@@ -658,6 +683,7 @@ impl ObvhsTracer {
             bvh,
             triangles,
             rays: Vec::new(),
+            build_seconds: start.elapsed().as_secs_f64(),
         }
     }
 
@@ -982,16 +1008,12 @@ fn print_build_rows(rows: &[BuildRow]) {
         "scene", "triangles", "backend", "build s", "memory MB", "B/tri"
     );
     for r in rows {
-        let seconds = if r.seconds.is_nan() {
-            "-".to_string()
-        } else {
-            format!("{:.3}", r.seconds)
-        };
         println!(
-            "{:<8} {:>10} {:<11} {seconds:>9} {:>10.1} {:>9.1}",
+            "{:<8} {:>10} {:<11} {:>9.3} {:>10.1} {:>9.1}",
             r.scene,
             r.triangles,
             r.backend,
+            r.seconds,
             r.bytes as f64 / 1e6,
             r.bytes as f64 / r.triangles as f64
         );
@@ -1151,7 +1173,7 @@ fn main() {
         let obvhs = ObvhsTracer::build(&scene.triangles).with_rays(&rays);
         build_rows.push(BuildRow {
             backend: "raw obvhs",
-            seconds: f64::NAN,
+            seconds: obvhs.build_seconds,
             bytes: obvhs.memory_bytes(),
             ..*build_rows.last().unwrap()
         });
@@ -1194,7 +1216,7 @@ fn main() {
             ));
         }
     }
-    println!("\nbuild (median of {builds}; raw obvhs: memory only, its build is mlt bvh's):");
+    println!("\nbuild (median of {builds}; raw obvhs: one build):");
     print_build_rows(&build_rows);
 
     let dir = output_dir();
