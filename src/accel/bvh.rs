@@ -107,6 +107,21 @@ impl BvhAccel {
         &self.build_order
     }
 
+    /// The bytes of the structure, from the arrays' lengths: the CWBVH's nodes and index
+    /// array (and exact node boxes, if any), the leaf-order triangles and the build order.
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of_val;
+        size_of_val(self.bvh.nodes.as_slice())
+            + size_of_val(self.bvh.primitive_indices.as_slice())
+            + self
+                .bvh
+                .exact_node_aabbs
+                .as_ref()
+                .map_or(0, |boxes| size_of_val(boxes.as_slice()))
+            + size_of_val(self.triangles.as_slice())
+            + size_of_val(self.build_order.as_slice())
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         if self.triangles.is_empty() {
@@ -149,24 +164,26 @@ impl BvhAccel {
         let traverse_ray = obvhs::ray::Ray::new(ray.origin, ray.direction, ray.tmin, ray.tmax);
         let mut state = self.bvh.new_traversal(ray.direction);
         let mut node;
-        let mut blocked = false;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            node.intersect_ray(&traverse_ray, state.oct_inv4),
-            {
-                let tri = &self.triangles[state.primitive_id as usize];
-                if tri
-                    .intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
-                    .is_some()
+        // A plain `break` in the macro's primitive block would only leave the loop over the
+        // current leaf's triangles and traversal would go on: leave the whole traversal.
+        'traversal: {
+            obvhs::traverse!(
+                self.bvh,
+                node,
+                state,
+                node.intersect_ray(&traverse_ray, state.oct_inv4),
                 {
-                    blocked = true;
-                    break;
+                    let tri = &self.triangles[state.primitive_id as usize];
+                    if tri
+                        .intersect(ray.origin, ray.direction, ray.tmin, ray.tmax)
+                        .is_some()
+                    {
+                        break 'traversal true;
+                    }
                 }
-            }
-        );
-        blocked
+            );
+            false
+        }
     }
 }
 
