@@ -29,11 +29,17 @@
 //!
 //! A quick run: `MLT_BENCH_SECONDS=2 MLT_BENCH_REFERENCE_SPP=256 cargo bench --bench equal_time`.
 
+mod common;
+
+use common::{
+    FONT_FAMILY, draw_legend, env_names, env_value, output_dir, plot_font_or_color_key,
+    series_color,
+};
 use mlt::{Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render};
 use plotters::prelude::*;
 use std::error::Error;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The algorithms compared, by the name the table, the plot and `MLT_BENCH_ALGORITHMS` use,
 /// with their `direct_samples_per_mutation` (Metropolis: the default direct pass, or 0 for
@@ -61,34 +67,6 @@ const DEFAULT_REFERENCE_SPP: u32 = 4096;
 /// would make its error look smaller than it is.
 const REFERENCE_SEEDS: [u64; 2] = [0x5EED_0000_000A, 0x5EED_0000_000B];
 
-/// The family the plot's text asks for; `register_plot_font` registers a font file under it.
-const FONT_FAMILY: &str = "sans-serif";
-const FONT_CANDIDATES: &[&str] = &[
-    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-    "/usr/share/fonts/TTF/DejaVuSans.ttf",
-    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
-    "/System/Library/Fonts/Supplemental/Arial.ttf",
-    "C:\\Windows\\Fonts\\arial.ttf",
-];
-
-/// Line colors of the algorithms, in `ALGORITHMS` order (repeating past the end): distinct
-/// and dark enough to read on white.
-const LINE_COLORS: &[RGBColor] = &[
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
-];
-
-fn line_color(algorithm_index: usize) -> RGBColor {
-    LINE_COLORS[algorithm_index % LINE_COLORS.len()]
-}
-
 /// A converged image and the estimate of its own remaining error.
 struct Reference {
     image: Vec<f32>,
@@ -113,29 +91,6 @@ struct SceneResult {
     scene: String,
     reference_rmse: f64,
     measurements: Vec<Measurement>,
-}
-
-fn env_value<T: std::str::FromStr>(name: &str, default: T) -> T {
-    match std::env::var(name) {
-        Ok(text) => text
-            .trim()
-            .parse()
-            .unwrap_or_else(|_| panic!("{name}={text:?} is not a valid number")),
-        Err(_) => default,
-    }
-}
-
-/// The comma-separated names in `name`, or `default` when it is not set.
-fn env_names(name: &str, default: &[&str]) -> Vec<String> {
-    match std::env::var(name) {
-        Ok(text) => text
-            .split(',')
-            .map(str::trim)
-            .filter(|s| !s.is_empty())
-            .map(String::from)
-            .collect(),
-        Err(_) => default.iter().map(|s| s.to_string()).collect(),
-    }
 }
 
 /// The 1-2-5 series from a tenth of `max_seconds` up to it, ending at `max_seconds` itself
@@ -187,14 +142,6 @@ fn load_scene(name: &str) -> (Scene, Camera) {
     let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).expect("scene builds");
     let camera = data.camera.expect("camera sidecar").camera;
     (scene, camera)
-}
-
-/// `target/mlt-bench`, in the target directory cargo uses.
-fn output_dir() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target"));
-    target.join("mlt-bench")
 }
 
 /// The two reference halves, read from the cache or rendered (and cached) when missing.
@@ -336,23 +283,6 @@ fn print_row(scene: &str, m: &Measurement) {
     let _ = std::io::stdout().flush();
 }
 
-/// Registers the first readable font of `MLT_BENCH_FONT` or the usual system paths; returns
-/// its path, or `None` when there is none and the plot must do without text.
-fn register_plot_font() -> Option<PathBuf> {
-    let candidates: Vec<PathBuf> = match std::env::var_os("MLT_BENCH_FONT") {
-        Some(path) => vec![PathBuf::from(path)],
-        None => FONT_CANDIDATES.iter().map(PathBuf::from).collect(),
-    };
-    candidates.into_iter().find(|path| {
-        let Ok(bytes) = std::fs::read(path) else {
-            return false;
-        };
-        // plotters keeps fonts for the life of the program and takes only 'static bytes.
-        let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-        plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, bytes).is_ok()
-    })
-}
-
 /// Tick values of a log axis over `min..max`: labelled ones on the 1-2-5 series and unlabelled
 /// grid lines at every multiple of a power of ten. (plotters' own log ticks start at the first
 /// power of ten inside the range, which leaves a range like 0.2..2 with a single label.)
@@ -481,7 +411,7 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
             if points.is_empty() {
                 continue;
             }
-            let color = line_color(index);
+            let color = series_color(index);
             let series =
                 chart.draw_series(LineSeries::new(points, color.stroke_width(2)).point_size(4))?;
             if with_text {
@@ -492,13 +422,7 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
         }
         if with_text {
             // Upper right: the curves fall from upper left to lower right.
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font((FONT_FAMILY, 14))
-                .draw()?;
+            draw_legend(&mut chart)?;
         }
     }
     root.present()?;
@@ -568,18 +492,9 @@ fn main() {
         });
     }
 
-    let font = register_plot_font();
-    if font.is_none() {
-        println!(
-            "no font found (set MLT_BENCH_FONT to a .ttf file): the plot has no title, labels or legend"
-        );
-        for (index, &(name, _, _)) in ALGORITHMS.iter().enumerate() {
-            let RGBColor(r, g, b) = line_color(index);
-            println!("  {name}: line color #{r:02x}{g:02x}{b:02x}");
-        }
-    }
+    let with_text = plot_font_or_color_key(ALGORITHMS.iter().map(|&(name, _, _)| name));
     let plot_path = dir.join("convergence.png");
-    match plot(&plot_path, &results, font.is_some()) {
+    match plot(&plot_path, &results, with_text) {
         Ok(()) => println!("plot: {}", plot_path.display()),
         Err(e) => println!("plot failed: {e}"),
     }

@@ -4,6 +4,9 @@
 //! `cargo bench --bench render` (set MLT_BENCH_SPP / MLT_BENCH_RUNS to change the work).
 //! Timings are reported, never asserted: the machines are shared and noisy.
 
+mod common;
+
+use common::{env_value, median};
 use mlt::{RenderSettings, Scene, render};
 use std::path::Path;
 
@@ -11,21 +14,9 @@ use std::path::Path;
 /// of these machines: about 420k camera samples per second.
 const PBRT_V3_SAMPLES_PER_SECOND: f64 = 420_000.0;
 
-fn env_or(name: &str, default: u32) -> u32 {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(|a, b| a.total_cmp(b));
-    values[values.len() / 2]
-}
-
 fn main() {
-    let spp = env_or("MLT_BENCH_SPP", 32);
-    let runs = env_or("MLT_BENCH_RUNS", 5);
+    let spp = env_value("MLT_BENCH_SPP", 32u32);
+    let runs = env_value("MLT_BENCH_RUNS", 5u32);
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes");
     println!(
         "{:<14} {:>7} {:>14} {:>10} {:>11} {:>12}",

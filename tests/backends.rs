@@ -21,10 +21,11 @@
 
 mod common;
 
+use common::generate::{MeshBuilder, bounce_ray, point_in_bounds, random_ray};
 use common::*;
 use glam::{DVec3, Vec3A};
 use mlt::accel::{Hit, Ray};
-use mlt::sampling::{OrthonormalBasis, Rng, cosine_hemisphere};
+use mlt::sampling::Rng;
 use mlt::{Backend, Camera, Material, Scene};
 
 const RAYS_PER_KIND: usize = 100_000;
@@ -144,31 +145,14 @@ fn rays(pair: &Pair, kind: Kind, seed: u64) -> Vec<Ray> {
             camera_rays(pair, &mut rng)
                 .filter_map(|ray| {
                     let hit = pair.bvh.intersect(&ray)?;
-                    let mut normal = pair.normal(hit.triangle);
-                    if normal.dot(ray.direction) > 0.0 {
-                        normal = -normal;
-                    }
-                    let point = ray.origin + ray.direction * hit.t + normal * epsilon;
-                    let local = cosine_hemisphere(directions.uniform2());
-                    let direction = OrthonormalBasis::from_normal(normal).to_world(local);
-                    Some(Ray::new(point, direction.normalize(), 0.0, f32::INFINITY))
+                    let normal = pair.normal(hit.triangle);
+                    Some(bounce_ray(&ray, hit.t, normal, epsilon, &mut directions))
                 })
                 .take(RAYS_PER_KIND)
                 .collect()
         }
         Kind::Random => (0..RAYS_PER_KIND)
-            .map(|_| {
-                let z = 1.0 - 2.0 * rng.uniform();
-                let phi = std::f32::consts::TAU * rng.uniform();
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let direction = Vec3A::new(r * phi.cos(), r * phi.sin(), z);
-                Ray::new(
-                    point_in_bounds(pair, &mut rng),
-                    direction,
-                    0.0,
-                    f32::INFINITY,
-                )
-            })
+            .map(|_| random_ray(pair.bounds, f32::INFINITY, &mut rng))
             .collect(),
         Kind::Edge => std::iter::repeat_with(|| {
             let triangle = (rng.next_u32() as usize) % pair.triangles.len();
@@ -176,7 +160,7 @@ fn rays(pair: &Pair, kind: Kind, seed: u64) -> Vec<Ray> {
             let edge = (rng.next_u32() % 3) as usize;
             let (from, to) = (vertices[edge], vertices[(edge + 1) % 3]);
             let target = from + (to - from) * rng.uniform();
-            let origin = point_in_bounds(pair, &mut rng);
+            let origin = point_in_bounds(pair.bounds, &mut rng);
             let direction = (target - origin).normalize();
             direction
                 .is_finite()
@@ -186,11 +170,6 @@ fn rays(pair: &Pair, kind: Kind, seed: u64) -> Vec<Ray> {
         .take(RAYS_PER_KIND)
         .collect(),
     }
-}
-
-fn point_in_bounds(pair: &Pair, rng: &mut Rng) -> Vec3A {
-    let (lo, hi) = pair.bounds;
-    lo + (hi - lo) * Vec3A::new(rng.uniform(), rng.uniform(), rng.uniform())
 }
 
 /// Where a ray meets a triangle's plane, in f64.
@@ -513,27 +492,9 @@ fn generated_mesh_rays_agree() {
 /// it and each other. Many thin triangles, shared edges, intersection curves and grazing
 /// views. Deterministic.
 fn generated_mesh() -> Mesh {
-    let mut positions: Vec<f32> = Vec::new();
-    let mut indices: Vec<u32> = Vec::new();
-    // A grid of (rows + 1) × (columns + 1) vertices as two triangles per cell.
-    let mut grid = |rows: u32, columns: u32, point: &dyn Fn(f64, f64) -> DVec3| {
-        let base = (positions.len() / 3) as u32;
-        for i in 0..=rows {
-            for j in 0..=columns {
-                let p = point(i as f64 / rows as f64, j as f64 / columns as f64);
-                positions.extend([p.x as f32, p.y as f32, p.z as f32]);
-            }
-        }
-        let at = |i: u32, j: u32| base + i * (columns + 1) + j;
-        for i in 0..rows {
-            for j in 0..columns {
-                indices.extend([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                indices.extend([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-    };
     use std::f64::consts::{PI, TAU};
-    grid(150, 200, &|s, u| {
+    let mut mesh = MeshBuilder::default();
+    mesh.grid(150, 200, |s, u| {
         let theta = 0.05 + s * (PI - 0.1);
         let phi = u * TAU;
         let r = 40.0
@@ -546,7 +507,7 @@ fn generated_mesh() -> Mesh {
             r * theta.sin() * phi.sin(),
         )
     });
-    grid(160, 160, &|s, u| {
+    mesh.grid(160, 160, |s, u| {
         let (x, z) = (-90.0 + 180.0 * s, -90.0 + 180.0 * u);
         DVec3::new(
             x,
@@ -554,29 +515,13 @@ fn generated_mesh() -> Mesh {
             z,
         )
     });
-    grid(100, 100, &|s, u| {
+    mesh.grid(100, 100, |s, u| {
         let (y, z) = (-90.0 + 180.0 * s, -90.0 + 180.0 * u);
         DVec3::new(15.0 * (0.09 * z + 0.02 * y).sin() + 5.0, y, z)
     });
     // The box, two triangles per face.
-    grid(1, 1, &|s, u| {
-        DVec3::new(-100.0 + 200.0 * s, -100.0, -100.0 + 200.0 * u)
-    });
-    grid(1, 1, &|s, u| {
-        DVec3::new(-100.0 + 200.0 * s, 100.0, -100.0 + 200.0 * u)
-    });
-    grid(1, 1, &|s, u| {
-        DVec3::new(-100.0, -100.0 + 200.0 * s, -100.0 + 200.0 * u)
-    });
-    grid(1, 1, &|s, u| {
-        DVec3::new(100.0, -100.0 + 200.0 * s, -100.0 + 200.0 * u)
-    });
-    grid(1, 1, &|s, u| {
-        DVec3::new(-100.0 + 200.0 * s, -100.0 + 200.0 * u, -100.0)
-    });
-    grid(1, 1, &|s, u| {
-        DVec3::new(-100.0 + 200.0 * s, -100.0 + 200.0 * u, 100.0)
-    });
+    mesh.cuboid(glam::DAffine3::from_scale(DVec3::splat(100.0)), 1);
+    let MeshBuilder { positions, indices } = mesh;
     Mesh {
         positions,
         indices,

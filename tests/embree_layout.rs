@@ -1,6 +1,6 @@
 //! The hand-written Embree declarations (`mlt::accel::embree::ffi`) against the installed
 //! header: a small C program prints the size, alignment and every field offset of the structs
-//! we pass to Embree, the enum values we use, and what the header's inline
+//! we pass to Embree, the enum values we use, the memory monitor's signature, and what the header's inline
 //! `rtcInitIntersectContext` writes; each must equal its Rust counterpart.
 #![cfg(feature = "embree")]
 
@@ -76,6 +76,15 @@ fn expectations() -> Vec<(String, i64)> {
             size_of::<std::ffi::c_int>() as i64,
         ));
     }
+    // The memory monitor's signature, `fn(*mut c_void, isize, bool) -> bool` in ffi.rs
+    // (GCC and Clang's builtin compares the C types).
+    list.push(("sizeof(ssize_t)".into(), size_of::<isize>() as i64));
+    list.push(("sizeof(bool)".into(), size_of::<bool>() as i64));
+    list.push((
+        "__builtin_types_compatible_p(RTCMemoryMonitorFunction, bool (*)(void *, ssize_t, bool))"
+            .into(),
+        1,
+    ));
     // Our reimplementation of the inline rtcInitIntersectContext.
     let context = RTCIntersectContext::new();
     list.push(("context.flags".into(), context.flags as i64));

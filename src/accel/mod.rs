@@ -100,6 +100,17 @@ impl Accel {
         }
     }
 
+    /// The bytes the structure holds: for the BVH computed from its arrays' lengths, for
+    /// Embree the balance of what Embree allocated (counted by its memory monitor) plus our
+    /// own arrays. For comparing backends and sizing scenes; allocator overhead is not counted.
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Accel::Bvh(bvh) => bvh.memory_bytes(),
+            #[cfg(feature = "embree")]
+            Accel::Embree(embree) => embree.memory_bytes(),
+        }
+    }
+
     /// For each internal triangle index, the index into the triangle list the backend was
     /// built from.
     pub fn internal_to_build_order(&self) -> &[u32] {

@@ -1,6 +1,8 @@
 //! Shared helpers of the integration tests: test scenes built in code and image statistics.
 #![allow(dead_code)]
 
+pub mod generate;
+
 use mlt::{Backend, Camera, Material, Scene, SceneDesc};
 
 /// An icosphere of `radius` around the origin, subdivided `levels` times, with every

@@ -76,6 +76,11 @@ pub const RTC_MAX_INSTANCE_LEVEL_COUNT: usize = 1;
 pub type RTCErrorFunction =
     Option<unsafe extern "C" fn(user_ptr: *mut c_void, code: RTCError, message: *const c_char)>;
 
+/// `RTCMemoryMonitorFunction`: called with the bytes Embree is about to allocate (positive,
+/// `post` false) or has freed (negative, `post` true); returning false fails the allocation.
+pub type RTCMemoryMonitorFunction =
+    Option<unsafe extern "C" fn(user_ptr: *mut c_void, bytes: isize, post: bool) -> bool>;
+
 /// `RTCFilterFunctionN` (never set: always NULL).
 pub type RTCFilterFunctionN = Option<unsafe extern "C" fn(args: *const c_void)>;
 
@@ -155,6 +160,11 @@ unsafe extern "C" {
     pub fn rtcSetDeviceErrorFunction(
         device: RTCDevice,
         error: RTCErrorFunction,
+        user_ptr: *mut c_void,
+    );
+    pub fn rtcSetDeviceMemoryMonitorFunction(
+        device: RTCDevice,
+        monitor: RTCMemoryMonitorFunction,
         user_ptr: *mut c_void,
     );
 

@@ -22,8 +22,9 @@ use crate::error::{
     Result,
 };
 use ffi::*;
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 use std::ffi::{CStr, c_char, c_void};
+use std::sync::atomic::{AtomicIsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 /// The build quality of the (static) scenes: high (spatial splits) traces camera rays about
@@ -65,6 +66,16 @@ unsafe extern "C" fn record_error(user_ptr: *mut c_void, code: RTCError, message
         .get_or_insert((code, text));
 }
 
+/// The device's memory monitor: keeps the balance of the bytes Embree allocates and frees
+/// (scene structures and geometry buffers), and allows every allocation.
+unsafe extern "C" fn count_memory(user_ptr: *mut c_void, bytes: isize, _post: bool) -> bool {
+    // SAFETY: `user_ptr` is the counter registered in `Device::new`, which lives until after
+    // `rtcReleaseDevice` (see `Device`).
+    let allocated = unsafe { &*user_ptr.cast::<AtomicIsize>() };
+    allocated.fetch_add(bytes, Ordering::Relaxed);
+    true
+}
+
 fn error_name(code: RTCError) -> &'static str {
     match code {
         RTC_ERROR_NONE => "no error code",
@@ -97,12 +108,15 @@ fn embree_error(call: &str, code: RTCError, detail: &str) -> Error {
     Error::new(status_of(code), message)
 }
 
-/// An Embree device and the log its error callback writes to.
+/// An Embree device, the log its error callback writes to and the balance its memory
+/// monitor keeps.
 struct Device {
     raw: RTCDevice,
     /// Boxed so its address, registered with the device, stays put. Dropped after the
     /// device is released (fields drop after `Drop::drop`).
     errors: Box<ErrorLog>,
+    /// Bytes Embree holds for this device; boxed and dropped like `errors`.
+    allocated: Box<AtomicIsize>,
 }
 
 impl Device {
@@ -117,11 +131,16 @@ impl Device {
         let device = Device {
             raw,
             errors: Box::default(),
+            allocated: Box::default(),
         };
         let log: *const ErrorLog = &*device.errors;
-        // SAFETY: a live device; the log outlives it (see the field's comment) and the
-        // callback only reads it through a shared reference.
-        unsafe { rtcSetDeviceErrorFunction(raw, Some(record_error), log.cast_mut().cast()) };
+        let allocated: *const AtomicIsize = &*device.allocated;
+        // SAFETY: a live device; the log and the counter outlive it (see the fields'
+        // comments) and the callbacks only use them through shared references.
+        unsafe {
+            rtcSetDeviceErrorFunction(raw, Some(record_error), log.cast_mut().cast());
+            rtcSetDeviceMemoryMonitorFunction(raw, Some(count_memory), allocated.cast_mut().cast());
+        }
         device.check("rtcNewDevice")?;
         Ok(device)
     }
@@ -293,18 +312,23 @@ impl EmbreeAccel {
         &self.build_order
     }
 
+    /// The bytes Embree holds for this scene (its BVH and the geometry's vertex and index
+    /// buffers, as its memory monitor counts them) plus our build-order array.
+    pub fn memory_bytes(&self) -> usize {
+        let embree = self.device.allocated.load(Ordering::Relaxed).max(0) as usize;
+        embree + std::mem::size_of_val(self.build_order.as_slice())
+    }
+
+    /// The committed scene, for calling Embree directly (the traversal benchmark's baseline).
+    #[doc(hidden)]
+    pub fn raw_scene(&self) -> RTCScene {
+        self.scene
+    }
+
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let mut context = RTCIntersectContext::new();
-        let mut rayhit = RTCRayHit {
-            ray: rtc_ray(ray),
-            hit: RTCHit {
-                primID: RTC_INVALID_GEOMETRY_ID,
-                geomID: RTC_INVALID_GEOMETRY_ID,
-                instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
-                ..RTCHit::default()
-            },
-        };
+        let mut rayhit = rtc_rayhit(ray);
         // SAFETY: a committed scene (see `build`), alive as long as `self`; `context` and
         // `rayhit` are initialized, correctly aligned locals that Embree writes only during
         // the call.
@@ -330,21 +354,38 @@ impl EmbreeAccel {
 
 /// Our ray as Embree's: every mask bit set (Debian's Embree is built with ray masks, and a
 /// zero mask would hit nothing), time 0.
+///
+/// Written as three 16-byte vectors (origin and tnear, direction and time, tfar with mask, id
+/// and flags), the way Embree reads it: a 16-byte load that spans several narrower stores
+/// cannot be forwarded from them and waits for them to reach the cache. Built field by field,
+/// that stall cost 10-20% of Embree's ray rate (`benches/traversal.rs`, mlt embree against
+/// raw embree).
 #[inline]
-fn rtc_ray(ray: &Ray) -> RTCRay {
-    RTCRay {
-        org_x: ray.origin.x,
-        org_y: ray.origin.y,
-        org_z: ray.origin.z,
-        tnear: ray.tmin,
-        dir_x: ray.direction.x,
-        dir_y: ray.direction.y,
-        dir_z: ray.direction.z,
-        time: 0.0,
-        tfar: ray.tmax,
-        mask: u32::MAX,
-        id: 0,
-        flags: 0,
+#[doc(hidden)]
+pub fn rtc_ray(ray: &Ray) -> RTCRay {
+    let rows = [
+        ray.origin.extend(ray.tmin),
+        ray.direction.extend(0.0),
+        Vec4::new(ray.tmax, f32::from_bits(u32::MAX), 0.0, 0.0),
+    ];
+    // SAFETY: `RTCRay` is 12 four-byte fields in this order, 48 bytes (checked against the
+    // header by tests/embree_layout.rs), and every bit pattern is valid for each: mask =
+    // u32::MAX, id = flags = 0.
+    unsafe { std::mem::transmute::<[Vec4; 3], RTCRay>(rows) }
+}
+
+/// Our ray as Embree's closest-hit query: the ray of [`rtc_ray`] and no hit yet.
+#[inline]
+#[doc(hidden)]
+pub fn rtc_rayhit(ray: &Ray) -> RTCRayHit {
+    RTCRayHit {
+        ray: rtc_ray(ray),
+        hit: RTCHit {
+            primID: RTC_INVALID_GEOMETRY_ID,
+            geomID: RTC_INVALID_GEOMETRY_ID,
+            instID: [RTC_INVALID_GEOMETRY_ID; RTC_MAX_INSTANCE_LEVEL_COUNT],
+            ..RTCHit::default()
+        },
     }
 }
 
@@ -369,6 +410,26 @@ mod tests {
         assert_eq!(accel.intersect(&ray), None);
         assert!(!accel.occluded(&ray));
         assert!(accel.internal_to_build_order().is_empty());
+    }
+
+    /// The memory monitor counts what a build allocates: at least the vertex and index
+    /// buffers (48 bytes a triangle).
+    #[test]
+    fn memory_monitor_counts_the_build() {
+        let triangles: Vec<[Vec3A; 3]> = (0..1000)
+            .map(|i| {
+                let x = i as f32;
+                [
+                    Vec3A::new(x, 0.0, 0.0),
+                    Vec3A::new(x + 1.0, 0.0, 0.0),
+                    Vec3A::new(x, 1.0, 0.0),
+                ]
+            })
+            .collect();
+        let accel = EmbreeAccel::build(&triangles).unwrap();
+        let bytes = accel.memory_bytes();
+        assert!(bytes >= 1000 * 48, "{bytes}");
+        assert!(bytes < 100 << 20, "{bytes}");
     }
 
     /// An error Embree reports becomes an `Error` naming the call, the code and Embree's
