@@ -84,9 +84,8 @@ impl BoxRay {
         let slab = |bound: usize, axis: usize| {
             (node.bounds[bound] - self.origin[axis]) * self.inv_direction[axis]
         };
-        let t_near = slab(self.near[2], 2).max(
-            slab(self.near[1], 1).max(slab(self.near[0], 0).max(Vec4::splat(tmin))),
-        );
+        let t_near = slab(self.near[2], 2)
+            .max(slab(self.near[1], 1).max(slab(self.near[0], 0).max(Vec4::splat(tmin))));
         let t_far = slab(self.far[2], 2)
             .min(slab(self.far[1], 1).min(slab(self.far[0], 0).min(Vec4::splat(tmax))));
         (t_near, t_near.cmple(t_far).bitmask())
@@ -155,8 +154,13 @@ impl BvhAccel {
             .iter()
             .map(|&[v0, v1, v2]| Triangle { v0, v1, v2 })
             .collect();
+        // Reinsertion over every node (ratio 1 instead of the preset's 0.05) makes the tree
+        // fit cluttered scenes far better: on the traversal bench's 70k-triangle room, 3.0x
+        // the camera-ray rate and 2.4x on bounce and random rays, for 7x the build time
+        // (0.03 -> 0.22 s; the 1.2M-triangle terrain: 0.55 -> 3.8 s, single-threaded).
         let params = BvhBuildParams {
             max_prims_per_leaf: WIDTH as u32,
+            reinsertion_batch_ratio: 1.0,
             ..BvhBuildParams::medium_build()
         };
         let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
@@ -399,7 +403,11 @@ mod tests {
         let c = v0 - o;
         let r = d.cross(c);
         let inv_det = 1.0 / ng.dot(d);
-        let (u, v, t) = (r.dot(e2) * inv_det, r.dot(e1) * inv_det, ng.dot(c) * inv_det);
+        let (u, v, t) = (
+            r.dot(e2) * inv_det,
+            r.dot(e1) * inv_det,
+            ng.dot(c) * inv_det,
+        );
         (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= tmin && t <= tmax).then_some(t)
     }
 
