@@ -24,7 +24,8 @@ pub enum Algorithm {
     /// Bidirectional path tracing: every connection strategy, combined by MIS.
     Bdpt,
     /// Primary-sample-space Metropolis light transport (Kelemen) over the path tracer. The
-    /// default: lowest error at equal time on the benchmark scenes (`benches/equal_time.rs`).
+    /// default: the Metropolis variant with the lowest error at equal time on the benchmark
+    /// scenes (`benches/equal_time.rs`).
     #[default]
     Pssmlt,
     /// Multiplexed MLT (Hachisuka): primary-sample-space chains over BDPT that also pick the
