@@ -210,6 +210,19 @@ fn bootstrap_film_position(i: u64, n: u64, camera: &CameraModel, rng: &mut Rng) 
     ]
 }
 
+/// A sampler laid out for `target` with the chains' step settings; each use restarts it
+/// (`restart_as_bootstrap`) before its first sample.
+fn new_sampler<T: PrimarySpaceTarget>(target: &T, settings: &PssmltSettings) -> PssSampler {
+    PssSampler::new(
+        settings.seed,
+        0,
+        settings.large_step_probability,
+        settings.small_step_sigma,
+        target.streams(),
+        target.dimensions(),
+    )
+}
+
 /// Restarts `sampler` as bootstrap sample `i` of `n`.
 fn restart_as_bootstrap(
     sampler: &mut PssSampler,
@@ -256,14 +269,7 @@ fn bootstrap<T: PrimarySpaceTarget>(
             .collect::<Vec<u64>>()
             .into_par_iter()
             .map(|first| {
-                let mut sampler = PssSampler::new(
-                    settings.seed,
-                    0,
-                    settings.large_step_probability,
-                    settings.small_step_sigma,
-                    target.streams(),
-                    target.dimensions(),
-                );
+                let mut sampler = new_sampler(target, settings);
                 let mut scratch = target.scratch();
                 let mut sums = vec![0.0f64; groups];
                 let mut values = vec![0.0f32; groups];
@@ -415,14 +421,7 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
         .into_par_iter()
         .enumerate()
         .map(|(c, (group, index))| {
-            let mut sampler = PssSampler::new(
-                settings.seed,
-                0,
-                settings.large_step_probability,
-                settings.small_step_sigma,
-                target.streams(),
-                target.dimensions(),
-            );
+            let mut sampler = new_sampler(target, settings);
             restart_as_bootstrap(&mut sampler, settings, camera, index, n);
             let mut scratch = target.scratch();
             let mut current = PathSample::with_capacity(target.max_entries());
