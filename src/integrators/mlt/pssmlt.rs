@@ -167,8 +167,10 @@ pub(crate) trait PrimarySpaceTarget: Sync {
 /// The film position of a primary sample pair, in pixels, and its pixel index.
 #[inline]
 pub(crate) fn film_position(camera: &CameraModel, [u, v]: [f32; 2]) -> (f32, f32, u32) {
-    let x = (u * camera.width as f32).min(camera.width as f32 - 1.0);
-    let y = (v * camera.height as f32).min(camera.height as f32 - 1.0);
+    let (width, height) = (camera.width as f32, camera.height as f32);
+    // u < 1, but u · width can round up to width itself.
+    let x = (u * width).min(width.next_down());
+    let y = (v * height).min(height.next_down());
     (x, y, y as u32 * camera.width + x as u32)
 }
 
@@ -548,6 +550,16 @@ mod tests {
         let chains = allot_chains(&[0.5, 0.3, 0.2], 1000);
         assert_eq!(chains.iter().sum::<u64>(), 1000);
         assert_eq!(chains, vec![500, 300, 200]);
+    }
+
+    #[test]
+    fn film_positions_keep_their_place_within_the_last_pixel() {
+        // The last column and row once had every position clamped to their pixel's corner.
+        let camera = crate::scene::Camera::default().model(4, 2);
+        assert_eq!(film_position(&camera, [0.9, 0.75]), (3.6, 1.5, 7));
+        assert_eq!(film_position(&camera, [0.1, 0.25]), (0.4, 0.5, 0));
+        let (x, y, pixel) = film_position(&camera, [1.0f32.next_down(), 1.0f32.next_down()]);
+        assert!(x < 4.0 && y < 2.0 && pixel == 7, "{x} {y} {pixel}");
     }
 
     #[test]
