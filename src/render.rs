@@ -8,7 +8,7 @@ use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
 use crate::integrators::{PixelEstimator, SampleCounters, Splat};
-use crate::sampling::Rng;
+use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::{Camera, CameraModel, Scene};
 use glam::Vec3A;
 use rayon::prelude::*;
@@ -115,6 +115,10 @@ impl Estimator<'_> {
         }
     }
 }
+
+/// Stream offset of the per-pixel shifts of the camera samples' positions (apart from the
+/// per-sample streams, which hash the sample index into the seed).
+const PIXEL_SHIFT_STREAM: u64 = 0x5eed_0f15_0000_0000;
 
 // Limits beyond which a setting is a mistake, not a request.
 
@@ -678,9 +682,12 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                         let y = band.first_row + i as u32 / width;
                         let pixel = y as u64 * width as u64 + x as u64;
                         let mut pixel_sum = Vec3A::ZERO;
+                        // The pixel's samples spread over it as a (0, 2)-sequence.
+                        let mut shift = Rng::new(self.seed, PIXEL_SHIFT_STREAM + pixel);
+                        let shift = [shift.next_u32(), shift.next_u32()];
                         for sample in first..end {
                             let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
-                            let [jx, jy] = rng.uniform2();
+                            let [jx, jy] = shifted_sobol_2d(sample, shift);
                             let splats_before = state.splats.len();
                             let l = self.estimator.sample(
                                 &self.camera,

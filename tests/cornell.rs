@@ -52,13 +52,15 @@ fn cornell_error_falls_like_one_over_square_root_of_samples() {
     };
     let coarse = rms_error(16, 0..4);
     let fine = rms_error(256, 10..14);
-    // 16× the samples shrink the error 4×; the reference's own noise (1024 spp) adds to
-    // both: expected ratio sqrt((1/16 + 1/1024) / (1/256 + 1/1024)) = 3.61 to 4 (the
-    // light-edge pixels keep the 16 spp error heavy-tailed, so its estimate is loose). A
-    // biased estimator's error stops shrinking (ratio near 1); a 1/N^¼ rate gives 2.
+    // 16× the samples shrink the error 4× where the integrand is many-dimensional (the
+    // shading); the pixels on the light's edge, where the stratified positions within the
+    // pixel do the work, converge like N^(-3/4), up to 8×. The reference's own noise (1024
+    // spp) pulls the ratio down a little. A biased estimator's error stops shrinking (ratio
+    // near 1), a 1/N^¼ rate gives 2, and renders correlated with the reference would make
+    // the fine error vanish (a ratio far above 8).
     let ratio = coarse / fine;
     assert!(
-        (3.0..=4.6).contains(&ratio),
+        (3.0..=8.5).contains(&ratio),
         "ratio {ratio} ({coarse} / {fine})"
     );
 }

@@ -3,11 +3,13 @@
 mod distribution;
 mod rng;
 mod sampler;
+mod sobol;
 mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
 pub use rng::Rng;
 pub use sampler::Sampler;
+pub use sobol::shifted_sobol_2d;
 pub use warp::{
     OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic, uniform_disk,
     uniform_triangle,
