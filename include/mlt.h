@@ -125,9 +125,10 @@
 #define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
 
 /**
- * The default `direct_samples_per_mutation`.
+ * The default `direct_samples_per_mutation`: one, the best measured at equal time on
+ * the Cornell scenes (benches/equal_time.rs).
  */
-#define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 8
+#define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
 
 /**
  * Result of every fallible mlt call. Values are stable: hosts may store them.

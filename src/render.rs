@@ -190,8 +190,9 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
-    /// The default `direct_samples_per_mutation`.
-    pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 8;
+    /// The default `direct_samples_per_mutation`: one, the best measured at equal time on
+    /// the Cornell scenes (benches/equal_time.rs).
+    pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
 
     pub fn validate(&self) -> Result<()> {
         for (name, side) in [("width", self.width), ("height", self.height)] {

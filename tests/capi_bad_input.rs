@@ -353,7 +353,7 @@ fn defaults_are_valid_and_documented() {
             s.small_step_sigma,
             s.direct_samples_per_mutation
         ),
-        (0.3, 0.01, 8)
+        (0.3, 0.01, 1)
     );
 }
 
@@ -1251,9 +1251,9 @@ fn metropolis_settings_out_of_range() {
             )
         };
         assert_eq!(status, MLT_STATUS_OK, "algorithm {algorithm}");
-        // One mutation per pixel by the chains, 8 direct-pass camera samples per mutation.
+        // One mutation per pixel by the chains, one direct-pass camera sample per mutation.
         assert_eq!(stats.mutations, 16, "algorithm {algorithm}");
-        assert_eq!(stats.samples, 16 * 8, "algorithm {algorithm}");
+        assert_eq!(stats.samples, 16, "algorithm {algorithm}");
         // Nothing reaches the camera after two bounces here: the chains' b is 0 and the
         // direct pass alone makes the image.
         assert_eq!(

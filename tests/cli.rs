@@ -114,8 +114,8 @@ fn the_default_algorithm_is_metropolis_and_its_summary_counts_mutations() {
     assert!(output.status.success(), "{output:?}");
     for needle in [
         "Pssmlt",
-        // The direct pass: 8 camera samples per mutation.
-        "samples    16384 (16.00 per pixel)",
+        // The direct pass: one camera sample per mutation.
+        "samples    2048 (2.00 per pixel)",
         "mutations  2048 (2.00 per pixel)",
         "mutations/s",
         "metropolis b = ",

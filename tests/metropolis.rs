@@ -45,8 +45,9 @@ fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
     path_traced_estimate(scene, camera, 64, 256, 1000..1008)
 }
 
-/// The luminance of a Metropolis image's mean is exactly its normalization b, so the image
-/// mean is only as good as b: enough bootstrap samples make a 2% error resolvable.
+/// The luminance of a Metropolis image's mean is its normalization b plus the chains' noise,
+/// so the image mean is only as good as b: enough bootstrap samples make a 2% error
+/// resolvable.
 fn metropolis_estimate(
     variant: Variant,
     scene: &Scene,

@@ -71,17 +71,24 @@ impl PathTracer<'_> {
             // weighted by MIS against the BSDF-sampled ray even at the last vertex, where that
             // ray only looks for emission: light sampling alone has unbounded variance near
             // concave edges (the geometry term's 1/d² where two surfaces meet).
+            // Every vertex reads the same coordinates (light sample, BSDF sample, roulette)
+            // whether or not it uses them, so a Metropolis chain's small step that changes a
+            // vertex from specular to diffuse leaves the later vertices' numbers in place.
+            let u_light = [rng.uniform(), rng.uniform(), rng.uniform()];
+            let u_bsdf = rng.uniform2();
+            let u_lobe = rng.uniform();
+            let u_roulette = rng.uniform();
             let diffuse = material.kind == MaterialKind::Diffuse;
             if diffuse && depth + 1 >= self.min_depth {
-                radiance += throughput * self.sample_light(p, normal, wo, material, rng, rays);
+                radiance += throughput * self.sample_light(p, normal, wo, material, u_light, rays);
             }
 
             let Some(sample) = bsdf::sample(
                 material,
                 normal,
                 wo,
-                rng.uniform2(),
-                rng.uniform(),
+                u_bsdf,
+                u_lobe,
                 TransportMode::Radiance,
             ) else {
                 break;
@@ -93,7 +100,7 @@ impl PathTracer<'_> {
 
             if depth >= ROULETTE_START_DEPTH {
                 let survival = throughput.max_element().min(ROULETTE_MAX_SURVIVAL);
-                if rng.uniform() >= survival {
+                if u_roulette >= survival {
                     break;
                 }
                 throughput /= survival;
@@ -109,18 +116,16 @@ impl PathTracer<'_> {
     /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
     /// against BSDF sampling. Returns the contribution before the path throughput.
     #[inline]
-    fn sample_light<S: Sampler>(
+    fn sample_light(
         &self,
         p: Vec3A,
         normal: Vec3A,
         wo: Vec3A,
         material: &crate::scene::Material,
-        rng: &mut S,
+        [u_select, u_point @ ..]: [f32; 3],
         rays: &mut u64,
     ) -> Vec3A {
         let scene = self.scene;
-        let u_select = rng.uniform();
-        let u_point = rng.uniform2();
         if scene.lights.is_empty() {
             return Vec3A::ZERO;
         }

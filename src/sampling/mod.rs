@@ -1,12 +1,14 @@
 //! Random numbers, distributions and warps used by every integrator.
 
 mod distribution;
+mod normal;
 mod rng;
 mod sampler;
 mod sobol;
 mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
+pub use normal::standard_normal;
 pub use rng::Rng;
 pub use sampler::Sampler;
 pub use sobol::shifted_sobol_2d;

@@ -5,7 +5,7 @@
 //! iterations the coordinate was not read. A rejected proposal restores the backups.
 //! Both steps are symmetric, so the transfer ratio is 1.
 
-use crate::sampling::{Rng, Sampler};
+use crate::sampling::{Rng, Sampler, standard_normal};
 
 #[derive(Clone, Copy, Debug)]
 struct PrimarySample {
@@ -156,6 +156,7 @@ impl PssSampler {
 
     /// Brings coordinate `i` up to the current iteration. A coordinate read again in the same
     /// iteration keeps its value (BDPT reads its connection stream once per strategy).
+    #[inline]
     fn ensure_ready(&mut self, i: usize) {
         if i >= self.samples.len() {
             self.samples.resize(i + 1, PrimarySample::UNREAD);
@@ -183,13 +184,14 @@ impl PssSampler {
         } else if self.large_step {
             x.value = self.rng.uniform();
         } else {
-            let small_steps = (self.iteration - x.modified) as f32;
-            let normal = standard_normal(&mut self.rng);
-            let moved = x.value + normal * self.sigma * small_steps.sqrt();
-            x.value = moved - moved.floor();
-            if x.value >= 1.0 {
-                x.value = 0.0;
+            // Unread for k iterations, the coordinate takes the k small steps it missed at
+            // once: their sum is Gaussian with k times the variance.
+            let small_steps = self.iteration - x.modified;
+            let mut step = self.sigma * standard_normal(&mut self.rng);
+            if small_steps > 1 {
+                step *= (small_steps as f32).sqrt();
             }
+            x.value = wrap_to_unit(x.value + step);
         }
         x.modified = self.iteration;
     }
@@ -212,11 +214,21 @@ impl Sampler for PssSampler {
     }
 }
 
-/// A standard normal variate (Box–Muller).
-fn standard_normal(rng: &mut Rng) -> f32 {
-    let u1 = 1.0 - rng.uniform();
-    let u2 = rng.uniform();
-    (-2.0 * u1.ln()).sqrt() * (std::f32::consts::TAU * u2).cos()
+/// `value` wrapped into [0, 1). Small steps rarely leave the interval by more than its
+/// width, so branches usually replace `floor` (a libm call without SSE4.1).
+#[inline]
+fn wrap_to_unit(value: f32) -> f32 {
+    let wrapped = if (0.0..1.0).contains(&value) {
+        value
+    } else if (-1.0..0.0).contains(&value) {
+        value + 1.0
+    } else if (1.0..2.0).contains(&value) {
+        value - 1.0
+    } else {
+        value - value.floor()
+    };
+    // Rounding (a tiny negative value plus one) can land on 1.0 itself.
+    if wrapped < 1.0 { wrapped } else { 0.0 }
 }
 
 #[cfg(test)]

@@ -11,13 +11,16 @@
 //!    value (systematic resampling), which removes start-up bias up to the resampling's own
 //!    accuracy. Every chain makes the same number of mutations.
 //! 3. Each mutation deposits the proposal with weight a and the current state with 1 − a
-//!    (expected-value splatting), each as f⃗ / f, so a chain's deposits sum to one unit of
-//!    luminance per mutation.
-//! 4. A chain of group g is scaled by b_g / (its group's chains × mutations per chain): every
-//!    group then carries exactly its bootstrap estimate b_g of the image's luminance, however
-//!    its chains wandered. The image's brightness error is the error of the b_g alone, which
-//!    the stratified bootstrap keeps small; a single group normalized by the chains' own visits
-//!    (pbrt-v3's design) adds the random allotment of chains to depths on top.
+//!    (expected-value splatting). A large step's proposal is also an independent sample and
+//!    is deposited once more; every deposit is f⃗ / (f + p_large·b_g), the balance heuristic
+//!    between the chain (density f/b_g) and the large steps (density p_large) of Kelemen et
+//!    al. In bright regions this is the usual f⃗ / f; dim regions, which chains rarely visit,
+//!    are carried by the large steps as a path tracer would.
+//! 4. A chain of group g is scaled by b_g / (its group's chains × mutations per chain), so
+//!    each group's expected luminance is b_g, its bootstrap estimate, however many chains
+//!    it was allotted. The image's brightness error is the error of the b_g plus the
+//!    chains' own noise; a single group normalized by the chains' own visits (pbrt-v3's
+//!    design) adds the random allotment of chains to depths on top.
 //!
 //! Determinism: each chain's random numbers derive from (seed, chain index). Chains run in
 //! rounds; within a round they run in parallel, each recording its deposits, which are added
@@ -183,6 +186,8 @@ struct Chain<T: PrimarySpaceTarget> {
     current: PathSample,
     proposal: PathSample,
     deposits: Vec<Splat>,
+    /// p_large × b_g, added to f in the deposits' denominators (see `mutate`).
+    mis_offset: f32,
     accepted: u64,
     rays: u64,
 }
@@ -448,6 +453,7 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
                 current,
                 proposal: PathSample::with_capacity(target.max_entries()),
                 deposits: Vec::with_capacity((per_round * deposits_per_mutation) as usize),
+                mis_offset: (settings.large_step_probability as f64 * b[group]) as f32,
                 accepted: 0,
                 rays,
             }
@@ -510,11 +516,22 @@ fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut C
         &mut chain.rays,
     );
     let a = acceptance(chain.current.target, chain.proposal.target, 1.0);
+    // Kelemen et al.'s combination: the expected-value deposits have density f/b, and a
+    // large step is also an independent uniform sample (density p_large) deposited once
+    // more. Weighting every deposit by 1/(f/b + p_large), the balance heuristic over the
+    // two, lets the large steps carry the dim parts of the image, which the chain visits
+    // rarely.
+    let mis = chain.mis_offset;
+    let large = if chain.sampler.is_large_step() {
+        1.0
+    } else {
+        0.0
+    };
     if a > 0.0 {
-        deposit(&mut chain.deposits, &chain.proposal, a);
+        deposit(&mut chain.deposits, &chain.proposal, a + large, mis);
     }
     if a < 1.0 && chain.current.target > 0.0 {
-        deposit(&mut chain.deposits, &chain.current, 1.0 - a);
+        deposit(&mut chain.deposits, &chain.current, 1.0 - a, mis);
     }
     if chain.sampler.decision() < a {
         std::mem::swap(&mut chain.current, &mut chain.proposal);
@@ -525,10 +542,11 @@ fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut C
     }
 }
 
-/// Records `weight` × the state's contributions, each divided by the state's target value.
+/// Records `weight` × the state's contributions, each divided by the state's target value
+/// plus `mis_offset`.
 #[inline]
-fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32) {
-    let scale = weight / state.target;
+fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32, mis_offset: f32) {
+    let scale = weight / (state.target + mis_offset);
     for entry in &state.entries {
         deposits.push(Splat {
             pixel: entry.pixel,
