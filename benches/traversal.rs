@@ -20,6 +20,8 @@
 //! diagonal for a miss) for occlusion. Every backend traces the same rays, in chunks of
 //! 1024 spread over a rayon pool of 1 thread and of every core. The tracers:
 //! - `mlt bvh`, `mlt embree`: `Accel::intersect` / `Accel::occluded` on `mlt::accel::Ray`;
+//! - `mlt bvh4`: the same with the BVH forced to its 4-wide fallback (only on CPUs where the
+//!   default is wider, i.e. x86-64 with AVX2 and FMA);
 //! - `raw obvhs`: obvhs 0.4 used as its examples do, with no mlt code: its own CWBVH build
 //!   (the same `medium_build` preset unless `MLT_BENCH_OBVHS_BUILD` says otherwise), its
 //!   `ray_traverse` / `ray_traverse_miss` and its `Triangle::intersect` on its own triangle
@@ -40,10 +42,11 @@
 //! - `MLT_BENCH_RUNS`: runs of every measurement; the median is reported (default 5).
 //! - `MLT_BENCH_BUILDS`: builds per backend and scene for the build time (default 3).
 //! - `MLT_BENCH_SCENES`: comma-separated, of `room`, `terrain` (default both).
+//! - `MLT_BENCH_THREADS`: comma-separated thread counts (default 1 and every core).
 //! - `MLT_BENCH_PREVIEW=1`: also writes a shaded view of each scene through its camera to
 //!   `target/mlt-bench/traversal-SCENE.png`.
-//! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `raw obvhs`, `mlt embree`, `raw embree`
-//!   (default all that the build has), e.g. to profile one.
+//! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `mlt bvh4`, `raw obvhs`, `mlt embree`,
+//!   `raw embree` (default all that the build and CPU have), e.g. to profile one.
 //! - `MLT_BENCH_OBVHS_BUILD`: the obvhs build preset of `raw obvhs` (`fastest`, `very_fast`,
 //!   `fast`, `medium`, `slow`, `very_slow`; default `medium`, mlt's), to see what a preset
 //!   would change; `slow` and `very_slow` split triangles, which mlt's BVH does not support.
@@ -63,7 +66,7 @@ use common::{
 };
 use generate::{bounce_ray, bounds, random_ray};
 use glam::Vec3A;
-use mlt::accel::{Accel, Ray};
+use mlt::accel::{Accel, BvhWidth, Ray, with_bvh_width};
 use mlt::sampling::Rng;
 use mlt::{Backend, Camera};
 use plotters::prelude::*;
@@ -463,7 +466,11 @@ fn time_trace(
 /// The tracers' names, in table and chart order; those without Embree only in builds with it.
 /// `MLT_BENCH_TRACERS` picks some.
 fn tracer_names() -> Vec<&'static str> {
-    let mut all = vec!["mlt bvh", "raw obvhs"];
+    let mut all = vec!["mlt bvh"];
+    if BvhWidth::best() != BvhWidth::Four {
+        all.push("mlt bvh4");
+    }
+    all.push("raw obvhs");
     if cfg!(feature = "embree") {
         all.extend(["mlt embree", "raw embree"]);
     }
@@ -483,6 +490,7 @@ const RATIOS: &[(&str, &str, &str)] = &[
     ("bvh/obvhs", "mlt bvh", "raw obvhs"),
     ("embree/raw", "mlt embree", "raw embree"),
     ("bvh/embree", "mlt bvh", "mlt embree"),
+    ("bvh4/embree", "mlt bvh4", "mlt embree"),
 ];
 
 struct RateRow {
@@ -619,6 +627,30 @@ struct BuildRow {
 
 /// Builds `backend` `builds` times over the scene; returns the last build and its row.
 fn measure_build(scene: &BenchScene, backend: Backend, builds: usize) -> (Accel, BuildRow) {
+    measure_build_named(
+        scene,
+        backend,
+        builds,
+        match backend {
+            Backend::Bvh => "mlt bvh",
+            Backend::Embree => "mlt embree",
+        },
+    )
+}
+
+/// `measure_build` with the 4-wide BVH.
+fn measure_build_bvh4(scene: &BenchScene, builds: usize) -> (Accel, BuildRow) {
+    with_bvh_width(BvhWidth::Four, || {
+        measure_build_named(scene, Backend::Bvh, builds, "mlt bvh4")
+    })
+}
+
+fn measure_build_named(
+    scene: &BenchScene,
+    backend: Backend,
+    builds: usize,
+    name: &'static str,
+) -> (Accel, BuildRow) {
     let mut seconds = Vec::new();
     let mut accel = None;
     for _ in 0..builds.max(1) {
@@ -632,10 +664,7 @@ fn measure_build(scene: &BenchScene, backend: Backend, builds: usize) -> (Accel,
     let row = BuildRow {
         scene: scene.name,
         triangles: scene.triangles.len(),
-        backend: match backend {
-            Backend::Bvh => "mlt bvh",
-            Backend::Embree => "mlt embree",
-        },
+        backend: name,
         seconds: median(&mut seconds),
         bytes: accel.memory_bytes(),
     };
@@ -784,7 +813,14 @@ fn main() {
     let builds: usize = env_value("MLT_BENCH_BUILDS", DEFAULT_BUILDS);
     let scene_names = env_names("MLT_BENCH_SCENES", SCENES);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let thread_counts: Vec<usize> = if cores > 1 { vec![1, cores] } else { vec![1] };
+    let default_threads = if cores > 1 { vec![1, cores] } else { vec![1] };
+    let thread_counts: Vec<usize> = match std::env::var("MLT_BENCH_THREADS") {
+        Ok(list) => list
+            .split(',')
+            .map(|n| n.trim().parse().expect("MLT_BENCH_THREADS: thread counts"))
+            .collect(),
+        Err(_) => default_threads,
+    };
     println!(
         "traversal: {ray_count} rays of each kind, median of {runs} runs, {builds} builds, threads {thread_counts:?}; tracers {:?}",
         tracer_names()
@@ -815,11 +851,15 @@ fn main() {
             bytes: obvhs.memory_bytes(),
             ..*build_rows.last().unwrap()
         });
+        let bvh4 = tracer_names().contains(&"mlt bvh4").then(|| {
+            let (bvh4, row) = measure_build_bvh4(&scene, builds);
+            build_rows.push(row);
+            bvh4
+        });
         #[cfg(feature = "embree")]
         let (embree, row) = measure_build(&scene, Backend::Embree, builds);
         #[cfg(feature = "embree")]
         build_rows.push(row);
-        #[cfg_attr(not(feature = "embree"), allow(unused_mut))]
         let mut tracers: Vec<Box<dyn Tracer + '_>> = vec![
             Box::new(MltTracer {
                 name: "mlt bvh",
@@ -828,6 +868,16 @@ fn main() {
             }),
             Box::new(obvhs),
         ];
+        if let Some(bvh4) = &bvh4 {
+            tracers.insert(
+                1,
+                Box::new(MltTracer {
+                    name: "mlt bvh4",
+                    accel: bvh4,
+                    rays: &rays,
+                }),
+            );
+        }
         #[cfg(feature = "embree")]
         {
             tracers.push(Box::new(MltTracer {

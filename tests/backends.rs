@@ -1,4 +1,5 @@
-//! The BVH and Embree backends answer the same queries the same way.
+//! The BVH and Embree backends answer the same queries the same way; the BVH at each width
+//! this CPU supports (the 8-wide AVX2 tree and the 4-wide fallback).
 //!
 //! Scenes: cornell-box, cornell-glass and a generated mesh of ~130k triangles (a displaced
 //! sphere and two wavy sheets that cut through it and each other, in a box). Rays, 100k of
@@ -24,7 +25,7 @@ mod common;
 use common::generate::{MeshBuilder, bounce_ray, point_in_bounds, random_ray};
 use common::*;
 use glam::{DVec3, Vec3A};
-use mlt::accel::{Hit, Ray};
+use mlt::accel::{BvhWidth, Hit, Ray, with_bvh_width};
 use mlt::sampling::Rng;
 use mlt::{Backend, Camera, Material, Scene};
 
@@ -42,7 +43,10 @@ const GRAZING_COS: f64 = 1e-4;
 /// A triangle scene built with both backends, plus the host's triangles in f64.
 struct Pair {
     name: &'static str,
+    /// The default BVH: as wide as the CPU supports.
     bvh: Scene,
+    /// The 4-wide fallback, when the default is wider.
+    bvh4: Option<Scene>,
     embree: Scene,
     camera: Camera,
     triangles: Vec<[DVec3; 3]>,
@@ -54,6 +58,8 @@ struct Pair {
 impl Pair {
     fn new(name: &'static str, mesh: &Mesh, camera: Camera) -> Pair {
         let bvh = mesh.scene_with(Backend::Bvh);
+        let bvh4 = (BvhWidth::best() != BvhWidth::Four)
+            .then(|| with_bvh_width(BvhWidth::Four, || mesh.scene_with(Backend::Bvh)));
         let embree = mesh.scene_with(Backend::Embree);
         let info = bvh.info();
         assert_eq!(info, embree.info());
@@ -71,6 +77,7 @@ impl Pair {
         Pair {
             name,
             bvh,
+            bvh4,
             embree,
             camera,
             triangles,
@@ -345,14 +352,15 @@ impl Tally {
 /// At most this many disagreements per kind of ray get the (slow) brute-force explanation.
 const MAX_JUDGED: usize = 500;
 
-fn compare(pair: &Pair, kind: Kind) -> Tally {
+/// Compares `bvh` (one of the pair's BVH scenes) with Embree.
+fn compare(pair: &Pair, bvh: &Scene, kind: Kind) -> Tally {
     let judge = Judge { pair };
     let mut tally = Tally::default();
     let mut tmax_rng = Rng::new(7, kind as u64 + 10);
     let diagonal = (pair.bounds.1 - pair.bounds.0).length();
     for ray in rays(pair, kind, 1) {
         tally.queries += 1;
-        let a = pair.bvh.intersect(&ray);
+        let a = bvh.intersect(&ray);
         let b = pair.embree.intersect(&ray);
         if let (Some(a), Some(b)) = (a, b)
             && a.triangle == b.triangle
@@ -388,7 +396,7 @@ fn compare(pair: &Pair, kind: Kind) -> Tally {
             ray.tmin,
             reach * 1.5 * tmax_rng.uniform(),
         );
-        let (oa, ob) = (pair.bvh.occluded(&shadow), pair.embree.occluded(&shadow));
+        let (oa, ob) = (bvh.occluded(&shadow), pair.embree.occluded(&shadow));
         tally.blocked += oa as usize;
         if oa != ob {
             tally.occluded_disagreements += 1;
@@ -402,15 +410,24 @@ fn compare(pair: &Pair, kind: Kind) -> Tally {
 }
 
 fn check_pair(pair: &Pair) {
+    check_bvh(pair, "default", &pair.bvh);
+    if let Some(bvh4) = &pair.bvh4 {
+        check_bvh(pair, "4-wide", bvh4);
+    }
+}
+
+/// Every query of every kind through `bvh` against Embree.
+fn check_bvh(pair: &Pair, width: &str, bvh: &Scene) {
+    let name = format!("{} ({width} bvh)", pair.name);
     let mut queries = 0;
     let mut disagreements = 0;
     let mut unexplained = Vec::new();
     for kind in [Kind::Camera, Kind::Bounce, Kind::Random, Kind::Edge] {
-        let t = compare(pair, kind);
+        let t = compare(pair, bvh, kind);
         assert_eq!(t.queries, RAYS_PER_KIND);
         println!(
             "{} {kind:?}: {} rays, {} on the same triangle (max t error {:.1e} relative, point error {:.1e} of the magnitude), {} blocked; disagreements: closest hit {} (farther hit: bvh {}, embree {}), occlusion {}",
-            pair.name,
+            name,
             t.queries,
             t.hits,
             t.max_t_error,
@@ -428,7 +445,7 @@ fn check_pair(pair: &Pair) {
         assert!(
             t.hits > RAYS_PER_KIND / 4,
             "{} {kind:?}: only {} hits",
-            pair.name,
+            name,
             t.hits
         );
         assert!(t.blocked > RAYS_PER_KIND / 10 && t.blocked < RAYS_PER_KIND * 9 / 10);
@@ -436,7 +453,7 @@ fn check_pair(pair: &Pair) {
             assert!(
                 !t.examples.is_empty(),
                 "{}: edge-aimed rays should exercise the explanations",
-                pair.name
+                name
             );
         } else {
             queries += 2 * t.queries;
@@ -447,7 +464,7 @@ fn check_pair(pair: &Pair) {
     assert!(
         unexplained.is_empty(),
         "{}: {} disagreements without a rounding-sensitive configuration:\n{}",
-        pair.name,
+        name,
         unexplained.len(),
         unexplained.join("\n")
     );
@@ -455,7 +472,7 @@ fn check_pair(pair: &Pair) {
     assert!(
         rate <= MAX_DISAGREEMENT_RATE,
         "{}: {disagreements} of {queries} queries disagree ({rate:.1e})",
-        pair.name
+        name
     );
 }
 

@@ -1,8 +1,13 @@
-//! The default backend: a 4-wide BVH with its triangles packed four to a leaf block, both in
-//! structure-of-arrays layout, so one SSE instruction tests a ray against four boxes or four
-//! triangles (glam's `Vec4` is an SSE register on x86-64). obvhs builds the binary tree (PLOC
-//! with reinsertion and leaf collapsing, leaves of at most four triangles); we collapse it to
-//! four children per node and traverse it ourselves, nearest child first.
+//! The default backend: a wide BVH whose triangles are packed four to a leaf block, nodes and
+//! blocks both in structure-of-arrays layout, so one vector instruction tests a ray against
+//! several boxes or four triangles. obvhs builds the binary tree (PLOC with reinsertion and
+//! leaf collapsing, leaves of at most four triangles); we collapse it to a wide tree and
+//! traverse it ourselves, nearest child first.
+//!
+//! The width is picked at build time from the CPU: on x86-64 with AVX2 and FMA, eight children
+//! per node, whose boxes are tested with one AVX instruction per slab (`mod avx2`); elsewhere
+//! four, tested with SSE (or NEON) through glam's `Vec4`. Leaf blocks are tested with `Vec4`
+//! in both. Tests and benches can force the 4-wide tree with [`with_bvh_width`].
 //!
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
@@ -12,30 +17,109 @@ use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, Result};
 use glam::{BVec4A, Vec3A, Vec4};
 use obvhs::{
     BvhBuildParams,
+    aabb::Aabb,
     bvh2::{Bvh2, builder::build_bvh2_from_tris},
     triangle::Triangle,
 };
+use std::cell::Cell;
 use std::mem::MaybeUninit;
 use std::time::Duration;
 
-/// Children of a node, and triangles of a leaf block.
+/// Triangles of a leaf block, and children of a 4-wide node.
 const WIDTH: usize = 4;
 /// A child reference with this bit set is a leaf block index; otherwise a node index.
 const LEAF_BIT: u32 = 1 << 31;
 /// The reference of an empty child slot (its box is empty, so it is never entered).
 const EMPTY: u32 = u32::MAX;
-/// Entries of the traversal stack: each level of the tree adds at most WIDTH - 1, so trees
-/// up to 85 levels deep fit (PLOC trees over real scenes are a few dozen levels deep).
+/// Entries of the traversal stack. A query holds at most, summed over the nodes on one path
+/// from the root, each node's child count minus one (plus one for the root in occlusion
+/// queries); the build checks that its tree fits. PLOC trees over real scenes need a few
+/// dozen.
 const STACK_SIZE: usize = 256;
-/// Deepest tree the stack can traverse.
-const MAX_DEPTH: usize = (STACK_SIZE - 1) / (WIDTH - 1);
+
+/// Children per node of the BVH.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BvhWidth {
+    /// Tested with SSE (or NEON): any CPU.
+    Four,
+    /// Tested with AVX2 and FMA: x86-64 CPUs that have them.
+    Eight,
+}
+
+impl BvhWidth {
+    /// The widest this CPU supports.
+    pub fn best() -> BvhWidth {
+        if BvhWidth::Eight.is_supported() {
+            BvhWidth::Eight
+        } else {
+            BvhWidth::Four
+        }
+    }
+
+    pub fn is_supported(self) -> bool {
+        match self {
+            BvhWidth::Four => true,
+            #[cfg(target_arch = "x86_64")]
+            BvhWidth::Eight => is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma"),
+            #[cfg(not(target_arch = "x86_64"))]
+            BvhWidth::Eight => false,
+        }
+    }
+}
+
+thread_local! {
+    static FORCED_WIDTH: Cell<Option<BvhWidth>> = const { Cell::new(None) };
+}
+
+/// Runs `f` with the BVHs built on this thread `width` wide (if the CPU supports it) instead
+/// of the widest it supports: for tests and benches of the fallback.
+#[doc(hidden)]
+pub fn with_bvh_width<R>(width: BvhWidth, f: impl FnOnce() -> R) -> R {
+    struct Restore(Option<BvhWidth>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            FORCED_WIDTH.set(self.0);
+        }
+    }
+    let _restore = Restore(FORCED_WIDTH.replace(Some(width)));
+    f()
+}
 
 /// Four child boxes: `bounds[2 * axis]` their minima along the axis, `bounds[2 * axis + 1]`
 /// their maxima. Empty slots have min = +inf, max = -inf.
 #[derive(Clone, Copy, Debug)]
-struct Node {
+struct Node4 {
     bounds: [Vec4; 6],
     children: [u32; WIDTH],
+}
+
+/// A node of the wide tree, as `Builder::collapse` fills it.
+trait WideNode {
+    const WIDTH: usize;
+    /// Every slot empty.
+    fn empty() -> Self;
+    fn set_child(&mut self, slot: usize, aabb: &Aabb, reference: u32);
+}
+
+impl WideNode for Node4 {
+    const WIDTH: usize = WIDTH;
+
+    fn empty() -> Self {
+        let (min, max) = (Vec4::INFINITY, Vec4::NEG_INFINITY);
+        Node4 {
+            bounds: [min, max, min, max, min, max],
+            children: [EMPTY; WIDTH],
+        }
+    }
+
+    fn set_child(&mut self, slot: usize, aabb: &Aabb, reference: u32) {
+        for axis in 0..3 {
+            self.bounds[2 * axis][slot] = aabb.min[axis];
+            self.bounds[2 * axis + 1][slot] = aabb.max[axis];
+        }
+        self.children[slot] = reference;
+    }
 }
 
 /// Four triangles for the Möller–Trumbore test with the normal precomputed: v0, e1 = v0 - v1,
@@ -81,7 +165,7 @@ impl BoxRay {
 
     /// Entry distances of the four children and which of them the ray enters in [tmin, tmax].
     #[inline(always)]
-    fn intersect(&self, node: &Node, tmin: f32, tmax: f32) -> (Vec4, u32) {
+    fn intersect(&self, node: &Node4, tmin: f32, tmax: f32) -> (Vec4, u32) {
         let slab = |bound: usize, axis: usize| {
             (node.bounds[bound] - self.origin[axis]) * self.inv_direction[axis]
         };
@@ -130,8 +214,15 @@ fn splat3(v: Vec3A) -> [Vec4; 3] {
     [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
 }
 
+enum Nodes {
+    Four(Vec<Node4>),
+    /// Only built on CPUs with AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    Eight(Vec<avx2::Node8>),
+}
+
 pub struct BvhAccel {
-    nodes: Vec<Node>,
+    nodes: Nodes,
     blocks: Vec<TriangleBlock>,
     /// The root: a node index, a leaf block (`LEAF_BIT`) or `EMPTY`.
     root: u32,
@@ -139,17 +230,106 @@ pub struct BvhAccel {
     build_order: Vec<u32>,
 }
 
+/// The state of the collapse from the binary tree.
+struct Builder<'a> {
+    bvh2: &'a Bvh2,
+    vertices: &'a [[Vec3A; 3]],
+    blocks: Vec<TriangleBlock>,
+    build_order: Vec<u32>,
+}
+
+impl Builder<'_> {
+    /// The wide subtree of binary node `index`, appended to `nodes`: its reference, and the
+    /// traversal stack entries a closest-hit query in it needs at most.
+    fn collapse<N: WideNode>(&mut self, nodes: &mut Vec<N>, index: usize) -> (u32, usize) {
+        let bvh2 = self.bvh2;
+        let node = &bvh2.nodes[index];
+        if node.prim_count > 0 {
+            return (self.leaf_block(index), 0);
+        }
+        // Open the binary children with the largest surface area until there are N::WIDTH.
+        let mut open = Vec::with_capacity(N::WIDTH);
+        open.extend([node.first_index as usize, node.first_index as usize + 1]);
+        while open.len() < N::WIDTH {
+            let widest = open
+                .iter()
+                .enumerate()
+                .filter(|&(_, &i)| bvh2.nodes[i].prim_count == 0)
+                .max_by(|&(_, &a), &(_, &b)| {
+                    let area = |i: usize| bvh2.nodes[i].aabb.half_area();
+                    area(a).total_cmp(&area(b))
+                })
+                .map(|(slot, _)| slot);
+            let Some(slot) = widest else { break };
+            let first = bvh2.nodes[open[slot]].first_index as usize;
+            open[slot] = first;
+            open.push(first + 1);
+        }
+        let me = nodes.len();
+        nodes.push(N::empty());
+        let mut deepest_need = 0;
+        for (slot, &child) in open.iter().enumerate() {
+            let (reference, need) = self.collapse(nodes, child);
+            deepest_need = deepest_need.max(need);
+            nodes[me].set_child(slot, &bvh2.nodes[child].aabb, reference);
+        }
+        // The query goes on with one child and pushes the others.
+        (me as u32, deepest_need + open.len() - 1)
+    }
+
+    /// Packs the triangles of binary leaf `index` into a block; returns its reference.
+    fn leaf_block(&mut self, index: usize) -> u32 {
+        let node = &self.bvh2.nodes[index];
+        let first = node.first_index as usize;
+        let ids = &self.bvh2.primitive_indices[first..first + node.prim_count as usize];
+        assert!(ids.len() <= WIDTH, "obvhs made a leaf larger than asked");
+        let mut block = TriangleBlock {
+            v0: [Vec4::ZERO; 3],
+            e1: [Vec4::ZERO; 3],
+            e2: [Vec4::ZERO; 3],
+            ng: [Vec4::ZERO; 3],
+            first: self.build_order.len() as u32,
+        };
+        for (lane, &id) in ids.iter().enumerate() {
+            let [v0, v1, v2] = self.vertices[id as usize];
+            let e1 = v0 - v1;
+            let e2 = v2 - v0;
+            let ng = e1.cross(e2);
+            for axis in 0..3 {
+                block.v0[axis][lane] = v0[axis];
+                block.e1[axis][lane] = e1[axis];
+                block.e2[axis][lane] = e2[axis];
+                block.ng[axis][lane] = ng[axis];
+            }
+            self.build_order.push(id);
+        }
+        self.blocks.push(block);
+        (self.blocks.len() - 1) as u32 | LEAF_BIT
+    }
+}
+
 impl BvhAccel {
-    /// Builds over triangles given as vertex triples. None of them may be degenerate.
+    /// Builds over triangles given as vertex triples, none of them degenerate, as wide as the
+    /// CPU supports (or as [`with_bvh_width`] asks).
     pub fn build(vertices: &[[Vec3A; 3]]) -> Result<Self> {
-        let mut accel = BvhAccel {
-            nodes: Vec::new(),
-            blocks: Vec::new(),
-            root: EMPTY,
-            build_order: Vec::with_capacity(vertices.len()),
+        let width = FORCED_WIDTH.get().unwrap_or_else(BvhWidth::best);
+        Self::build_with_width(vertices, width)
+    }
+
+    /// Builds `width` wide, or 4-wide if the CPU does not support `width`.
+    pub(crate) fn build_with_width(vertices: &[[Vec3A; 3]], width: BvhWidth) -> Result<Self> {
+        let width = if width.is_supported() {
+            width
+        } else {
+            BvhWidth::Four
         };
         if vertices.is_empty() {
-            return Ok(accel);
+            return Ok(BvhAccel {
+                nodes: Nodes::Four(Vec::new()),
+                blocks: Vec::new(),
+                root: EMPTY,
+                build_order: Vec::new(),
+            });
         }
         let tris: Vec<Triangle> = vertices
             .iter()
@@ -165,105 +345,54 @@ impl BvhAccel {
             ..BvhBuildParams::medium_build()
         };
         let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
-        let mut depth = 0;
-        accel.root = accel.collapse(&bvh2, 0, vertices, 1, &mut depth);
-        if depth > MAX_DEPTH {
+        let mut builder = Builder {
+            bvh2: &bvh2,
+            vertices,
+            blocks: Vec::new(),
+            build_order: Vec::with_capacity(vertices.len()),
+        };
+        let (nodes, (root, stack_need)) = match width {
+            BvhWidth::Four => {
+                let mut nodes = Vec::new();
+                let root = builder.collapse(&mut nodes, 0);
+                (Nodes::Four(nodes), root)
+            }
+            #[cfg(target_arch = "x86_64")]
+            BvhWidth::Eight => {
+                let mut nodes = Vec::new();
+                let root = builder.collapse(&mut nodes, 0);
+                (Nodes::Eight(nodes), root)
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            BvhWidth::Eight => unreachable!("8-wide needs x86-64"),
+        };
+        // Occlusion queries push the root too.
+        if stack_need + 1 > STACK_SIZE {
             return Err(Error::new(
                 MLT_STATUS_INTERNAL_ERROR,
                 format!(
-                    "the BVH over these {} triangles is {depth} levels deep; at most {MAX_DEPTH} are supported",
-                    vertices.len()
+                    "the BVH over these {} triangles needs a traversal stack of {} entries; at most {STACK_SIZE} are supported",
+                    vertices.len(),
+                    stack_need + 1
                 ),
             ));
         }
-        Ok(accel)
+        Ok(BvhAccel {
+            nodes,
+            blocks: builder.blocks,
+            root,
+            build_order: builder.build_order,
+        })
     }
 
-    /// The wide subtree of binary node `index` at `level` (the root's is 1); returns its
-    /// reference and raises `depth` to the deepest level it reaches.
-    fn collapse(
-        &mut self,
-        bvh2: &Bvh2,
-        index: usize,
-        vertices: &[[Vec3A; 3]],
-        level: usize,
-        depth: &mut usize,
-    ) -> u32 {
-        *depth = (*depth).max(level);
-        let node = &bvh2.nodes[index];
-        if node.prim_count > 0 {
-            return self.leaf_block(bvh2, index, vertices);
+    /// Children per node.
+    #[doc(hidden)]
+    pub fn width(&self) -> BvhWidth {
+        match self.nodes {
+            Nodes::Four(_) => BvhWidth::Four,
+            #[cfg(target_arch = "x86_64")]
+            Nodes::Eight(_) => BvhWidth::Eight,
         }
-        // Open the binary children with the largest surface area until there are WIDTH.
-        let mut open = vec![node.first_index as usize, node.first_index as usize + 1];
-        while open.len() < WIDTH {
-            let widest = open
-                .iter()
-                .enumerate()
-                .filter(|&(_, &i)| bvh2.nodes[i].prim_count == 0)
-                .max_by(|&(_, &a), &(_, &b)| {
-                    let area = |i: usize| bvh2.nodes[i].aabb.half_area();
-                    area(a).total_cmp(&area(b))
-                })
-                .map(|(slot, _)| slot);
-            let Some(slot) = widest else { break };
-            let first = bvh2.nodes[open[slot]].first_index as usize;
-            open[slot] = first;
-            open.push(first + 1);
-        }
-        let me = self.nodes.len();
-        self.nodes.push(Node {
-            bounds: [
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
-                Vec4::INFINITY,
-                Vec4::NEG_INFINITY,
-            ],
-            children: [EMPTY; WIDTH],
-        });
-        for (slot, &child) in open.iter().enumerate() {
-            let reference = self.collapse(bvh2, child, vertices, level + 1, depth);
-            let aabb = bvh2.nodes[child].aabb;
-            let node = &mut self.nodes[me];
-            for axis in 0..3 {
-                node.bounds[2 * axis][slot] = aabb.min[axis];
-                node.bounds[2 * axis + 1][slot] = aabb.max[axis];
-            }
-            node.children[slot] = reference;
-        }
-        me as u32
-    }
-
-    /// Packs the triangles of binary leaf `index` into a block; returns its reference.
-    fn leaf_block(&mut self, bvh2: &Bvh2, index: usize, vertices: &[[Vec3A; 3]]) -> u32 {
-        let node = &bvh2.nodes[index];
-        let first = node.first_index as usize;
-        let ids = &bvh2.primitive_indices[first..first + node.prim_count as usize];
-        assert!(ids.len() <= WIDTH, "obvhs made a leaf larger than asked");
-        let mut block = TriangleBlock {
-            v0: [Vec4::ZERO; 3],
-            e1: [Vec4::ZERO; 3],
-            e2: [Vec4::ZERO; 3],
-            ng: [Vec4::ZERO; 3],
-            first: self.build_order.len() as u32,
-        };
-        for (lane, &id) in ids.iter().enumerate() {
-            let [v0, v1, v2] = vertices[id as usize];
-            let e1 = v0 - v1;
-            let e2 = v2 - v0;
-            let ng = e1.cross(e2);
-            for axis in 0..3 {
-                block.v0[axis][lane] = v0[axis];
-                block.e1[axis][lane] = e1[axis];
-                block.e2[axis][lane] = e2[axis];
-                block.ng[axis][lane] = ng[axis];
-            }
-            self.build_order.push(id);
-        }
-        self.blocks.push(block);
-        (self.blocks.len() - 1) as u32 | LEAF_BIT
     }
 
     pub fn internal_to_build_order(&self) -> &[u32] {
@@ -272,13 +401,68 @@ impl BvhAccel {
 
     /// Bytes of the structure: nodes, triangle blocks and the index map.
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * size_of::<Node>()
+        let nodes = match &self.nodes {
+            Nodes::Four(nodes) => nodes.len() * size_of::<Node4>(),
+            #[cfg(target_arch = "x86_64")]
+            Nodes::Eight(nodes) => nodes.len() * size_of::<avx2::Node8>(),
+        };
+        nodes
             + self.blocks.len() * size_of::<TriangleBlock>()
             + self.build_order.len() * size_of::<u32>()
     }
 
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        match &self.nodes {
+            Nodes::Four(nodes) => self.intersect4(nodes, ray),
+            // SAFETY: `Nodes::Eight` is only built on CPUs with AVX2 and FMA
+            // (`build_with_width`), which `intersect8` needs.
+            #[cfg(target_arch = "x86_64")]
+            Nodes::Eight(nodes) => unsafe { self.intersect8(nodes, ray) },
+        }
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        match &self.nodes {
+            Nodes::Four(nodes) => self.occluded4(nodes, ray),
+            // SAFETY: as in `intersect`.
+            #[cfg(target_arch = "x86_64")]
+            Nodes::Eight(nodes) => unsafe { self.occluded8(nodes, ray) },
+        }
+    }
+
+    /// Tests leaf block `reference` and narrows `tmax` to its closest hit in [tmin, tmax].
+    #[inline(always)]
+    fn intersect_leaf(
+        &self,
+        reference: u32,
+        origin: &[Vec4; 3],
+        direction: &[Vec4; 3],
+        tmin: f32,
+        tmax: &mut f32,
+        best: &mut Option<Hit>,
+    ) {
+        let block = &self.blocks[(reference & !LEAF_BIT) as usize];
+        let (t, u, v, hit) = intersect_block(block, origin, direction, tmin, *tmax);
+        let mut mask = hit.bitmask();
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            if t[lane] <= *tmax {
+                *tmax = t[lane];
+                *best = Some(Hit {
+                    triangle: block.first + lane as u32,
+                    t: t[lane],
+                    u: u[lane],
+                    v: v[lane],
+                });
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn intersect4(&self, nodes: &[Node4], ray: &Ray) -> Option<Hit> {
         if self.root == EMPTY {
             return None;
         }
@@ -291,7 +475,7 @@ impl BvhAccel {
         let mut current = self.root;
         loop {
             if current & LEAF_BIT == 0 {
-                let node = &self.nodes[current as usize];
+                let node = &nodes[current as usize];
                 let (t_near, mut mask) = box_ray.intersect(node, ray.tmin, tmax);
                 if mask != 0 {
                     // Go on with the nearest child; push the others, farthest first.
@@ -317,38 +501,17 @@ impl BvhAccel {
                     continue;
                 }
             } else {
-                let block = &self.blocks[(current & !LEAF_BIT) as usize];
-                let (t, u, v, hit) = intersect_block(block, &origin, &direction, ray.tmin, tmax);
-                let mut mask = hit.bitmask();
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    if t[lane] <= tmax {
-                        tmax = t[lane];
-                        best = Some(Hit {
-                            triangle: block.first + lane as u32,
-                            t: t[lane],
-                            u: u[lane],
-                            v: v[lane],
-                        });
-                    }
-                }
+                self.intersect_leaf(current, &origin, &direction, ray.tmin, &mut tmax, &mut best);
             }
-            // Next: the nearest pushed entry the ray can still reach.
-            loop {
-                let Some((reference, t_near)) = stack.pop() else {
-                    return best;
-                };
-                if t_near <= tmax {
-                    current = reference;
-                    break;
-                }
+            match stack.pop_within(tmax) {
+                Some(next) => current = next,
+                None => return best,
             }
         }
     }
 
-    #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
+    #[inline(always)]
+    fn occluded4(&self, nodes: &[Node4], ray: &Ray) -> bool {
         if self.root == EMPTY {
             return false;
         }
@@ -359,23 +522,233 @@ impl BvhAccel {
         stack.push(self.root);
         while let Some(current) = stack.pop() {
             if current & LEAF_BIT == 0 {
-                let node = &self.nodes[current as usize];
+                let node = &nodes[current as usize];
                 let (_, mut mask) = box_ray.intersect(node, ray.tmin, ray.tmax);
                 while mask != 0 {
                     let slot = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     stack.push(node.children[slot]);
                 }
-            } else {
-                let block = &self.blocks[(current & !LEAF_BIT) as usize];
-                let (_, _, _, hit) =
-                    intersect_block(block, &origin, &direction, ray.tmin, ray.tmax);
-                if hit.any() {
-                    return true;
-                }
+            } else if self.leaf_blocked(current, &origin, &direction, ray.tmin, ray.tmax) {
+                return true;
             }
         }
         false
+    }
+
+    /// Whether leaf block `reference` has a hit in [tmin, tmax].
+    #[inline(always)]
+    fn leaf_blocked(
+        &self,
+        reference: u32,
+        origin: &[Vec4; 3],
+        direction: &[Vec4; 3],
+        tmin: f32,
+        tmax: f32,
+    ) -> bool {
+        let block = &self.blocks[(reference & !LEAF_BIT) as usize];
+        intersect_block(block, origin, direction, tmin, tmax)
+            .3
+            .any()
+    }
+}
+
+/// The 8-wide tree, tested with AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::*;
+    use std::arch::x86_64::*;
+
+    /// Eight child boxes, as in `Node4`: `bounds[2 * axis]` their minima along the axis,
+    /// `bounds[2 * axis + 1]` their maxima; empty slots have min = +inf, max = -inf. Aligned
+    /// so each row is one 32-byte line.
+    #[repr(C, align(32))]
+    #[derive(Clone, Copy, Debug)]
+    pub(super) struct Node8 {
+        bounds: [[f32; 8]; 6],
+        children: [u32; 8],
+    }
+
+    impl WideNode for Node8 {
+        const WIDTH: usize = 8;
+
+        fn empty() -> Self {
+            let (min, max) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
+            Node8 {
+                bounds: [min, max, min, max, min, max],
+                children: [EMPTY; 8],
+            }
+        }
+
+        fn set_child(&mut self, slot: usize, aabb: &Aabb, reference: u32) {
+            for axis in 0..3 {
+                self.bounds[2 * axis][slot] = aabb.min[axis];
+                self.bounds[2 * axis + 1][slot] = aabb.max[axis];
+            }
+            self.children[slot] = reference;
+        }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn load(row: &[f32; 8]) -> __m256 {
+        // SAFETY: reads the eight floats `row` refers to (unaligned load, no alignment needed).
+        unsafe { _mm256_loadu_ps(row.as_ptr()) }
+    }
+
+    #[inline]
+    #[target_feature(enable = "avx2,fma")]
+    fn lanes(v: __m256) -> [f32; 8] {
+        // SAFETY: both are 32 bytes of eight f32, and every bit pattern is a valid f32.
+        unsafe { std::mem::transmute::<__m256, [f32; 8]>(v) }
+    }
+
+    /// `BoxRay` for eight boxes, with each slab computed as one fused bound · inv − origin · inv.
+    ///
+    /// For a zero direction component (inv = ±inf) the fused form gives the slab's ±inf only
+    /// when the bound and the origin have opposite signs, and NaN otherwise (inf − inf, or
+    /// 0 · inf). NaN slabs leave the interval unconstrained, as in `BoxRay`: such a ray is
+    /// culled by the other two axes only, never wrongly. A direction of all zeros would leave
+    /// empty slots unculled, so such rays are answered before the traversal.
+    struct BoxRay8 {
+        near: [usize; 3],
+        far: [usize; 3],
+        inv_direction: [__m256; 3],
+        origin_inv: [__m256; 3],
+    }
+
+    impl BoxRay8 {
+        #[inline]
+        #[target_feature(enable = "avx2,fma")]
+        fn new(ray: &Ray) -> Self {
+            let inv = Vec3A::ONE / ray.direction;
+            let origin_inv = ray.origin * inv;
+            // The sign bit, so -0 (inv = -inf) counts as negative.
+            let near = |axis: usize| 2 * axis + inv[axis].is_sign_negative() as usize;
+            BoxRay8 {
+                near: [near(0), near(1), near(2)],
+                far: [near(0) ^ 1, near(1) ^ 1, near(2) ^ 1],
+                inv_direction: inv.to_array().map(|v| _mm256_set1_ps(v)),
+                origin_inv: origin_inv.to_array().map(|v| _mm256_set1_ps(v)),
+            }
+        }
+
+        /// Entry distances of the eight children and which of them the ray enters in
+        /// [tmin, tmax]. The running value is the second operand of max/min, which vmaxps and
+        /// vminps return when the first is NaN.
+        #[inline]
+        #[target_feature(enable = "avx2,fma")]
+        fn intersect(&self, node: &Node8, tmin: __m256, tmax: __m256) -> (__m256, u32) {
+            let slab = |bound: usize, axis: usize| {
+                _mm256_fmsub_ps(
+                    load(&node.bounds[bound]),
+                    self.inv_direction[axis],
+                    self.origin_inv[axis],
+                )
+            };
+            let t_near = _mm256_max_ps(
+                slab(self.near[2], 2),
+                _mm256_max_ps(
+                    slab(self.near[1], 1),
+                    _mm256_max_ps(slab(self.near[0], 0), tmin),
+                ),
+            );
+            let t_far = _mm256_min_ps(
+                slab(self.far[2], 2),
+                _mm256_min_ps(
+                    slab(self.far[1], 1),
+                    _mm256_min_ps(slab(self.far[0], 0), tmax),
+                ),
+            );
+            let entered = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far);
+            (t_near, _mm256_movemask_ps(entered) as u32)
+        }
+    }
+
+    impl BvhAccel {
+        #[target_feature(enable = "avx2,fma")]
+        pub(super) fn intersect8(&self, nodes: &[Node8], ray: &Ray) -> Option<Hit> {
+            if self.root == EMPTY || ray.direction == Vec3A::ZERO {
+                return None;
+            }
+            let box_ray = BoxRay8::new(ray);
+            let tmin = _mm256_set1_ps(ray.tmin);
+            let origin = splat3(ray.origin);
+            let direction = splat3(ray.direction);
+            let mut tmax = ray.tmax;
+            let mut best: Option<Hit> = None;
+            let mut stack = TraversalStack::<(u32, f32)>::new();
+            let mut current = self.root;
+            loop {
+                if current & LEAF_BIT == 0 {
+                    let node = &nodes[current as usize];
+                    let (t_near, mut mask) = box_ray.intersect(node, tmin, _mm256_set1_ps(tmax));
+                    if mask != 0 {
+                        if mask & (mask - 1) == 0 {
+                            current = node.children[mask.trailing_zeros() as usize];
+                            continue;
+                        }
+                        // Go on with the nearest child; push the others, farthest first.
+                        let t_near = lanes(t_near);
+                        let mut hits = [(0u32, 0f32); 8];
+                        let mut count = 0;
+                        while mask != 0 {
+                            let slot = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            let entry = (node.children[slot], t_near[slot]);
+                            // Insertion sort, nearest last.
+                            let mut at = count;
+                            while at > 0 && hits[at - 1].1 < entry.1 {
+                                hits[at] = hits[at - 1];
+                                at -= 1;
+                            }
+                            hits[at] = entry;
+                            count += 1;
+                        }
+                        for &entry in &hits[..count - 1] {
+                            stack.push(entry);
+                        }
+                        current = hits[count - 1].0;
+                        continue;
+                    }
+                } else {
+                    self.intersect_leaf(
+                        current, &origin, &direction, ray.tmin, &mut tmax, &mut best,
+                    );
+                }
+                match stack.pop_within(tmax) {
+                    Some(next) => current = next,
+                    None => return best,
+                }
+            }
+        }
+
+        #[target_feature(enable = "avx2,fma")]
+        pub(super) fn occluded8(&self, nodes: &[Node8], ray: &Ray) -> bool {
+            if self.root == EMPTY || ray.direction == Vec3A::ZERO {
+                return false;
+            }
+            let box_ray = BoxRay8::new(ray);
+            let (tmin, tmax) = (_mm256_set1_ps(ray.tmin), _mm256_set1_ps(ray.tmax));
+            let origin = splat3(ray.origin);
+            let direction = splat3(ray.direction);
+            let mut stack = TraversalStack::<u32>::new();
+            stack.push(self.root);
+            while let Some(current) = stack.pop() {
+                if current & LEAF_BIT == 0 {
+                    let node = &nodes[current as usize];
+                    let (_, mut mask) = box_ray.intersect(node, tmin, tmax);
+                    while mask != 0 {
+                        let slot = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack.push(node.children[slot]);
+                    }
+                } else if self.leaf_blocked(current, &origin, &direction, ray.tmin, ray.tmax) {
+                    return true;
+                }
+            }
+            false
+        }
     }
 }
 
@@ -414,6 +787,19 @@ impl<T: Copy> TraversalStack<T> {
     }
 }
 
+impl TraversalStack<(u32, f32)> {
+    /// The nearest pushed reference whose entry distance the ray can still reach.
+    #[inline(always)]
+    fn pop_within(&mut self, tmax: f32) -> Option<u32> {
+        while let Some((reference, t_near)) = self.pop() {
+            if t_near <= tmax {
+                return Some(reference);
+            }
+        }
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -439,12 +825,39 @@ mod tests {
         (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= tmin && t <= tmax).then_some(t)
     }
 
+    /// The widths this CPU can build: both on x86-64 with AVX2 and FMA.
+    fn widths() -> Vec<BvhWidth> {
+        [BvhWidth::Four, BvhWidth::Eight]
+            .into_iter()
+            .filter(|w| w.is_supported())
+            .collect()
+    }
+
+    #[test]
+    fn builds_the_widest_supported_unless_forced() {
+        let tris = [[Vec3A::ZERO, Vec3A::X, Vec3A::Y]; 40];
+        assert_eq!(BvhAccel::build(&tris).unwrap().width(), BvhWidth::best());
+        let forced = with_bvh_width(BvhWidth::Four, || BvhAccel::build(&tris).unwrap());
+        assert_eq!(forced.width(), BvhWidth::Four);
+        assert_eq!(BvhAccel::build(&tris).unwrap().width(), BvhWidth::best());
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            assert_eq!(BvhWidth::best(), BvhWidth::Eight);
+        }
+    }
+
     /// The BVH must return what testing every triangle returns, for scenes of every size
-    /// (a lone leaf as root, partly filled nodes and blocks, deep trees).
+    /// (a lone leaf as root, partly filled nodes and blocks, deep trees), at every width.
     #[test]
     fn matches_brute_force() {
+        for width in widths() {
+            matches_brute_force_at(width);
+        }
+    }
+
+    fn matches_brute_force_at(width: BvhWidth) {
         let mut rng = Rng::new(5, 5);
-        for count in [1, 3, 5, 17, 500, 5000] {
+        for count in [1, 3, 5, 9, 17, 40, 500, 5000] {
             let tris: Vec<[Vec3A; 3]> = (0..count)
                 .map(|_| {
                     let c = random_point(&mut rng);
@@ -455,7 +868,8 @@ mod tests {
                     ]
                 })
                 .collect();
-            let accel = BvhAccel::build(&tris).unwrap();
+            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            assert_eq!(accel.width(), width);
             let mut sorted = accel.build_order.clone();
             sorted.sort_unstable();
             assert_eq!(sorted, (0..count as u32).collect::<Vec<_>>());
@@ -483,7 +897,7 @@ mod tests {
                         let p = a * (1.0 - h.u - h.v) + b * h.u + c * h.v;
                         assert!((p - (o + d * h.t)).length() < 1e-3);
                     }
-                    other => panic!("{count} triangles: mismatch {other:?}"),
+                    other => panic!("{width:?}, {count} triangles: mismatch {other:?}"),
                 }
                 assert_eq!(accel.occluded(&ray), best.is_some());
                 // A segment that ends before the closest hit is not blocked by it.
@@ -497,12 +911,13 @@ mod tests {
                 }
             }
             if count >= 500 {
-                assert!(hits > 1000, "{count} triangles: {hits} hits");
+                assert!(hits > 1000, "{width:?}, {count} triangles: {hits} hits");
             }
         }
     }
 
-    /// Rays along the axes (zero direction components) from origins on box planes.
+    /// Rays along the axes (zero direction components) from origins on box planes, at every
+    /// width; and rays with no direction at all, which hit nothing.
     #[test]
     fn axis_aligned_rays_from_box_planes() {
         let square = |z: f32| {
@@ -519,15 +934,32 @@ mod tests {
                 ],
             ]
         };
-        let tris: Vec<[Vec3A; 3]> = (0..8).flat_map(|i| square(i as f32)).collect();
-        let accel = BvhAccel::build(&tris).unwrap();
-        // From x = 0 and y = 0 (the boxes' own planes), straight along +z.
-        let ray = Ray::new(Vec3A::new(0.0, 0.25, -1.0), Vec3A::Z, 0.0, f32::INFINITY);
-        let hit = accel.intersect(&ray).expect("the first square");
-        assert_eq!(hit.t, 1.0);
-        let ray = Ray::new(Vec3A::new(0.5, 0.0, 2.5), -Vec3A::Z, 0.0, f32::INFINITY);
-        assert_eq!(accel.intersect(&ray).map(|h| h.t), Some(0.5));
-        let ray = Ray::new(Vec3A::new(0.5, 0.5, 2.5), -Vec3A::Z, 0.0, 0.4);
-        assert!(!accel.occluded(&ray));
+        // 8 squares: one 8-wide node over leaves; 40: two levels, partly filled.
+        for squares in [8, 40] {
+            let tris: Vec<[Vec3A; 3]> = (0..squares).flat_map(|i| square(i as f32)).collect();
+            for width in widths() {
+                let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+                // From x = 0 and y = 0 (the boxes' own planes), straight along +z.
+                let ray = Ray::new(Vec3A::new(0.0, 0.25, -1.0), Vec3A::Z, 0.0, f32::INFINITY);
+                let hit = accel.intersect(&ray).expect("the first square");
+                assert_eq!(hit.t, 1.0, "{width:?}");
+                let ray = Ray::new(Vec3A::new(0.5, 0.0, 2.5), -Vec3A::Z, 0.0, f32::INFINITY);
+                assert_eq!(accel.intersect(&ray).map(|h| h.t), Some(0.5), "{width:?}");
+                // From the far corner's planes (x = 1, y = 1), along -z.
+                let far_corner = Vec3A::new(1.0, 1.0, squares as f32 + 0.5);
+                let ray = Ray::new(far_corner, -Vec3A::Z, 0.0, f32::INFINITY);
+                assert_eq!(accel.intersect(&ray).map(|h| h.t), Some(1.5), "{width:?}");
+                let ray = Ray::new(Vec3A::new(0.5, 0.5, 2.5), -Vec3A::Z, 0.0, 0.4);
+                assert!(!accel.occluded(&ray), "{width:?}");
+                let ray = Ray::new(Vec3A::new(0.5, 0.5, 2.5), -Vec3A::Z, 0.0, 0.5);
+                assert!(accel.occluded(&ray), "{width:?}");
+                // Along x and y inside the squares' planes: grazing, so no hit.
+                let ray = Ray::new(Vec3A::new(-1.0, 0.5, 3.0), Vec3A::X, 0.0, f32::INFINITY);
+                assert_eq!(accel.intersect(&ray), None, "{width:?}");
+                let ray = Ray::new(Vec3A::new(0.5, 0.5, 3.0), Vec3A::ZERO, 0.0, f32::INFINITY);
+                assert_eq!(accel.intersect(&ray), None, "{width:?}");
+                assert!(!accel.occluded(&ray), "{width:?}");
+            }
+        }
     }
 }

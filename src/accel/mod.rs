@@ -18,6 +18,8 @@ mod bvh;
 pub mod embree;
 
 pub use bvh::BvhAccel;
+#[doc(hidden)]
+pub use bvh::{BvhWidth, with_bvh_width};
 #[cfg(feature = "embree")]
 pub use embree::EmbreeAccel;
 
