@@ -1,7 +1,7 @@
 //! Traversal: rays per second of the ray-query backends through mlt's own query layer
 //! (`mlt::accel::Accel`), next to the raw libraries, plus build time and memory.
 //!
-//! `cargo bench --bench traversal` measures the default backend (the obvhs CWBVH) and raw
+//! `cargo bench --bench traversal` measures the default backend (mlt's own BVH) and raw
 //! obvhs; `cargo bench --bench traversal --features embree` adds Embree 3 through `Accel`
 //! and raw Embree. It prints two tables and writes a bar chart of the ray rates, one panel
 //! per scene and thread count, to `target/mlt-bench/traversal.png`. Numbers are reported,

@@ -49,7 +49,8 @@
 #define MLT_MATERIAL_DIELECTRIC 2
 
 /**
- * `MltSceneDesc.backend`: mlt's own 4-wide BVH (built with obvhs), always available.
+ * `MltSceneDesc.backend`: mlt's own SIMD BVH (8-wide with AVX2, else 4-wide; built with
+ * obvhs), always available.
  */
 #define MLT_BACKEND_BVH 0
 

@@ -29,7 +29,8 @@ pub const MLT_MATERIAL_MIRROR: i32 = 1;
 /// `MltMaterial.kind`: smooth dielectric (glass) with index of refraction `ior`, tinted by `color`.
 pub const MLT_MATERIAL_DIELECTRIC: i32 = 2;
 
-/// `MltSceneDesc.backend`: mlt's own 4-wide BVH (built with obvhs), always available.
+/// `MltSceneDesc.backend`: mlt's own SIMD BVH (8-wide with AVX2, else 4-wide; built with
+/// obvhs), always available.
 pub const MLT_BACKEND_BVH: i32 = 0;
 /// `MltSceneDesc.backend`: Intel Embree 3, only when mlt was built with the `embree` feature.
 pub const MLT_BACKEND_EMBREE: i32 = 1;
