@@ -1,8 +1,9 @@
 //! The default backend: a wide BVH whose triangles are packed four to a leaf block, nodes and
 //! blocks both in structure-of-arrays layout, so one vector instruction tests a ray against
 //! several boxes or four triangles. obvhs builds the binary tree (PLOC with reinsertion and
-//! leaf collapsing); we collapse it to a wide tree and traverse it ourselves, nearest child
-//! first. A leaf is one block, or two consecutive ones in the 8-wide tree.
+//! leaf collapsing); we collapse it to a wide tree, choosing each wide node's children by the
+//! surface area heuristic (a dynamic programme over the binary tree), and traverse it
+//! ourselves, nearest child first. A leaf is one block, or two consecutive ones in the 8-wide tree.
 //!
 //! The width is picked at build time from the CPU: on x86-64 with AVX2 and FMA, eight children
 //! per node, whose boxes are tested with one AVX instruction per slab (`mod avx2`); elsewhere
@@ -239,13 +240,92 @@ pub struct BvhAccel {
 /// The state of the collapse from the binary tree.
 struct Builder<'a> {
     bvh2: &'a Bvh2,
+    /// Per binary node, `plan_slots`'s answer for 1..=width slots.
+    plans: Vec<[SlotPlan; 8]>,
     vertices: &'a [[Vec3A; 3]],
     blocks: Vec<TriangleBlock>,
     block_first: Vec<u32>,
     build_order: Vec<u32>,
 }
 
+/// How a binary subtree fills at most i slots of a wide node, at the least surface area
+/// heuristic cost: as one slot (a leaf, or a wide node of its own: `split` 0), or split
+/// between its children, `split` slots to the left one and the rest to the right one.
+#[derive(Clone, Copy, Debug, Default)]
+struct SlotPlan {
+    cost: f32,
+    split: u8,
+}
+
+/// SAH cost of a wide node's box test, relative to a block's triangle test. (Every binary
+/// leaf becomes one leaf of the wide tree, so only the node cost steers the plan.)
+const NODE_COST: f32 = 1.0;
+const BLOCK_COST: f32 = 1.0;
+
 impl Builder<'_> {
+    /// Fills `plans` for the subtree of binary node `index` (Ylitie et al. 2017's dynamic
+    /// programme for wide BVHs, with the binary leaves kept as they are).
+    fn plan_slots(&mut self, index: usize, width: usize) {
+        let node = &self.bvh2.nodes[index];
+        let area = node.aabb.half_area();
+        if node.prim_count > 0 {
+            let blocks = (node.prim_count as usize).div_ceil(WIDTH) as f32;
+            self.plans[index] = [SlotPlan {
+                cost: area * BLOCK_COST * blocks,
+                split: 0,
+            }; 8];
+            return;
+        }
+        let (left, right) = (node.first_index as usize, node.first_index as usize + 1);
+        self.plan_slots(left, width);
+        self.plan_slots(right, width);
+        // The best split of i slots between the children, for i = 2..=width.
+        let mut split_plans = [SlotPlan {
+            cost: f32::INFINITY,
+            split: 0,
+        }; 8];
+        for slots in 2..=width {
+            for to_left in 1..slots {
+                let cost = self.plans[left][to_left - 1].cost
+                    + self.plans[right][slots - to_left - 1].cost;
+                if cost < split_plans[slots - 1].cost {
+                    split_plans[slots - 1] = SlotPlan {
+                        cost,
+                        split: to_left as u8,
+                    };
+                }
+            }
+        }
+        let whole = SlotPlan {
+            cost: area * NODE_COST + split_plans[width - 1].cost,
+            split: 0,
+        };
+        let plans = &mut self.plans[index];
+        plans[0] = whole;
+        for slots in 2..=width {
+            let split = split_plans[slots - 1];
+            // Ties split: at the full width the split always wins (whole adds a node), so a
+            // wide node always has a split to follow, even over boxes of zero area.
+            plans[slots - 1] = if split.cost <= whole.cost {
+                split
+            } else {
+                whole
+            };
+        }
+    }
+
+    /// Appends the binary nodes that fill `slots` slots for the subtree of `index`.
+    fn gather(&self, index: usize, slots: usize, out: &mut Vec<usize>) {
+        let plan = self.plans[index][slots - 1];
+        if plan.split == 0 {
+            out.push(index);
+        } else {
+            let left = self.bvh2.nodes[index].first_index as usize;
+            self.gather(left, plan.split as usize, out);
+            self.gather(left + 1, slots - plan.split as usize, out);
+        }
+    }
+
     /// The wide subtree of binary node `index`, appended to `nodes`: its reference, and the
     /// traversal stack entries a closest-hit query in it needs at most.
     fn collapse<N: WideNode>(&mut self, nodes: &mut Vec<N>, index: usize) -> (u32, usize) {
@@ -254,24 +334,9 @@ impl Builder<'_> {
         if node.prim_count > 0 {
             return (self.leaf_block(index), 0);
         }
-        // Open the binary children with the largest surface area until there are N::WIDTH.
         let mut open = Vec::with_capacity(N::WIDTH);
-        open.extend([node.first_index as usize, node.first_index as usize + 1]);
-        while open.len() < N::WIDTH {
-            let widest = open
-                .iter()
-                .enumerate()
-                .filter(|&(_, &i)| bvh2.nodes[i].prim_count == 0)
-                .max_by(|&(_, &a), &(_, &b)| {
-                    let area = |i: usize| bvh2.nodes[i].aabb.half_area();
-                    area(a).total_cmp(&area(b))
-                })
-                .map(|(slot, _)| slot);
-            let Some(slot) = widest else { break };
-            let first = bvh2.nodes[open[slot]].first_index as usize;
-            open[slot] = first;
-            open.push(first + 1);
-        }
+        // The children the cost-based plan gives this wide node.
+        self.gather(index, N::WIDTH, &mut open);
         let me = nodes.len();
         nodes.push(N::empty());
         let mut deepest_need = 0;
@@ -378,6 +443,7 @@ impl BvhAccel {
         let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
         let mut builder = Builder {
             bvh2: &bvh2,
+            plans: vec![[SlotPlan::default(); 8]; bvh2.nodes.len()],
             vertices,
             blocks: Vec::new(),
             block_first: Vec::new(),
@@ -386,12 +452,14 @@ impl BvhAccel {
         let (nodes, (root, stack_need)) = match width {
             BvhWidth::Four => {
                 let mut nodes = Vec::new();
+                builder.plan_slots(0, 4);
                 let root = builder.collapse(&mut nodes, 0);
                 (Nodes::Four(nodes), root)
             }
             #[cfg(target_arch = "x86_64")]
             BvhWidth::Eight => {
                 let mut nodes = Vec::new();
+                builder.plan_slots(0, 8);
                 let root = builder.collapse(&mut nodes, 0);
                 (Nodes::Eight(nodes), root)
             }
