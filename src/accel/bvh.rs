@@ -587,28 +587,9 @@ impl BvhAccel {
         loop {
             if current & LEAF_BIT == 0 {
                 let node = &nodes[current as usize];
-                let (t_near, mut mask) = box_ray.intersect(node, ray.tmin, tmax);
+                let (t_near, mask) = box_ray.intersect(node, ray.tmin, tmax);
                 if mask != 0 {
-                    // Go on with the nearest child; push the others, farthest first.
-                    let mut hits = [(0u32, 0f32); WIDTH];
-                    let mut count = 0;
-                    while mask != 0 {
-                        let slot = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        let entry = (node.children[slot], t_near[slot]);
-                        // Insertion sort, nearest last.
-                        let mut at = count;
-                        while at > 0 && hits[at - 1].1 < entry.1 {
-                            hits[at] = hits[at - 1];
-                            at -= 1;
-                        }
-                        hits[at] = entry;
-                        count += 1;
-                    }
-                    for &entry in &hits[..count - 1] {
-                        stack.push(entry);
-                    }
-                    current = hits[count - 1].0;
+                    current = stack.descend(mask, &node.children, &t_near.to_array());
                     continue;
                 }
             } else {
@@ -801,33 +782,9 @@ mod avx2 {
             loop {
                 if current & LEAF_BIT == 0 {
                     let node = &nodes[current as usize];
-                    let (t_near, mut mask) = box_ray.intersect(node, tmin, _mm256_set1_ps(tmax));
+                    let (t_near, mask) = box_ray.intersect(node, tmin, _mm256_set1_ps(tmax));
                     if mask != 0 {
-                        if mask & (mask - 1) == 0 {
-                            current = node.children[mask.trailing_zeros() as usize];
-                            continue;
-                        }
-                        // Go on with the nearest child; push the others, farthest first.
-                        let t_near = lanes(t_near);
-                        let mut hits = [(0u32, 0f32); 8];
-                        let mut count = 0;
-                        while mask != 0 {
-                            let slot = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            let entry = (node.children[slot], t_near[slot]);
-                            // Insertion sort, nearest last.
-                            let mut at = count;
-                            while at > 0 && hits[at - 1].1 < entry.1 {
-                                hits[at] = hits[at - 1];
-                                at -= 1;
-                            }
-                            hits[at] = entry;
-                            count += 1;
-                        }
-                        for &entry in &hits[..count - 1] {
-                            stack.push(entry);
-                        }
-                        current = hits[count - 1].0;
+                        current = stack.descend(mask, &node.children, &lanes(t_near));
                         continue;
                     }
                 } else {
@@ -907,6 +864,40 @@ impl<T: Copy> TraversalStack<T> {
 }
 
 impl TraversalStack<(u32, f32)> {
+    /// The children of a node that `mask` says the ray enters (at least one): returns the
+    /// nearest to go on with and pushes the others, farthest first, with their entry
+    /// distances.
+    #[inline(always)]
+    fn descend<const N: usize>(
+        &mut self,
+        mut mask: u32,
+        children: &[u32; N],
+        t_near: &[f32; N],
+    ) -> u32 {
+        if mask & (mask - 1) == 0 {
+            return children[mask.trailing_zeros() as usize];
+        }
+        let mut hits = [(0u32, 0f32); N];
+        let mut count = 0;
+        while mask != 0 {
+            let slot = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let entry = (children[slot], t_near[slot]);
+            // Insertion sort, nearest last.
+            let mut at = count;
+            while at > 0 && hits[at - 1].1 < entry.1 {
+                hits[at] = hits[at - 1];
+                at -= 1;
+            }
+            hits[at] = entry;
+            count += 1;
+        }
+        for &entry in &hits[..count - 1] {
+            self.push(entry);
+        }
+        hits[count - 1].0
+    }
+
     /// The nearest pushed reference whose entry distance the ray can still reach.
     #[inline(always)]
     fn pop_within(&mut self, tmax: f32) -> Option<u32> {
