@@ -18,6 +18,13 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// The top 24 bits of `bits` as a float in [0, 1): exactly representable, so 1.0 is never
+/// returned.
+#[inline]
+pub fn unit_float(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
 impl Rng {
     /// A generator for `stream` of `seed`: distinct streams are statistically independent.
     #[inline]
@@ -57,7 +64,7 @@ impl Rng {
     /// Uniform in [0, 1): 24 random mantissa bits, so 1.0 is never returned.
     #[inline]
     pub fn uniform(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+        unit_float(self.next_u32())
     }
 
     #[inline]

@@ -5,6 +5,8 @@
 //! N^(-1/2). The shift, random per pixel, keeps each point uniform on its own, so estimates
 //! stay unbiased.
 
+use super::rng::unit_float;
+
 /// Point `index` of the shifted sequence in [0, 1)²; `shift` is a pair of random words.
 #[inline]
 pub fn shifted_sobol_2d(index: u32, shift: [u32; 2]) -> [f32; 2] {
@@ -21,13 +23,7 @@ pub fn shifted_sobol_2d(index: u32, shift: [u32; 2]) -> [f32; 2] {
         column ^= column >> 1;
         bits >>= 1;
     }
-    [to_unit(first ^ shift[0]), to_unit(second ^ shift[1])]
-}
-
-/// The top 24 bits as a float in [0, 1) (never 1.0).
-#[inline]
-fn to_unit(bits: u32) -> f32 {
-    (bits >> 8) as f32 * (1.0 / 16_777_216.0)
+    [unit_float(first ^ shift[0]), unit_float(second ^ shift[1])]
 }
 
 #[cfg(test)]
