@@ -158,11 +158,10 @@ impl BoxRay {
     #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let inv = Vec3A::ONE / ray.direction;
-        // The sign bit, so -0 (inv = -inf) counts as negative.
-        let near = |axis: usize| 2 * axis + inv[axis].is_sign_negative() as usize;
+        let (near, far) = near_and_far_bounds(inv);
         BoxRay {
-            near: [near(0), near(1), near(2)],
-            far: [near(0) ^ 1, near(1) ^ 1, near(2) ^ 1],
+            near,
+            far,
             origin: splat3(ray.origin),
             inv_direction: splat3(inv),
         }
@@ -180,6 +179,18 @@ impl BoxRay {
             .min(slab(self.far[1], 1).min(slab(self.far[0], 0).min(Vec4::splat(tmax))));
         (t_near, t_near.cmple(t_far).bitmask())
     }
+}
+
+/// For a ray with reciprocal direction `inv`, the rows of a node's bounds (`2 * axis` minima,
+/// `2 * axis + 1` maxima) it meets first and last on each axis.
+#[inline(always)]
+fn near_and_far_bounds(inv: Vec3A) -> ([usize; 3], [usize; 3]) {
+    // The sign bit, so -0 (inv = -inf) counts as negative.
+    let near = |axis: usize| 2 * axis + inv[axis].is_sign_negative() as usize;
+    (
+        [near(0), near(1), near(2)],
+        [near(0) ^ 1, near(1) ^ 1, near(2) ^ 1],
+    )
 }
 
 /// The ray against four triangles: (t, u, v) per lane and the lanes hit within [tmin, tmax].
@@ -723,11 +734,10 @@ mod avx2 {
         fn new(ray: &Ray) -> Self {
             let inv = Vec3A::ONE / ray.direction;
             let origin_inv = ray.origin * inv;
-            // The sign bit, so -0 (inv = -inf) counts as negative.
-            let near = |axis: usize| 2 * axis + inv[axis].is_sign_negative() as usize;
+            let (near, far) = near_and_far_bounds(inv);
             BoxRay8 {
-                near: [near(0), near(1), near(2)],
-                far: [near(0) ^ 1, near(1) ^ 1, near(2) ^ 1],
+                near,
+                far,
                 inv_direction: inv.to_array().map(|v| _mm256_set1_ps(v)),
                 origin_inv: origin_inv.to_array().map(|v| _mm256_set1_ps(v)),
             }
