@@ -33,9 +33,9 @@
 //! warm-up, in alternating order); the ratios (mlt's layer
 //! against its raw library, and the BVH against Embree) are medians of the ratios within each
 //! run. The build table gives the median `Accel::build` time and `Accel::memory_bytes` (BVH:
-//! nodes, triangles and index arrays from their lengths; Embree: what its memory monitor
-//! counted, vertex and index buffers included). obvhs builds on one thread (mlt does not
-//! enable its `parallel` feature); Embree builds on every core.
+//! the allocations of its nodes, triangles and index arrays; Embree: what its memory monitor
+//! counted, vertex and index buffers included). Both build on every core: obvhs through
+//! rayon (its `parallel` feature), Embree through TBB.
 //!
 //! Environment:
 //! - `MLT_BENCH_RAYS`: rays of each kind (default 262144).

@@ -95,7 +95,7 @@ pub fn with_bvh_width<R>(width: BvhWidth, f: impl FnOnce() -> R) -> R {
 /// their maxima. Empty slots have min = +inf, max = -inf. Aligned to cache lines, for
 /// `BvhAccel::prefetch`.
 #[repr(align(64))]
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Node4 {
     bounds: [Vec4; 6],
     children: [u32; WIDTH],
@@ -133,7 +133,7 @@ impl WideNode for Node4 {
 /// e2 = v2 - v0 and ng = e1 × e2, each as x, y, z lanes. Exactly three cache lines: the
 /// triangles' numbers are kept apart (`BvhAccel::block_first`), since only hits need them.
 #[repr(align(64))]
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct TriangleBlock {
     v0: [Vec4; 3],
     e1: [Vec4; 3],
@@ -283,6 +283,7 @@ fn splat3(v: Vec3A) -> [Vec4; 3] {
     [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
 }
 
+#[derive(PartialEq)]
 enum Nodes {
     Four(Vec<Node4>),
     /// Only built on CPUs with AVX2 and FMA.
@@ -492,7 +493,8 @@ impl BvhAccel {
         // Reinsertion over every node (ratio 1 instead of the preset's 0.05) makes the tree
         // fit cluttered scenes far better: on the traversal bench's 70k-triangle room, 3.0x
         // the camera-ray rate and 2.4x on bounce and random rays, for 7x the build time
-        // (0.03 -> 0.22 s; the 1.2M-triangle terrain: 0.55 -> 3.8 s, single-threaded).
+        // (0.03 -> 0.22 s; the 1.2M-triangle terrain: 0.55 -> 3.8 s, single-threaded; obvhs
+        // now builds on rayon's threads, 2 cores halve it).
         // The 8-wide tree takes leaves of up to two blocks: on the terrain, 30% fewer nodes
         // (they average only ~4.3 children: the bottom nodes hold few leaves) and ~7% more
         // random rays per second; the room is unchanged.
@@ -761,7 +763,7 @@ mod avx2 {
     /// `bounds[2 * axis + 1]` their maxima; empty slots have min = +inf, max = -inf. Aligned
     /// to cache lines (for `BvhAccel::prefetch`), so each row is one aligned 32-byte load.
     #[repr(C, align(64))]
-    #[derive(Clone, Copy, Debug)]
+    #[derive(Clone, Copy, Debug, PartialEq)]
     pub(super) struct Node8 {
         bounds: [[f32; 8]; 6],
         children: [u32; 8],
@@ -1070,6 +1072,46 @@ mod tests {
             .into_iter()
             .filter(|w| w.is_supported())
             .collect()
+    }
+
+    /// obvhs builds in parallel (rayon); the tree, and so which of two equally near
+    /// triangles a ray reports, must not depend on the threads. (150k triangles: obvhs
+    /// switches to its parallel Morton sort above 100k.)
+    #[test]
+    fn builds_the_same_tree_on_any_thread_count() {
+        let mut rng = Rng::new(5, 0);
+        let triangles: Vec<[Vec3A; 3]> = (0..150_000)
+            .map(|_| {
+                let p = random_point(&mut rng);
+                [0; 3].map(|_| p + (random_point(&mut rng) * 0.02))
+            })
+            .collect();
+        for width in widths() {
+            let build_on = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| BvhAccel::build_with_width(&triangles, width).unwrap())
+            };
+            let one = build_on(1);
+            for threads in [2, 3, 8] {
+                let many = build_on(threads);
+                assert!(
+                    one.nodes == many.nodes,
+                    "{width:?}, {threads} threads: nodes"
+                );
+                assert!(
+                    one.blocks == many.blocks,
+                    "{width:?}, {threads} threads: blocks"
+                );
+                assert_eq!(
+                    one.build_order, many.build_order,
+                    "{width:?}, {threads} threads"
+                );
+                assert_eq!(one.root, many.root);
+            }
+        }
     }
 
     #[test]
