@@ -91,6 +91,14 @@
 #define MLT_ALGORITHM_PSSMLT_BDPT 4
 
 /**
+ * `MltRenderSettings.algorithm`: path-space Metropolis light transport (Veach & Guibas
+ * 1997): the chains' states are light paths, changed by Veach's mutations; seeded and
+ * normalized by a bidirectional bootstrap. Uses `mutations_per_pixel`, `bootstrap_samples`
+ * and `chains`.
+ */
+#define MLT_ALGORITHM_PATH_SPACE_MLT 5
+
+/**
  * `MltHit.triangle_id` of a ray that hit nothing.
  */
 #define MLT_INVALID_ID UINT32_MAX

@@ -51,6 +51,11 @@ pub const MLT_ALGORITHM_MMLT: i32 = 3;
 /// `MltRenderSettings.algorithm`: primary-sample-space MLT over bidirectional path tracing,
 /// all strategies of a sample summed.
 pub const MLT_ALGORITHM_PSSMLT_BDPT: i32 = 4;
+/// `MltRenderSettings.algorithm`: path-space Metropolis light transport (Veach & Guibas
+/// 1997): the chains' states are light paths, changed by Veach's mutations; seeded and
+/// normalized by a bidirectional bootstrap. Uses `mutations_per_pixel`, `bootstrap_samples`
+/// and `chains`.
+pub const MLT_ALGORITHM_PATH_SPACE_MLT: i32 = 5;
 
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
@@ -386,6 +391,7 @@ fn algorithm_to_c(algorithm: Algorithm) -> i32 {
         Algorithm::Pssmlt => MLT_ALGORITHM_PSSMLT,
         Algorithm::Mmlt => MLT_ALGORITHM_MMLT,
         Algorithm::PssmltBdpt => MLT_ALGORITHM_PSSMLT_BDPT,
+        Algorithm::PathSpaceMlt => MLT_ALGORITHM_PATH_SPACE_MLT,
     }
 }
 
@@ -396,9 +402,10 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         MLT_ALGORITHM_PSSMLT => Algorithm::Pssmlt,
         MLT_ALGORITHM_MMLT => Algorithm::Mmlt,
         MLT_ALGORITHM_PSSMLT_BDPT => Algorithm::PssmltBdpt,
+        MLT_ALGORITHM_PATH_SPACE_MLT => Algorithm::PathSpaceMlt,
         other => {
             return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3) or MLT_ALGORITHM_PSSMLT_BDPT (4)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4) or MLT_ALGORITHM_PATH_SPACE_MLT (5)"
             )));
         }
     };

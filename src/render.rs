@@ -4,6 +4,7 @@
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
+use crate::integrators::mlt::path_space::{self, PathSpaceTarget};
 use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
@@ -33,6 +34,9 @@ pub enum Algorithm {
     Mmlt,
     /// Primary-sample-space MLT over BDPT, all strategies of a sample summed.
     PssmltBdpt,
+    /// Path-space MLT (Veach & Guibas 1997): the chains' states are light paths, changed by
+    /// Veach's mutations.
+    PathSpaceMlt,
 }
 
 impl Algorithm {
@@ -40,7 +44,7 @@ impl Algorithm {
     pub fn is_metropolis(self) -> bool {
         matches!(
             self,
-            Algorithm::Pssmlt | Algorithm::Mmlt | Algorithm::PssmltBdpt
+            Algorithm::Pssmlt | Algorithm::Mmlt | Algorithm::PssmltBdpt | Algorithm::PathSpaceMlt
         )
     }
 }
@@ -52,6 +56,7 @@ enum Estimator<'a> {
     Pssmlt(&'a PathTracer<'a>),
     Mmlt(&'a BdptMultiplexed<'a>),
     PssmltBdpt(&'a BdptAllStrategies<'a>),
+    PathSpaceMlt(&'a Bdpt<'a>),
 }
 
 /// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
@@ -111,6 +116,17 @@ impl Estimator<'_> {
             }
             Estimator::PssmltBdpt(target) => {
                 pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::PathSpaceMlt(bdpt) => {
+                let target = PathSpaceTarget {
+                    bdpt: BdptAllStrategies(Bdpt {
+                        scene: bdpt.scene,
+                        max_depth: bdpt.max_depth,
+                        min_depth: bdpt.min_depth,
+                    }),
+                    camera: *camera,
+                };
+                path_space::run(&target, &chains, film, control, &mut keep_pace)
             }
         }
     }
@@ -417,6 +433,7 @@ pub fn render(
             all_strategies = BdptAllStrategies(bdpt);
             Estimator::PssmltBdpt(&all_strategies)
         }
+        Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
     };
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit

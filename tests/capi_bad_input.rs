@@ -1125,7 +1125,7 @@ fn zero_samples_without_time_limit() {
 #[test]
 fn unknown_algorithm() {
     let scene = HostScene::floor_and_light().create();
-    for bad in [5, -1, i32::MAX] {
+    for bad in [6, -1, i32::MAX] {
         let s = MltRenderSettings {
             algorithm: bad,
             ..small_settings(4, 4, 1)
@@ -1230,6 +1230,7 @@ fn metropolis_settings_out_of_range() {
         MLT_ALGORITHM_PSSMLT,
         MLT_ALGORITHM_MMLT,
         MLT_ALGORITHM_PSSMLT_BDPT,
+        MLT_ALGORITHM_PATH_SPACE_MLT,
     ] {
         let settings = MltRenderSettings {
             algorithm,

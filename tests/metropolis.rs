@@ -1,5 +1,5 @@
-//! The Metropolis algorithms (PSSMLT over the path tracer, PSSMLT over BDPT, multiplexed MLT)
-//! against ground truth and the path tracer: the white furnace, the Cornell scenes (image
+//! The Metropolis algorithms (PSSMLT over the path tracer, PSSMLT over BDPT, multiplexed MLT,
+//! path-space MLT) against ground truth and the path tracer: the white furnace, the Cornell scenes (image
 //! mean and per-region means within 4 combined standard errors estimated from independent
 //! renders; a 2% bias resolvable), identical images for any thread count, and a stopped
 //! render normalized by the mutations actually made.
@@ -79,9 +79,17 @@ fn furnace_matches_the_geometric_series(variant: Variant) {
     let scene = furnace_scene(albedo, emission);
     let renders: Vec<Vec<f32>> = (0..8)
         .map(|seed| {
+            // Path-space chains change a path's length only through bidirectional
+            // mutations (no independent large steps), so without the direct pass they need
+            // more mutations to share their time between depths as finely.
+            let mutations = if variant.algorithm == Algorithm::PathSpaceMlt {
+                128
+            } else {
+                32
+            };
             let settings = RenderSettings {
                 max_depth: 3,
-                ..metropolis_settings(variant, 32, 32, seed)
+                ..metropolis_settings(variant, 32, mutations, seed)
             };
             render_image(&scene, &furnace_camera(), &settings)
         })
@@ -218,6 +226,12 @@ metropolis_tests!(pssmlt_bdpt, Algorithm::PssmltBdpt, DIRECT);
 metropolis_tests!(pssmlt_bdpt_without_direct_pass, Algorithm::PssmltBdpt, 0);
 metropolis_tests!(mmlt, Algorithm::Mmlt, DIRECT);
 metropolis_tests!(mmlt_without_direct_pass, Algorithm::Mmlt, 0);
+metropolis_tests!(path_space_mlt, Algorithm::PathSpaceMlt, DIRECT);
+metropolis_tests!(
+    path_space_mlt_without_direct_pass,
+    Algorithm::PathSpaceMlt,
+    0
+);
 
 /// The acceptance criterion for the defaults: with `RenderSettings::default()` (the
 /// default algorithm, bootstrap, chains and mutations), the cornell-box image's per-channel

@@ -22,6 +22,8 @@ enum AlgorithmArg {
     Mmlt,
     /// Primary-sample-space MLT over BDPT, all strategies of a sample summed.
     PssmltBdpt,
+    /// Path-space MLT (Veach): chains over light paths, changed by Veach's mutations.
+    PathSpaceMlt,
 }
 
 // The kernel's `Algorithm` has no clap dependency; exhaustive matches keep the two in step.
@@ -33,6 +35,7 @@ impl From<AlgorithmArg> for mlt::Algorithm {
             AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
             AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
             AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
+            AlgorithmArg::PathSpaceMlt => mlt::Algorithm::PathSpaceMlt,
         }
     }
 }
@@ -45,6 +48,7 @@ impl From<mlt::Algorithm> for AlgorithmArg {
             mlt::Algorithm::Pssmlt => AlgorithmArg::Pssmlt,
             mlt::Algorithm::Mmlt => AlgorithmArg::Mmlt,
             mlt::Algorithm::PssmltBdpt => AlgorithmArg::PssmltBdpt,
+            mlt::Algorithm::PathSpaceMlt => AlgorithmArg::PathSpaceMlt,
         }
     }
 }

@@ -54,16 +54,60 @@ pub(super) fn sample(
     let sin_t2 = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
     let cos_t = (1.0 - sin_t2).max(0.0).sqrt();
     let wi = (-wo * eta + side_normal * (eta * cos_i - cos_t)).normalize();
+    Some(refraction(wi, color, eta, fresnel, mode))
+}
+
+/// Refraction into `wi`, chosen with probability 1 − F: the weight is the tint, times the
+/// radiance scaling η² (η = η_i/η_t) when radiance is carried.
+#[inline]
+fn refraction(
+    wi: Vec3A,
+    color: Vec3A,
+    eta: f32,
+    fresnel: f32,
+    mode: TransportMode,
+) -> ScatterSample {
     let scale = match mode {
         TransportMode::Radiance => eta * eta,
         TransportMode::Importance => 1.0,
     };
-    Some(ScatterSample {
+    ScatterSample {
         wi,
         weight: color * scale,
         pdf: 1.0 - fresnel,
         specular: true,
-    })
+    }
+}
+
+/// The lobe of a given scattering (reflection if `wi` stays on `wo`'s side, else
+/// refraction) with the weight and probability `sample` gives it.
+#[inline]
+pub(super) fn scatter(
+    ior: f32,
+    color: Vec3A,
+    normal: Vec3A,
+    wo: Vec3A,
+    wi: Vec3A,
+    mode: TransportMode,
+) -> Option<ScatterSample> {
+    let (cos_o, cos_i) = (wo.dot(normal), wi.dot(normal));
+    if cos_o == 0.0 || cos_i == 0.0 {
+        return None;
+    }
+    let (eta_i, eta_t) = if cos_o > 0.0 { (1.0, ior) } else { (ior, 1.0) };
+    let fresnel = fresnel_dielectric(cos_o.abs(), eta_i, eta_t);
+    if cos_o * cos_i > 0.0 {
+        return Some(ScatterSample {
+            wi,
+            weight: color,
+            pdf: fresnel,
+            specular: true,
+        });
+    }
+    if fresnel >= 1.0 {
+        return None;
+    }
+    Some(refraction(wi, color, eta_i / eta_t, fresnel, mode))
 }
 
 #[cfg(test)]
@@ -80,6 +124,26 @@ mod tests {
         assert_eq!(fresnel_dielectric(45f32.to_radians().cos(), 1.5, 1.0), 1.0);
         // Grazing incidence reflects everything.
         assert!((fresnel_dielectric(0.0, 1.0, 1.5) - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn scatter_gives_what_sample_gave() {
+        let n = Vec3A::new(0.2, 0.9, -0.1).normalize();
+        let color = Vec3A::new(0.9, 0.8, 0.7);
+        for wo in [Vec3A::new(0.5, 0.8, 0.1), Vec3A::new(-0.3, -0.6, 0.4)] {
+            let wo = wo.normalize();
+            for mode in [TransportMode::Radiance, TransportMode::Importance] {
+                for u_lobe in [0.001, 0.999] {
+                    let s = sample(1.5, color, n, wo, u_lobe, mode).unwrap();
+                    let e = scatter(1.5, color, n, wo, s.wi, mode).unwrap();
+                    assert_eq!(
+                        (e.weight, e.pdf),
+                        (s.weight, s.pdf),
+                        "{wo} {mode:?} {u_lobe}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

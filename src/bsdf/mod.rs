@@ -102,6 +102,39 @@ pub fn pdf(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
     }
 }
 
+/// What `sample` would return for scattering from `wo` into `wi`: the weight (BSDF ×
+/// |cos θi| / pdf) and the density (solid angle, or the lobe probability for a specular
+/// lobe), for path-space methods that evaluate given paths. A specular `wi` is taken to be
+/// the exact mirror or refracted direction of its side (the path was traced that way); it
+/// is not checked.
+#[inline]
+pub fn scatter(
+    material: &Material,
+    normal: Vec3A,
+    wo: Vec3A,
+    wi: Vec3A,
+    mode: TransportMode,
+) -> Option<ScatterSample> {
+    let color = Vec3A::from(material.color);
+    let (cos_o, cos_i) = (wo.dot(normal), wi.dot(normal));
+    let same_side = cos_o * cos_i > 0.0;
+    match material.kind {
+        MaterialKind::Diffuse => same_side.then(|| ScatterSample {
+            wi,
+            weight: color,
+            pdf: cosine_hemisphere_pdf(cos_i.abs()),
+            specular: false,
+        }),
+        MaterialKind::Mirror => same_side.then_some(ScatterSample {
+            wi,
+            weight: color,
+            pdf: 1.0,
+            specular: true,
+        }),
+        MaterialKind::Dielectric => dielectric::scatter(material.ior, color, normal, wo, wi, mode),
+    }
+}
+
 /// Mirror reflection of `wo` about `normal` (either orientation).
 #[inline]
 pub fn reflect(wo: Vec3A, normal: Vec3A) -> Vec3A {

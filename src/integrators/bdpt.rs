@@ -13,6 +13,7 @@
 //! Russian roulette is not used: subpaths end at the depth limit, which keeps the densities
 //! of both directions exact for MIS.
 
+use super::mlt::path_space::PathVertex;
 use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
 use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere, uniform_triangle};
@@ -81,6 +82,8 @@ impl Vertex {
 pub struct BdptScratch {
     camera: Vec<Vertex>,
     light: Vec<Vertex>,
+    /// The vertex the last strategy with s = 1 or t = 1 sampled to connect to.
+    connection: Vertex,
 }
 
 /// Converts a solid-angle density at `from` of the direction towards `to` into an area
@@ -439,8 +442,13 @@ pub(crate) const STREAMS: usize = 3;
 /// pixel the light subpath projects to.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Contribution {
+    /// The MIS-weighted contribution.
     pub value: Vec3A,
     pub splat_pixel: Option<u32>,
+    /// Its MIS weight: what divides `value` back into the strategy's own estimate (the
+    /// path-space tests compare that with their evaluation of the path).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub weight: f32,
 }
 
 impl Bdpt<'_> {
@@ -563,6 +571,7 @@ impl Bdpt<'_> {
             Some(Contribution {
                 value: pt.beta * le * weight,
                 splat_pixel: None,
+                weight,
             })
         } else if t == 1 {
             // Light tracing: connect a light-subpath vertex to the lens.
@@ -599,9 +608,11 @@ impl Bdpt<'_> {
             let weight = self.mis_weight(camera_model, camera, light, s, 1);
             camera[0] = saved;
             let [rx, ry] = importance.raster;
+            scratch.connection = sampled;
             Some(Contribution {
                 value: contribution * weight,
                 splat_pixel: Some(ry as u32 * camera_model.width + rx as u32),
+                weight,
             })
         } else if s == 1 {
             // Next-event estimation: a new point on a light.
@@ -642,9 +653,11 @@ impl Bdpt<'_> {
             light[0] = sampled;
             let weight = self.mis_weight(camera_model, camera, light, 1, t);
             light[0] = saved;
+            scratch.connection = sampled;
             Some(Contribution {
                 value: contribution * weight,
                 splat_pixel: None,
+                weight,
             })
         } else {
             // Connect light vertex s-1 and camera vertex t-1.
@@ -668,7 +681,44 @@ impl Bdpt<'_> {
             Some(Contribution {
                 value: contribution * weight,
                 splat_pixel: None,
+                weight,
             })
+        }
+    }
+}
+
+impl Bdpt<'_> {
+    /// The path strategy (s, t) of the traced subpaths built, as path-space vertices from
+    /// the light to the lens, into `out`. Call it right after `connect` returned the
+    /// strategy's contribution: for s = 1 or t = 1 it takes the vertex `connect` sampled.
+    pub(crate) fn strategy_path(
+        &self,
+        scratch: &BdptScratch,
+        s: usize,
+        t: usize,
+        out: &mut Vec<PathVertex>,
+    ) {
+        let as_path_vertex = |v: &Vertex| PathVertex {
+            p: v.p,
+            normal: v.normal,
+            triangle: v.triangle,
+        };
+        out.clear();
+        for i in 0..s {
+            let v = if s == 1 {
+                &scratch.connection
+            } else {
+                &scratch.light[i]
+            };
+            out.push(as_path_vertex(v));
+        }
+        for i in (0..t).rev() {
+            let v = if t == 1 {
+                &scratch.connection
+            } else {
+                &scratch.camera[i]
+            };
+            out.push(as_path_vertex(v));
         }
     }
 }
@@ -681,6 +731,7 @@ impl PixelEstimator for Bdpt<'_> {
         BdptScratch {
             camera: vec![Vertex::EMPTY; n],
             light: vec![Vertex::EMPTY; n],
+            connection: Vertex::EMPTY,
         }
     }
 

@@ -264,6 +264,22 @@ impl CameraModel {
         1.0 / (self.film_area() * cos_theta * cos_theta * cos_theta)
     }
 
+    /// The unit direction from lens point `lens` through film position (x, y) in pixels:
+    /// towards where that film point's pinhole ray meets the focal plane (any direction from
+    /// a pinhole's eye). Its solid-angle density, for (x, y) uniform on the film, is
+    /// `direction_pdf` for any lens point.
+    #[inline]
+    pub fn direction_through(&self, lens: Vec3A, x: f32, y: f32) -> Vec3A {
+        let sx = (2.0 * x / self.width as f32 - 1.0) * self.half_width;
+        let sy = (1.0 - 2.0 * y / self.height as f32) * self.half_height;
+        let dir = self.forward + self.right * sx + self.up * sy;
+        if self.lens_radius > 0.0 {
+            (self.eye + dir * self.focus_distance - lens).normalize()
+        } else {
+            dir.normalize()
+        }
+    }
+
     /// A lens point for connecting to `point`, from `u` in the unit square: the eye for a
     /// pinhole.
     #[inline]

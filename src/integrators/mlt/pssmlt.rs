@@ -177,19 +177,73 @@ pub(crate) fn film_position(camera: &CameraModel, [u, v]: [f32; 2]) -> (f32, f32
     (x, y, y as u32 * camera.width + x as u32)
 }
 
+/// A Markov chain of a Metropolis render: its state, random numbers and scratch memory.
+pub(crate) trait MarkovChain: Send {
+    /// What the chain explores (shared by all chains).
+    type Target: Sync;
+    /// Makes one mutation and appends its deposits (in units of the chain's weight).
+    fn mutate(&mut self, target: &Self::Target, camera: &CameraModel, deposits: &mut Vec<Splat>);
+    /// Proposals accepted so far.
+    fn accepted(&self) -> u64;
+    /// Rays traced so far.
+    fn rays(&self) -> u64;
+    /// Most deposits one mutation makes.
+    fn max_deposits(&self) -> usize;
+}
+
+/// A chain of a render with its weight (b_g / chains of its group: every deposit's factor)
+/// and the deposits of the current round.
+pub(crate) struct WeightedChain<C> {
+    pub chain: C,
+    pub weight: f64,
+    deposits: Vec<Splat>,
+}
+
+impl<C> WeightedChain<C> {
+    pub fn new(chain: C, weight: f64) -> Self {
+        WeightedChain {
+            chain,
+            weight,
+            deposits: Vec::new(),
+        }
+    }
+}
+
 struct Chain<T: PrimarySpaceTarget> {
     group: usize,
-    /// b_g / (chains of the group): the factor of this chain's deposits.
-    weight: f64,
     sampler: PssSampler,
     scratch: T::Scratch,
     current: PathSample,
     proposal: PathSample,
-    deposits: Vec<Splat>,
     /// p_large × b_g, added to f in the deposits' denominators (see `mutate`).
     mis_offset: f32,
+    max_entries: usize,
     accepted: u64,
     rays: u64,
+}
+
+impl<T: PrimarySpaceTarget> MarkovChain for Chain<T>
+where
+    T::Scratch: Send,
+{
+    type Target = T;
+
+    #[inline]
+    fn mutate(&mut self, target: &T, camera: &CameraModel, deposits: &mut Vec<Splat>) {
+        mutate(target, camera, self, deposits);
+    }
+
+    fn accepted(&self) -> u64 {
+        self.accepted
+    }
+
+    fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    fn max_deposits(&self) -> usize {
+        2 * self.max_entries
+    }
 }
 
 /// Bootstrap samples per pass: a pass covers the film once, stratified, so b from any
@@ -219,7 +273,10 @@ fn bootstrap_film_position(i: u64, n: u64, camera: &CameraModel, rng: &mut Rng) 
 
 /// A sampler laid out for `target` with the chains' step settings; each use restarts it
 /// (`restart_as_bootstrap`) before its first sample.
-fn new_sampler<T: PrimarySpaceTarget>(target: &T, settings: &PssmltSettings) -> PssSampler {
+pub(crate) fn new_sampler<T: PrimarySpaceTarget>(
+    target: &T,
+    settings: &PssmltSettings,
+) -> PssSampler {
     PssSampler::new(
         settings.seed,
         0,
@@ -231,7 +288,7 @@ fn new_sampler<T: PrimarySpaceTarget>(target: &T, settings: &PssmltSettings) -> 
 }
 
 /// Restarts `sampler` as bootstrap sample `i` of `n`.
-fn restart_as_bootstrap(
+pub(crate) fn restart_as_bootstrap(
     sampler: &mut PssSampler,
     settings: &PssmltSettings,
     camera: &CameraModel,
@@ -246,15 +303,15 @@ fn restart_as_bootstrap(
 
 /// The bootstrap: per group, the sum of the target over the samples taken, and the values of
 /// the first samples (sample-major) for resampling.
-struct Bootstrap {
-    sums: Vec<f64>,
+pub(crate) struct Bootstrap {
+    pub sums: Vec<f64>,
     /// Samples taken: all asked for, or the whole passes done before a stop.
-    samples: u64,
+    pub samples: u64,
     kept: Vec<f32>,
     kept_samples: u64,
 }
 
-fn bootstrap<T: PrimarySpaceTarget>(
+pub(crate) fn bootstrap<T: PrimarySpaceTarget>(
     target: &T,
     camera: &CameraModel,
     settings: &PssmltSettings,
@@ -320,7 +377,7 @@ fn bootstrap<T: PrimarySpaceTarget>(
 
 /// Chains per group: `total` in proportion to `b`, at least one per group with b > 0
 /// (largest remainder).
-fn allot_chains(b: &[f64], total: u64) -> Vec<u64> {
+pub(crate) fn allot_chains(b: &[f64], total: u64) -> Vec<u64> {
     let sum: f64 = b.iter().sum();
     let lit = b.iter().filter(|&&x| x > 0.0).count() as u64;
     let total = total.max(lit);
@@ -352,7 +409,11 @@ fn allot_chains(b: &[f64], total: u64) -> Vec<u64> {
 /// For each group, `chains[g]` bootstrap sample indices drawn in proportion to the kept
 /// values of that group by systematic resampling (one uniform number per group, so the
 /// seeds spread over the samples as evenly as their values allow).
-fn resample_seeds(bootstrap: &Bootstrap, chains: &[u64], seed: u64) -> Vec<(usize, u64)> {
+pub(crate) fn resample_seeds(
+    bootstrap: &Bootstrap,
+    chains: &[u64],
+    seed: u64,
+) -> Vec<(usize, u64)> {
     let groups = chains.len();
     let mut seeds = Vec::with_capacity(chains.iter().sum::<u64>() as usize);
     for (g, &count) in chains.iter().enumerate() {
@@ -377,6 +438,58 @@ fn resample_seeds(bootstrap: &Bootstrap, chains: &[u64], seed: u64) -> Vec<(usiz
     seeds
 }
 
+/// What a render's chains are to do: their total mutations and how they are split.
+pub(crate) struct ChainPlan {
+    pub chains_per_group: Vec<u64>,
+    pub chain_count: u64,
+    pub mutations_per_chain: u64,
+    pixels: u64,
+}
+
+impl ChainPlan {
+    /// Chains allotted to the groups by their normalizations `b`, each making an equal share
+    /// of the mutations asked for (or, without a count, enough for any time limit).
+    pub fn new(b: &[f64], camera: &CameraModel, settings: &PssmltSettings) -> Self {
+        let pixels = camera.width as u64 * camera.height as u64;
+        let total = if settings.mutations_per_pixel > 0 {
+            settings.mutations_per_pixel as u64 * pixels
+        } else {
+            u64::MAX / 4
+        };
+        let chains_per_group = allot_chains(b, (settings.chains as u64).min(total));
+        let chain_count: u64 = chains_per_group.iter().sum();
+        ChainPlan {
+            mutations_per_chain: total.div_ceil(chain_count),
+            chains_per_group,
+            chain_count,
+            pixels,
+        }
+    }
+}
+
+/// The end of a render whose bootstrap found no light reaching the camera: the chains'
+/// image is black and their mutations count as done; another pass still takes its share.
+pub(crate) fn finish_without_light(
+    camera: &CameraModel,
+    settings: &PssmltSettings,
+    film: &mut Film,
+    control: &Control,
+    after_round: &mut dyn FnMut(&mut Film, f64),
+) -> PssmltOutcome {
+    let pixels = camera.width as u64 * camera.height as u64;
+    control.mutations_done.fetch_add(
+        settings.mutations_per_pixel as u64 * pixels,
+        Ordering::Relaxed,
+    );
+    let mutations_per_pixel = if settings.mutations_per_pixel > 0 {
+        settings.mutations_per_pixel as f64
+    } else {
+        f64::INFINITY
+    };
+    after_round(film, mutations_per_pixel);
+    PssmltOutcome::default()
+}
+
 /// Runs the chains. `after_round(film, mutations per pixel so far)` is called after each round
 /// of mutations, to let another pass keep pace.
 pub(crate) fn run<T: PrimarySpaceTarget>(
@@ -386,45 +499,24 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
-) -> PssmltOutcome {
+) -> PssmltOutcome
+where
+    T::Scratch: Send,
+{
     // 1. Bootstrap.
     let n = settings.bootstrap_samples as u64;
     let boot = bootstrap(target, camera, settings, control);
     let b: Vec<f64> = boot.sums.iter().map(|&s| s / boot.samples as f64).collect();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
-        // No light reaches the camera along the chains' paths: their image is black and
-        // their mutations are done; another pass still takes its share.
-        let pixels = camera.width as u64 * camera.height as u64;
-        control.mutations_done.fetch_add(
-            settings.mutations_per_pixel as u64 * pixels,
-            Ordering::Relaxed,
-        );
-        let mutations_per_pixel = if settings.mutations_per_pixel > 0 {
-            settings.mutations_per_pixel as f64
-        } else {
-            f64::INFINITY
-        };
-        after_round(film, mutations_per_pixel);
-        return PssmltOutcome::default();
+        return finish_without_light(camera, settings, film, control, after_round);
     }
 
     // 2. Chains, allotted to groups and seeded from resampled bootstrap samples.
-    let pixels = camera.width as u64 * camera.height as u64;
-    // Without a mutation count the render runs until the time limit stops it.
-    let total = if settings.mutations_per_pixel > 0 {
-        settings.mutations_per_pixel as u64 * pixels
-    } else {
-        u64::MAX / 4
-    };
-    let chains_per_group = allot_chains(&b, (settings.chains as u64).min(total));
-    let chain_count: u64 = chains_per_group.iter().sum();
-    let mutations_per_chain = total.div_ceil(chain_count);
-    let deposits_per_mutation = 2 * target.max_entries() as u64;
-    let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / chain_count).max(1);
-    let seeds = resample_seeds(&boot, &chains_per_group, settings.seed);
+    let plan = ChainPlan::new(&b, camera, settings);
+    let seeds = resample_seeds(&boot, &plan.chains_per_group, settings.seed);
     drop(boot);
-    let mut chains: Vec<Chain<T>> = seeds
+    let mut chains: Vec<WeightedChain<Chain<T>>> = seeds
         .into_par_iter()
         .enumerate()
         .map(|(c, (group, index))| {
@@ -445,66 +537,114 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
             );
             // Chains seeded from the same sample must still move independently.
             sampler.reseed(settings.seed, CHAIN_STREAM + c as u64);
-            Chain {
+            let chain = Chain {
                 group,
-                weight: b[group] / chains_per_group[group] as f64,
                 sampler,
                 scratch,
                 current,
                 proposal: PathSample::with_capacity(target.max_entries()),
-                deposits: Vec::with_capacity((per_round * deposits_per_mutation) as usize),
                 mis_offset: (settings.large_step_probability as f64 * b[group]) as f32,
+                max_entries: target.max_entries(),
                 accepted: 0,
                 rays,
-            }
+            };
+            WeightedChain::new(chain, b[group] / plan.chains_per_group[group] as f64)
         })
         .collect();
 
-    // 3. Rounds of mutations, every chain making the same number. The first round, about
-    //    one mutation per pixel, always runs, so a stopped render still has an image.
+    // 3. and 4. Rounds of mutations, then the normalization.
+    let mut outcome = run_rounds(
+        target,
+        camera,
+        &mut chains,
+        &plan,
+        film,
+        control,
+        after_round,
+    );
+    outcome.normalization = normalization;
+    outcome
+}
+
+/// Runs `chains` in rounds, every chain making the same number of mutations, adds their
+/// deposits to the film in chain order after each round, and sets the film's splat scale
+/// so that each chain's deposits count with its weight per mutation.
+///
+/// The first round, about one mutation per pixel, always runs, so a stopped render still
+/// has an image.
+pub(crate) fn run_rounds<C: MarkovChain>(
+    target: &C::Target,
+    camera: &CameraModel,
+    chains: &mut [WeightedChain<C>],
+    plan: &ChainPlan,
+    film: &mut Film,
+    control: &Control,
+    after_round: &mut dyn FnMut(&mut Film, f64),
+) -> PssmltOutcome {
+    let chain_count = chains.len() as u64;
+    let deposits_per_mutation = chains
+        .iter()
+        .map(|c| c.chain.max_deposits())
+        .max()
+        .unwrap_or(1) as u64;
+    let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / chain_count.max(1)).max(1);
+    for chain in chains.iter_mut() {
+        chain.deposits = Vec::with_capacity((per_round * deposits_per_mutation) as usize);
+    }
     let mut mutations_done = 0u64;
-    let first_round = pixels.div_ceil(chain_count).min(per_round);
-    while mutations_done < mutations_per_chain && (mutations_done == 0 || !control.should_stop()) {
+    let first_round = plan.pixels.div_ceil(chain_count.max(1)).min(per_round);
+    while mutations_done < plan.mutations_per_chain
+        && (mutations_done == 0 || !control.should_stop())
+    {
         let round = if mutations_done == 0 {
             first_round
         } else {
             per_round
         };
-        let steps = (mutations_per_chain - mutations_done).min(round);
-        chains.par_iter_mut().for_each(|chain| {
-            chain.deposits.clear();
+        let steps = (plan.mutations_per_chain - mutations_done).min(round);
+        chains.par_iter_mut().for_each(|weighted| {
+            weighted.deposits.clear();
             for _ in 0..steps {
-                mutate(target, camera, chain);
+                weighted
+                    .chain
+                    .mutate(target, camera, &mut weighted.deposits);
             }
             control.mutations_done.fetch_add(steps, Ordering::Relaxed);
         });
         mutations_done += steps;
-        for chain in &chains {
+        for chain in chains.iter() {
             film.add_weighted_splats(&chain.deposits, chain.weight);
         }
-        after_round(film, (mutations_done * chain_count) as f64 / pixels as f64);
+        after_round(
+            film,
+            (mutations_done * chain_count) as f64 / plan.pixels as f64,
+        );
     }
 
-    // 4. Normalization: group g's deposits sum to (its chains × mutations per chain) units.
+    // Group g's deposits sum to (its chains × mutations per chain) units.
     let mut outcome = PssmltOutcome {
-        normalization,
         mutations: mutations_done * chain_count,
         ..Default::default()
     };
     let mut rays = 0;
-    for chain in &chains {
-        outcome.accepted += chain.accepted;
-        rays += chain.rays;
+    for chain in chains.iter() {
+        outcome.accepted += chain.chain.accepted();
+        rays += chain.chain.rays();
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
     if mutations_done > 0 {
-        film.set_splat_scale(pixels as f64 / mutations_done as f64);
+        film.set_splat_scale(plan.pixels as f64 / mutations_done as f64);
     }
     outcome
 }
 
 #[inline]
-fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut Chain<T>) {
+fn mutate<T: PrimarySpaceTarget>(
+    target: &T,
+    camera: &CameraModel,
+    chain: &mut Chain<T>,
+    deposits: &mut Vec<Splat>,
+) {
     chain.sampler.start_iteration();
     chain.proposal.clear();
     target.evaluate(
@@ -528,10 +668,10 @@ fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut C
         0.0
     };
     if a > 0.0 {
-        deposit(&mut chain.deposits, &chain.proposal, a + large, mis);
+        deposit(deposits, &chain.proposal, a + large, mis);
     }
     if a < 1.0 && chain.current.target > 0.0 {
-        deposit(&mut chain.deposits, &chain.current, 1.0 - a, mis);
+        deposit(deposits, &chain.current, 1.0 - a, mis);
     }
     if chain.sampler.decision() < a {
         std::mem::swap(&mut chain.current, &mut chain.proposal);
@@ -545,7 +685,7 @@ fn mutate<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel, chain: &mut C
 /// Records `weight` × the state's contributions, each divided by the state's target value
 /// plus `mis_offset`.
 #[inline]
-fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32, mis_offset: f32) {
+pub(crate) fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32, mis_offset: f32) {
     let scale = weight / (state.target + mis_offset);
     for entry in &state.entries {
         deposits.push(Splat {

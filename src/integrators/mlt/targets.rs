@@ -3,6 +3,7 @@
 //! BDPT), and BDPT with the path depth and one strategy picked by the chain (multiplexed MLT,
 //! Hachisuka et al. 2014).
 
+use super::path_space::PathVertex;
 use super::pss::PssSampler;
 use super::pssmlt::{PathSample, PrimarySpaceTarget, film_position};
 use crate::integrators::bdpt::{
@@ -161,6 +162,67 @@ fn evaluate_all_strategies(
 
 /// PSSMLT over BDPT: a state is one BDPT sample, all its strategies summed.
 pub(crate) struct BdptAllStrategies<'a>(pub Bdpt<'a>);
+
+impl BdptAllStrategies<'_> {
+    /// Replays the bootstrap sample `sampler` was restarted at, picks one of its strategies
+    /// in proportion to its MIS-weighted luminance (`choice` ∈ [0, 1)) and writes the path
+    /// that strategy built into `out`; returns its s (light vertices), or `None` if the
+    /// sample has no light. Path-space chains start there: over the bootstrap, a path is
+    /// picked with probability ∝ w_s·f/p_s, which resamples f/b.
+    pub(crate) fn seed_path(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        choice: f32,
+        out: &mut Vec<PathVertex>,
+        rays: &mut u64,
+    ) -> Option<usize> {
+        let bdpt = &self.0;
+        let mut counters = SampleCounters::default();
+        let (x, y, _, _) = start_camera_stream(camera, sampler);
+        let max_depth = bdpt.max_depth as usize;
+        let lengths = bdpt.trace_subpaths(
+            camera,
+            x,
+            y,
+            max_depth + 2,
+            max_depth + 1,
+            sampler,
+            &mut scratch.paths,
+            &mut counters,
+        );
+        let mut found: Vec<(usize, usize, f32)> = Vec::new();
+        bdpt.for_each_strategy(
+            camera,
+            lengths,
+            sampler,
+            &mut scratch.paths,
+            &mut counters,
+            |s, t, c| found.push((s, t, PathSample::usable_luminance(c.value))),
+        );
+        let total: f32 = found.iter().map(|&(_, _, l)| l).sum();
+        if total <= 0.0 {
+            return None;
+        }
+        let goal = choice * total;
+        let mut cumulative = 0.0;
+        let &(s, t, _) = found
+            .iter()
+            .find(|&&(_, _, l)| {
+                cumulative += l;
+                l > 0.0 && cumulative > goal
+            })
+            .or_else(|| found.iter().rev().find(|&&(_, _, l)| l > 0.0))?;
+        // The connection stream restarts for every strategy, so this repeats the chosen
+        // one exactly and leaves its sampled vertex in the scratch.
+        sampler.start_stream(CONNECTION_STREAM);
+        bdpt.connect(camera, &mut scratch.paths, s, t, sampler, &mut counters)?;
+        bdpt.strategy_path(&scratch.paths, s, t, out);
+        *rays += counters.rays;
+        Some(s)
+    }
+}
 
 impl PrimarySpaceTarget for BdptAllStrategies<'_> {
     type Scratch = BdptTargetScratch;

@@ -1,0 +1,338 @@
+//! Path-space Metropolis light transport (Veach & Guibas 1997; Veach's thesis, ch. 11): the
+//! chain's states are light paths, lists of vertices from a light to the lens, and mutations
+//! edit the vertices themselves.
+//!
+//! # Transfer ratios as ratios of unweighted contributions
+//!
+//! A mutation that keeps some vertices of x and samples the others anew, the way one of
+//! BDPT's strategies would (s vertices from the light, the rest from the lens), proposes y
+//! with density T(x→y) = q · p_s(y), where q is the probability of its discrete choices and
+//! p_s the density of the sampled vertices given the kept ones. Its reverse regenerates x's
+//! vertices the same way with a strategy s'. The acceptance ratio is then
+//!
+//! ```text
+//! f(y) T(y→x)     f(y)/p_s(y)      q(y→x)
+//! ----------- = -------------- · --------
+//! f(x) T(x→y)    f(x)/p_s'(x)     q(x→y)
+//! ```
+//!
+//! and f/p_s is what BDPT calls strategy s's unweighted contribution C_s. The kept vertices'
+//! factors of f and of p_s (a vertex sampled from a kept one depends only on kept vertices)
+//! are the same in x and y and cancel, so C_s can be evaluated over the whole path.
+//!
+//! Dirac (specular) scattering is where such ratios usually go wrong. C_s is a product of
+//! the BSDF sampling weights f·|cos|/p of each sampled vertex, in the transport mode of the
+//! side that sampled it, as BDPT computes them: each delta meets its own sampling density and
+//! the refraction Jacobian is the one BDPT already gets right (its strategies agree with the
+//! path tracer through glass). `unweighted_contribution` evaluates C_s for a given path and
+//! the tests check it against BDPT's own numbers for every strategy.
+
+mod bidirectional;
+mod chain;
+
+pub(crate) use chain::{PathSpaceTarget, run};
+
+use crate::bsdf::{self, TransportMode};
+use crate::scene::{CameraModel, MaterialKind, Scene};
+use glam::Vec3A;
+use std::f32::consts::PI;
+
+/// A vertex of a light path: a point on a light (the first), on a surface, or on the lens
+/// (the last).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PathVertex {
+    pub p: Vec3A,
+    /// The triangle's front geometric normal; the camera's view direction for the lens.
+    pub normal: Vec3A,
+    /// Internal triangle index (unused for the lens).
+    pub triangle: u32,
+}
+
+/// The scene and camera a path lives in, with the functions that evaluate paths.
+pub(crate) struct PathSpace<'a> {
+    pub scene: &'a Scene,
+    pub camera: &'a CameraModel,
+}
+
+/// The unit direction from `from` to `to`, or `None` for coincident points.
+#[inline]
+fn direction(from: &PathVertex, to: &PathVertex) -> Option<(Vec3A, f32)> {
+    let d = to.p - from.p;
+    let distance2 = d.length_squared();
+    (distance2 > 0.0).then(|| (d / distance2.sqrt(), distance2))
+}
+
+impl PathSpace<'_> {
+    #[inline]
+    fn material(&self, v: &PathVertex) -> &crate::scene::Material {
+        let shading = &self.scene.shading[v.triangle as usize];
+        &self.scene.materials[shading.material as usize]
+    }
+
+    #[inline]
+    fn is_specular(&self, v: &PathVertex) -> bool {
+        self.material(v).kind != MaterialKind::Diffuse
+    }
+
+    /// The pixel the path's last edge (from the lens) lands in.
+    #[inline]
+    pub fn pixel(&self, path: &[PathVertex]) -> Option<u32> {
+        let [.., previous, lens] = path else {
+            return None;
+        };
+        let (w, _) = direction(lens, previous)?;
+        let [x, y] = self.camera.raster_position(lens.p, w)?;
+        Some(y as u32 * self.camera.width + x as u32)
+    }
+
+    /// The sampling weight of vertex `at` scattering between its neighbors, in the mode of
+    /// the side that sampled it: `from` is where that side came from, `to` the vertex it
+    /// sampled. With `lobes_sampled` false, a specular lobe is taken as given (the
+    /// perturbations keep each vertex's lobe), so its choice probability is not divided out.
+    #[inline]
+    fn weight(
+        &self,
+        from: &PathVertex,
+        at: &PathVertex,
+        to: &PathVertex,
+        mode: TransportMode,
+        lobes_sampled: bool,
+    ) -> Option<Vec3A> {
+        let (wo, _) = direction(at, from)?;
+        let (wi, _) = direction(at, to)?;
+        let s = bsdf::scatter(self.material(at), at.normal, wo, wi, mode)?;
+        Some(if s.specular && !lobes_sampled {
+            s.weight * s.pdf
+        } else {
+            s.weight
+        })
+    }
+
+    /// The BSDF of non-specular vertex `at` between its neighbors (zero for specular ones).
+    #[inline]
+    fn bsdf(&self, from: &PathVertex, at: &PathVertex, to: &PathVertex) -> Option<Vec3A> {
+        let (wo, _) = direction(at, from)?;
+        let (wi, _) = direction(at, to)?;
+        Some(bsdf::eval(self.material(at), at.normal, wo, wi))
+    }
+
+    /// f(x) / p_s(x): the measurement contribution of `path` (a light vertex first, the
+    /// lens last, every edge unoccluded) divided by the density with which BDPT's strategy
+    /// with `s` light vertices samples it, and the pixel it lands in. Strategies BDPT skips
+    /// (s = 1 with t = 1, a connection at a specular vertex) and zero contributions give
+    /// `None`. See the module documentation for `lobes_sampled`.
+    pub fn unweighted_contribution(
+        &self,
+        path: &[PathVertex],
+        s: usize,
+        lobes_sampled: bool,
+    ) -> Option<(Vec3A, u32)> {
+        let n = path.len();
+        if n < 2 || s >= n || (s == 1 && n == 2) {
+            return None;
+        }
+        let pixel = self.pixel(path)?;
+        let t = n - s;
+        let light = &path[0];
+        let light_shading = &self.scene.shading[light.triangle as usize];
+        let area_pdf = light_shading.light_area_pdf;
+        if area_pdf <= 0.0 {
+            return None;
+        }
+        let emission = Vec3A::from(self.scene.materials[light_shading.material as usize].emission);
+        // The light leaves its front side only.
+        let (w_light, _) = direction(&path[0], &path[1])?;
+        if w_light.dot(light.normal) <= 0.0 {
+            return None;
+        }
+
+        // Light side: x_0 .. x_{s-1}.
+        let mut beta_light = Vec3A::ONE;
+        if s >= 1 {
+            beta_light = emission / area_pdf;
+            if s >= 2 {
+                // Cosine-weighted emission: Le·cos / (p_position · cos/π).
+                beta_light *= PI;
+            }
+            for j in 1..s.saturating_sub(1) {
+                beta_light *= self.weight(
+                    &path[j - 1],
+                    &path[j],
+                    &path[j + 1],
+                    TransportMode::Importance,
+                    lobes_sampled,
+                )?;
+            }
+        }
+        // Lens side: x_{n-1} .. x_s. The camera's importance is normalized so that the
+        // first direction's weight is 1.
+        let mut beta_eye = Vec3A::ONE;
+        for j in (s + 1..n - 1).rev() {
+            beta_eye *= self.weight(
+                &path[j + 1],
+                &path[j],
+                &path[j - 1],
+                TransportMode::Radiance,
+                lobes_sampled,
+            )?;
+        }
+
+        let value = if s == 0 {
+            // The lens side reached the light.
+            beta_eye * emission
+        } else if t == 1 {
+            // Light tracing: x_{s-1} connects to the lens.
+            let (lens, qs) = (&path[n - 1], &path[n - 2]);
+            if self.is_specular(qs) {
+                return None;
+            }
+            let (w, distance2) = direction(lens, qs)?;
+            let importance = self.camera.importance(lens.p, w)?;
+            let cos_lens = w.dot(self.camera.forward);
+            // The lens point's density in solid angle at qs.
+            let pdf = distance2 / cos_lens / self.camera.lens_area();
+            beta_light
+                * self.bsdf(&path[n - 3], qs, lens)?
+                * w.dot(qs.normal).abs()
+                * (importance.importance / pdf)
+        } else {
+            let (qs, pt) = (&path[s - 1], &path[s]);
+            if self.is_specular(pt) || (s >= 2 && self.is_specular(qs)) {
+                return None;
+            }
+            let (w, distance2) = direction(qs, pt)?;
+            let light_side = if s == 1 {
+                // Next-event estimation: the light's own factor is in beta_light.
+                Vec3A::ONE
+            } else {
+                self.bsdf(&path[s - 2], qs, pt)?
+            };
+            let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
+            beta_light * light_side * geometry * self.bsdf(&path[s + 1], pt, qs)? * beta_eye
+        };
+        (value.max_element() > 0.0 && value.is_finite()).then_some((value, pixel))
+    }
+}
+
+#[cfg(all(test, feature = "cli"))]
+mod tests {
+    use super::*;
+    use crate::integrators::SampleCounters;
+    use crate::integrators::bdpt::Bdpt;
+    use crate::sampling::Rng;
+    use crate::scene::{Backend, Camera, SceneDesc};
+
+    /// A scene of tests/scenes with its camera.
+    fn canonical(name: &str) -> (Scene, Camera) {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes");
+        let data = crate::io::load_scene(&dir.join(format!("{name}.obj"))).unwrap();
+        let scene = Scene::new(&SceneDesc {
+            positions: &data.positions,
+            indices: &data.indices,
+            material_ids: &data.material_ids,
+            materials: &data.materials,
+            backend: Backend::Bvh,
+        })
+        .unwrap();
+        let camera = crate::io::load_camera_json(&dir.join(format!("{name}.camera.json")))
+            .unwrap()
+            .camera;
+        (scene, camera)
+    }
+
+    /// For every strategy of many BDPT samples, the contribution evaluated on the path the
+    /// strategy built equals BDPT's own (its weighted value over its MIS weight), on the
+    /// diffuse box and through glass.
+    #[test]
+    fn unweighted_contributions_match_bdpt_for_every_strategy() {
+        for name in ["cornell-box", "cornell-glass"] {
+            let (scene, camera) = canonical(name);
+            let camera = camera.model(32, 32);
+            let max_depth = 6;
+            let bdpt = Bdpt {
+                scene: &scene,
+                max_depth,
+                min_depth: 0,
+            };
+            let space = PathSpace {
+                scene: &scene,
+                camera: &camera,
+            };
+            let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
+            let mut counters = SampleCounters::default();
+            let mut rng = Rng::new(7, 0);
+            let mut path = Vec::new();
+            // Per (s, t): strategies compared, and those through a specular vertex.
+            let mut compared = std::collections::BTreeMap::<(usize, usize), (u32, u32)>::new();
+            for _ in 0..20_000 {
+                let [x, y] = rng.uniform2();
+                let (n_camera, n_light) = bdpt.trace_subpaths(
+                    &camera,
+                    x * 32.0,
+                    y * 32.0,
+                    max_depth as usize + 2,
+                    max_depth as usize + 1,
+                    &mut rng,
+                    &mut scratch,
+                    &mut counters,
+                );
+                for t in 1..=n_camera {
+                    for s in 0..=n_light {
+                        if s + t < 2 || s + t - 2 > max_depth as usize || (s == 1 && t == 1) {
+                            continue;
+                        }
+                        let Some(c) =
+                            bdpt.connect(&camera, &mut scratch, s, t, &mut rng, &mut counters)
+                        else {
+                            continue;
+                        };
+                        bdpt.strategy_path(&scratch, s, t, &mut path);
+                        let expected = c.value / c.weight;
+                        let (value, pixel) = space
+                            .unweighted_contribution(&path, s, true)
+                            .unwrap_or_else(|| panic!("{name} ({s}, {t}): none, BDPT {expected}"));
+                        let error = ((value - expected).abs()
+                            / expected.abs().max(Vec3A::splat(1e-6)))
+                        .max_element();
+                        assert!(
+                            error < 2e-3,
+                            "{name} ({s}, {t}): {value} vs BDPT's {expected}"
+                        );
+                        if let Some(splat) = c.splat_pixel {
+                            assert_eq!(pixel, splat, "{name} ({s}, {t})");
+                        }
+                        let specular = path.iter().any(|v| {
+                            let shading = &scene.shading[v.triangle as usize];
+                            scene.materials[shading.material as usize].kind != MaterialKind::Diffuse
+                        });
+                        let entry = compared.entry((s, t)).or_default();
+                        entry.0 += 1;
+                        entry.1 += specular as u32;
+                    }
+                }
+            }
+            // Every kind of connection, and (in glass) paths through specular vertices on
+            // both sides, were compared.
+            for (s, t) in [(0, 3), (1, 2), (2, 2), (3, 1), (2, 4), (4, 2)] {
+                let (count, _) = compared.get(&(s, t)).copied().unwrap_or_default();
+                assert!(count > 50, "{name}: ({s}, {t}) compared {count} times");
+            }
+            if name == "cornell-glass" {
+                for (s, t, least) in [
+                    (0, 8, 5),
+                    (1, 5, 100),
+                    (2, 5, 100),
+                    (3, 4, 100),
+                    (4, 2, 50),
+                    (6, 1, 100),
+                ] {
+                    let (_, through_glass) = compared.get(&(s, t)).copied().unwrap_or_default();
+                    assert!(
+                        through_glass >= least,
+                        "{name}: ({s}, {t}) through glass {through_glass} times"
+                    );
+                }
+            }
+        }
+    }
+}
