@@ -99,6 +99,27 @@
 #define MLT_ALGORITHM_PATH_SPACE_MLT 5
 
 /**
+ * Index of the bidirectional mutation in `MltRenderSettings.mutation_weights` and the
+ * per-mutation counts of `MltRenderStats`.
+ */
+#define MLT_MUTATION_BIDIRECTIONAL 0
+
+/**
+ * Index of the lens perturbation.
+ */
+#define MLT_MUTATION_LENS 1
+
+/**
+ * Index of the caustic perturbation.
+ */
+#define MLT_MUTATION_CAUSTIC 2
+
+/**
+ * Index of the multi-chain perturbation.
+ */
+#define MLT_MUTATION_MULTI_CHAIN 3
+
+/**
  * `MltHit.triangle_id` of a ray that hit nothing.
  */
 #define MLT_INVALID_ID UINT32_MAX
@@ -181,6 +202,11 @@ typedef enum MltStatus {
  * safe: any number of threads may render and query one scene at the same time.
  */
 typedef struct MltScene MltScene;
+
+/**
+ * The mutations of a path-space chain.
+ */
+typedef struct Mutation Mutation;
 
 /**
  * A material. Initialize with `mlt_material_default`.
@@ -341,6 +367,13 @@ typedef struct MltRenderSettings {
    * pass, the chains render every depth.
    */
   uint32_t direct_samples_per_mutation;
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
+   * `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among
+   * those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
+   * positive.
+   */
+  float mutation_weights[4];
 } MltRenderSettings;
 
 /**
@@ -409,6 +442,15 @@ typedef struct MltRenderStats {
    * Metropolis: mutations made by all chains.
    */
   uint64_t mutations;
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT`: proposals of each mutation, indexed by
+   * `MLT_MUTATION_*`.
+   */
+  uint64_t mutations_proposed[4];
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT`: accepted proposals of each mutation.
+   */
+  uint64_t mutations_accepted[4];
 } MltRenderStats;
 
 /**
@@ -445,6 +487,8 @@ typedef struct MltHit {
   float u;
   float v;
 } MltHit;
+
+
 
 #ifdef __cplusplus
 extern "C" {

@@ -8,6 +8,7 @@
 //!   says it is optional.
 
 use crate::error::*;
+use crate::integrators::mlt::path_space::MutationWeights;
 use crate::render::{self, Algorithm, RenderSettings, StopReason};
 use crate::scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc};
 use glam::Vec3A;
@@ -56,6 +57,16 @@ pub const MLT_ALGORITHM_PSSMLT_BDPT: i32 = 4;
 /// normalized by a bidirectional bootstrap. Uses `mutations_per_pixel`, `bootstrap_samples`
 /// and `chains`.
 pub const MLT_ALGORITHM_PATH_SPACE_MLT: i32 = 5;
+
+/// Index of the bidirectional mutation in `MltRenderSettings.mutation_weights` and the
+/// per-mutation counts of `MltRenderStats`.
+pub const MLT_MUTATION_BIDIRECTIONAL: i32 = 0;
+/// Index of the lens perturbation.
+pub const MLT_MUTATION_LENS: i32 = 1;
+/// Index of the caustic perturbation.
+pub const MLT_MUTATION_CAUSTIC: i32 = 2;
+/// Index of the multi-chain perturbation.
+pub const MLT_MUTATION_MULTI_CHAIN: i32 = 3;
 
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
@@ -161,6 +172,11 @@ pub struct MltRenderSettings {
     /// the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
     /// pass, the chains render every depth.
     pub direct_samples_per_mutation: u32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
+    /// `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among
+    /// those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
+    /// positive.
+    pub mutation_weights: [f32; 4],
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -185,6 +201,11 @@ pub struct MltRenderStats {
     pub normalization: f64,
     /// Metropolis: mutations made by all chains.
     pub mutations: u64,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: proposals of each mutation, indexed by
+    /// `MLT_MUTATION_*`.
+    pub mutations_proposed: [u64; 4],
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: accepted proposals of each mutation.
+    pub mutations_accepted: [u64; 4],
 }
 
 /// Facts about a created scene.
@@ -424,6 +445,7 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         large_step_probability: s.large_step_probability,
         small_step_sigma: s.small_step_sigma,
         direct_samples_per_mutation: s.direct_samples_per_mutation,
+        mutation_weights: MutationWeights(s.mutation_weights),
     })
 }
 
@@ -562,6 +584,7 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             large_step_probability: d.large_step_probability,
             small_step_sigma: d.small_step_sigma,
             direct_samples_per_mutation: d.direct_samples_per_mutation,
+            mutation_weights: d.mutation_weights.0,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;
@@ -754,6 +777,8 @@ pub unsafe extern "C" fn mlt_render_ex(
                 accepted_mutations: stats.accepted_mutations,
                 normalization: stats.normalization,
                 mutations: stats.mutations,
+                mutations_proposed: stats.mutation_counts.proposed,
+                mutations_accepted: stats.mutation_counts.accepted,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };

@@ -39,6 +39,7 @@ pub mod scene;
 pub mod io;
 
 pub use error::{Error, MltStatus, Result};
+pub use integrators::mlt::path_space::{Mutation, MutationCounts, MutationWeights};
 pub use render::{Algorithm, RenderSettings, RenderStats, StopReason, render};
 pub use scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
 

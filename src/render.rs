@@ -4,7 +4,9 @@
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
-use crate::integrators::mlt::path_space::{self, PathSpaceTarget};
+use crate::integrators::mlt::path_space::{
+    self, MutationCounts, MutationWeights, PathSpaceTarget, PerturbationSizes,
+};
 use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
@@ -125,6 +127,8 @@ impl Estimator<'_> {
                         min_depth: bdpt.min_depth,
                     }),
                     camera: *camera,
+                    weights: settings.mutation_weights,
+                    sizes: PerturbationSizes::for_image(camera.width, camera.height),
                 };
                 path_space::run(&target, &chains, film, control, &mut keep_pace)
             }
@@ -182,6 +186,11 @@ pub struct RenderSettings {
     /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
     /// pass; the chains render every depth.
     pub direct_samples_per_mutation: u32,
+    /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
+    /// lens, caustic and multi-chain perturbations (`Mutation as usize` order). Each step
+    /// picks among those the current path admits. The bidirectional weight must be
+    /// positive: it alone makes every path reachable.
+    pub mutation_weights: MutationWeights,
 }
 
 impl Default for RenderSettings {
@@ -201,6 +210,7 @@ impl Default for RenderSettings {
             large_step_probability: 0.3,
             small_step_sigma: 0.01,
             direct_samples_per_mutation: Self::DEFAULT_DIRECT_SAMPLES_PER_MUTATION,
+            mutation_weights: MutationWeights::default(),
         }
     }
 }
@@ -291,6 +301,21 @@ impl RenderSettings {
                 "settings.small_step_sigma is {sigma}; it must be in (0, 1]"
             )));
         }
+        let weights = self.mutation_weights.0;
+        if let Some((i, w)) = weights
+            .iter()
+            .enumerate()
+            .find(|&(_, &w)| !(w.is_finite() && (0.0..=1e6).contains(&w)))
+        {
+            return Err(Error::invalid(format!(
+                "settings.mutation_weights[{i}] is {w}; weights must be finite, from 0 to 1e6"
+            )));
+        }
+        if weights[0] <= 0.0 {
+            return Err(Error::invalid(
+                "settings.mutation_weights[0] (the bidirectional mutation) is 0; it must be positive, or the chains cannot reach every path",
+            ));
+        }
         Ok(())
     }
 
@@ -335,6 +360,8 @@ pub struct RenderStats {
     pub accepted_mutations: u64,
     /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by.
     pub normalization: f64,
+    /// Path-space MLT: proposals and acceptances per mutation.
+    pub mutation_counts: MutationCounts,
 }
 
 /// Called from the rendering call's own thread with the fraction done; return `false` to stop.
@@ -510,6 +537,7 @@ pub fn render(
         threads,
         accepted_mutations: metropolis.accepted,
         normalization: metropolis.normalization,
+        mutation_counts: metropolis.mutation_counts,
     })
 }
 

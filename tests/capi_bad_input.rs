@@ -1148,7 +1148,7 @@ fn metropolis_settings_out_of_range() {
         chains: 4,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 10] = [
+    let cases: [(MltRenderSettings, &[&str]); 13] = [
         (
             MltRenderSettings {
                 mutations_per_pixel: 0,
@@ -1220,6 +1220,27 @@ fn metropolis_settings_out_of_range() {
                 ..metropolis
             },
             &["small_step_sigma is inf"],
+        ),
+        (
+            MltRenderSettings {
+                mutation_weights: [0.5, f32::NAN, 0.25, 0.25],
+                ..metropolis
+            },
+            &["mutation_weights[1] is NaN"],
+        ),
+        (
+            MltRenderSettings {
+                mutation_weights: [0.5, 0.25, -1.0, 0.25],
+                ..metropolis
+            },
+            &["mutation_weights[2] is -1"],
+        ),
+        (
+            MltRenderSettings {
+                mutation_weights: [0.0, 1.0, 1.0, 1.0],
+                ..metropolis
+            },
+            &["mutation_weights[0]", "bidirectional", "positive"],
         ),
     ];
     for (settings, needles) in &cases {

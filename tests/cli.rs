@@ -130,6 +130,58 @@ fn the_default_algorithm_is_metropolis_and_its_summary_counts_mutations() {
 }
 
 #[test]
+fn path_space_mlt_takes_mutation_weights_and_reports_each_mutation() {
+    let out = temp_path("path-space.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"path-space-mlt",
+        &"--mutation-weights",
+        &"1,1,1,1",
+        &"--mutations-per-pixel",
+        &"4",
+        &"--bootstrap",
+        &"4096",
+        &"--chains",
+        &"64",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    let proposed = |name: &str| -> u64 {
+        let line = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(name) && l.contains("proposed"))
+            .unwrap_or_else(|| panic!("no {name:?} line in:\n{stdout}"));
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    let counts = ["bidirectional", "lens", "caustic", "multichain"].map(proposed);
+    // Glass has caustic and multi-chain paths: every mutation is tried, and they add up to
+    // the mutations made.
+    assert!(counts.iter().all(|&n| n > 0), "{counts:?} in:\n{stdout}");
+    assert_eq!(counts.iter().sum::<u64>(), 4 * 32 * 32, "{stdout}");
+    // A weight that would break ergodicity is refused with the reason.
+    let refused = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"path-space-mlt",
+        &"--mutation-weights",
+        &"0,1,1,1",
+        &"--out",
+        &out,
+    ]);
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("bidirectional"), "{stderr}");
+    std::fs::remove_file(&out).unwrap();
+}
+
+#[test]
 fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
     let out = temp_path("timed.png");
     let output = mlt_render(&[

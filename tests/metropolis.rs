@@ -80,10 +80,11 @@ fn furnace_matches_the_geometric_series(variant: Variant) {
     let renders: Vec<Vec<f32>> = (0..8)
         .map(|seed| {
             // Path-space chains change a path's length only through bidirectional
-            // mutations (no independent large steps), so without the direct pass they need
-            // more mutations to share their time between depths as finely.
+            // mutations (no independent large steps; perturbations keep the length), so
+            // without the direct pass they need more mutations to share their time between
+            // depths as finely.
             let mutations = if variant.algorithm == Algorithm::PathSpaceMlt {
-                128
+                512
             } else {
                 32
             };

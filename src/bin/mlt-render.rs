@@ -5,7 +5,7 @@
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mlt::io::{CameraFile, ImageFormat, SceneData};
-use mlt::{RenderSettings, RenderStats, Scene, StopReason};
+use mlt::{MutationWeights, RenderSettings, RenderStats, Scene, StopReason};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -50,6 +50,31 @@ impl From<mlt::Algorithm> for AlgorithmArg {
             mlt::Algorithm::PssmltBdpt => AlgorithmArg::PssmltBdpt,
             mlt::Algorithm::PathSpaceMlt => AlgorithmArg::PathSpaceMlt,
         }
+    }
+}
+
+/// Four comma-separated mutation weights.
+#[derive(Clone, Copy, Debug)]
+struct WeightsArg([f32; 4]);
+
+impl std::str::FromStr for WeightsArg {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, String> {
+        let values: Vec<f32> = text
+            .split(',')
+            .map(|v| v.trim().parse::<f32>().map_err(|e| format!("{v:?}: {e}")))
+            .collect::<Result<_, _>>()?;
+        <[f32; 4]>::try_from(values.as_slice())
+            .map(WeightsArg)
+            .map_err(|_| format!("four weights are needed, not {}", values.len()))
+    }
+}
+
+impl std::fmt::Display for WeightsArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        let [b, l, c, m] = self.0;
+        write!(f, "{b},{l},{c},{m}")
     }
 }
 
@@ -99,6 +124,10 @@ struct Args {
     /// seen, direct lighting) per chain mutation (0: the chains render every depth).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().direct_samples_per_mutation)]
     direct_per_mutation: u32,
+    /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
+    /// lens, caustic and multi-chain perturbations.
+    #[arg(long, value_name = "B,L,C,M", default_value_t = WeightsArg(RenderSettings::default().mutation_weights.0))]
+    mutation_weights: WeightsArg,
     /// Stop after this many seconds (0: no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
     time_limit: f64,
@@ -229,6 +258,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         large_step_probability: args.large_step,
         small_step_sigma: args.small_step,
         direct_samples_per_mutation: args.direct_per_mutation,
+        mutation_weights: MutationWeights(args.mutation_weights.0),
     }
 }
 
@@ -336,6 +366,20 @@ fn print_summary(
             stats.normalization,
             100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
         );
+    }
+    let counts = stats.mutation_counts;
+    if counts.proposed.iter().any(|&n| n > 0) {
+        for mutation in mlt::Mutation::ALL {
+            let (proposed, accepted) = (
+                counts.proposed[mutation as usize],
+                counts.accepted[mutation as usize],
+            );
+            println!(
+                "  {:<13} {proposed} proposed, {:.1}% accepted",
+                format!("{mutation:?}").to_lowercase(),
+                100.0 * accepted as f64 / proposed.max(1) as f64
+            );
+        }
     }
     if stats.invalid_samples > 0 {
         println!(

@@ -19,6 +19,37 @@ pub fn fresnel_dielectric(cos_i: f32, eta_i: f32, eta_t: f32) -> f32 {
     0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
 }
 
+/// The interface as seen from direction `wo`: the indices on wo's side and the other, the
+/// normal on wo's side and |cos θ|. The front side is outside (index 1), the back side
+/// inside (index `ior`). `None` for a grazing `wo`.
+struct Interface {
+    eta_i: f32,
+    eta_t: f32,
+    side_normal: Vec3A,
+    cos_i: f32,
+}
+
+impl Interface {
+    #[inline]
+    fn seen_from(ior: f32, normal: Vec3A, wo: Vec3A) -> Option<Interface> {
+        let cos_o = wo.dot(normal);
+        if cos_o == 0.0 {
+            return None;
+        }
+        let (eta_i, eta_t, side_normal) = if cos_o > 0.0 {
+            (1.0, ior, normal)
+        } else {
+            (ior, 1.0, -normal)
+        };
+        Some(Interface {
+            eta_i,
+            eta_t,
+            side_normal,
+            cos_i: cos_o.abs(),
+        })
+    }
+}
+
 /// Samples reflection with probability F and refraction with 1 − F, so the weight is the
 /// tint alone (times the radiance scaling (η_i/η_t)² on refraction in radiance mode).
 #[inline]
@@ -30,17 +61,12 @@ pub(super) fn sample(
     u_lobe: f32,
     mode: TransportMode,
 ) -> Option<ScatterSample> {
-    let cos_o = wo.dot(normal);
-    if cos_o == 0.0 {
-        return None;
-    }
-    // The front side is outside (index 1), the back side inside (index `ior`).
-    let (eta_i, eta_t, side_normal) = if cos_o > 0.0 {
-        (1.0, ior, normal)
-    } else {
-        (ior, 1.0, -normal)
-    };
-    let cos_i = cos_o.abs();
+    let Interface {
+        eta_i,
+        eta_t,
+        side_normal,
+        cos_i,
+    } = Interface::seen_from(ior, normal, wo)?;
     let fresnel = fresnel_dielectric(cos_i, eta_i, eta_t);
     if u_lobe < fresnel {
         return Some(ScatterSample {
@@ -51,10 +77,33 @@ pub(super) fn sample(
         });
     }
     let eta = eta_i / eta_t;
+    let wi = refract(wo, side_normal, cos_i, eta);
+    Some(refraction(wi, color, eta, fresnel, mode))
+}
+
+/// `wo` refracted through the surface (`side_normal` on wo's side, cos_i = wo · side_normal,
+/// eta = η_i/η_t), below the critical angle.
+#[inline]
+fn refract(wo: Vec3A, side_normal: Vec3A, cos_i: f32, eta: f32) -> Vec3A {
     let sin_t2 = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
     let cos_t = (1.0 - sin_t2).max(0.0).sqrt();
-    let wi = (-wo * eta + side_normal * (eta * cos_i - cos_t)).normalize();
-    Some(refraction(wi, color, eta, fresnel, mode))
+    (-wo * eta + side_normal * (eta * cos_i - cos_t)).normalize()
+}
+
+/// The refracted direction of `wo` through an interface of index `ior` (front side outside),
+/// or `None` under total internal reflection.
+#[inline]
+pub(super) fn refracted(ior: f32, normal: Vec3A, wo: Vec3A) -> Option<Vec3A> {
+    let Interface {
+        eta_i,
+        eta_t,
+        side_normal,
+        cos_i,
+    } = Interface::seen_from(ior, normal, wo)?;
+    if fresnel_dielectric(cos_i, eta_i, eta_t) >= 1.0 {
+        return None;
+    }
+    Some(refract(wo, side_normal, cos_i, eta_i / eta_t))
 }
 
 /// Refraction into `wi`, chosen with probability 1 − F: the weight is the tint, times the
@@ -144,6 +193,19 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn refracted_is_the_direction_sample_refracts_into() {
+        let n = Vec3A::new(0.2, 0.9, -0.1).normalize();
+        for wo in [Vec3A::new(0.5, 0.8, 0.1), Vec3A::new(-0.3, -0.6, 0.4)] {
+            let wo = wo.normalize();
+            let s = sample(1.5, Vec3A::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
+            assert_eq!(refracted(1.5, n, wo), Some(s.wi));
+        }
+        // Beyond the critical angle from inside: no refraction.
+        let grazing = Vec3A::new(0.9, -0.3, 0.0).normalize();
+        assert_eq!(refracted(1.5, Vec3A::Y, grazing), None);
     }
 
     #[test]

@@ -135,6 +135,45 @@ pub fn scatter(
     }
 }
 
+/// The lobe of a specular scattering: whether `wi` stays on `wo`'s side of the surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpecularLobe {
+    Reflection,
+    Refraction,
+}
+
+impl SpecularLobe {
+    /// The lobe that scatters `wo` into `wi` at a surface with normal `normal`.
+    #[inline]
+    pub fn of(normal: Vec3A, wo: Vec3A, wi: Vec3A) -> SpecularLobe {
+        if wo.dot(normal) * wi.dot(normal) > 0.0 {
+            SpecularLobe::Reflection
+        } else {
+            SpecularLobe::Refraction
+        }
+    }
+}
+
+/// The direction a specular material scatters `wo` into through `lobe`, or `None` if it
+/// has no such lobe (a mirror's refraction, total internal reflection).
+#[inline]
+pub fn specular_direction(
+    material: &Material,
+    normal: Vec3A,
+    wo: Vec3A,
+    lobe: SpecularLobe,
+) -> Option<Vec3A> {
+    match (material.kind, lobe) {
+        (MaterialKind::Mirror | MaterialKind::Dielectric, SpecularLobe::Reflection) => {
+            Some(reflect(wo, normal))
+        }
+        (MaterialKind::Dielectric, SpecularLobe::Refraction) => {
+            dielectric::refracted(material.ior, normal, wo)
+        }
+        _ => None,
+    }
+}
+
 /// Mirror reflection of `wo` about `normal` (either orientation).
 #[inline]
 pub fn reflect(wo: Vec3A, normal: Vec3A) -> Vec3A {

@@ -27,6 +27,7 @@
 //! to the film in chain order after the round.
 
 use super::acceptance;
+use super::path_space::MutationCounts;
 use super::pss::PssSampler;
 use crate::film::Film;
 use crate::integrators::Splat;
@@ -71,6 +72,8 @@ pub struct PssmltOutcome {
     pub accepted: u64,
     /// The normalization b = ∫ f (summed over chain groups) the image is scaled by.
     pub normalization: f64,
+    /// Path-space chains: proposals and acceptances per mutation.
+    pub mutation_counts: MutationCounts,
 }
 
 /// What one state of a chain contributes to the image: a few (pixel, value) entries and the
@@ -189,6 +192,10 @@ pub(crate) trait MarkovChain: Send {
     fn rays(&self) -> u64;
     /// Most deposits one mutation makes.
     fn max_deposits(&self) -> usize;
+    /// Proposals and acceptances per mutation, for chains with several (path space).
+    fn mutation_counts(&self) -> MutationCounts {
+        MutationCounts::default()
+    }
 }
 
 /// A chain of a render with its weight (b_g / chains of its group: every deposit's factor)
@@ -630,6 +637,11 @@ pub(crate) fn run_rounds<C: MarkovChain>(
     for chain in chains.iter() {
         outcome.accepted += chain.chain.accepted();
         rays += chain.chain.rays();
+        let counts = chain.chain.mutation_counts();
+        for m in 0..counts.proposed.len() {
+            outcome.mutation_counts.proposed[m] += counts.proposed[m];
+            outcome.mutation_counts.accepted[m] += counts.accepted[m];
+        }
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
     if mutations_done > 0 {

@@ -40,7 +40,7 @@
 use super::{PathSpace, PathVertex};
 use crate::accel::Ray;
 use crate::bsdf::{self, TransportMode};
-use crate::integrators::{shadow_ray, spawn_ray};
+use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
 use glam::Vec3A;
 
@@ -114,36 +114,6 @@ pub(crate) fn split_density_sum(
         .sum()
 }
 
-/// The vertex a ray from `from` hits, or `None` if it escapes.
-#[inline]
-fn trace(space: &PathSpace, ray: &Ray, rays: &mut u64) -> Option<PathVertex> {
-    *rays += 1;
-    let hit = space.scene.accel.intersect(ray)?;
-    Some(PathVertex {
-        p: ray.origin + ray.direction * hit.t,
-        normal: space.scene.shading[hit.triangle as usize].normal,
-        triangle: hit.triangle,
-    })
-}
-
-/// Whether nothing blocks the segment between two vertices (`lens` marks a lens vertex,
-/// which has no surface to offset from).
-#[inline]
-fn visible(
-    space: &PathSpace,
-    a: &PathVertex,
-    b: &PathVertex,
-    b_is_lens: bool,
-    rays: &mut u64,
-) -> bool {
-    let normal_b = if b_is_lens { Vec3A::ZERO } else { b.normal };
-    let Some(ray) = shadow_ray(space.scene, a.p, a.normal, b.p, normal_b) else {
-        return false;
-    };
-    *rays += 1;
-    !space.scene.accel.occluded(&ray)
-}
-
 /// A proposal's outcome: the new path is in the output buffer, with this acceptance
 /// ratio's factor f(y)T(y→x) / (f(x)T(x→y)).
 pub(crate) struct Proposal {
@@ -206,7 +176,7 @@ impl Bidirectional {
         debug_assert_eq!(y.len(), n_new);
         if s >= 1 && s < y.len() {
             let lens_index = y.len() - 1;
-            if !visible(space, &y[s - 1], &y[s], s == lens_index, rays) {
+            if !space.visible(&y[s - 1], &y[s], s == lens_index, rays) {
                 return None;
             }
         }
@@ -253,15 +223,11 @@ impl Bidirectional {
                     return None;
                 }
                 let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
-                trace(
-                    space,
-                    &spawn_ray(scene, light.p, light.normal, direction),
-                    rays,
-                )
+                space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
             }
             [.., previous, end] => {
                 let wi = sample_direction(space, previous, end, TransportMode::Importance, rng)?;
-                trace(space, &spawn_ray(scene, end.p, end.normal, wi), rays)
+                space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)
             }
         }
     }
@@ -301,10 +267,10 @@ impl Bidirectional {
             let [u, v] = rng.uniform2();
             let direction =
                 camera.direction_through(end.p, u * camera.width as f32, v * camera.height as f32);
-            return trace(space, &Ray::new(end.p, direction, 0.0, f32::INFINITY), rays);
+            return space.trace(&Ray::new(end.p, direction, 0.0, f32::INFINITY), rays);
         };
         let wi = sample_direction(space, previous, end, TransportMode::Radiance, rng)?;
-        trace(space, &spawn_ray(space.scene, end.p, end.normal, wi), rays)
+        space.trace(&spawn_ray(space.scene, end.p, end.normal, wi), rays)
     }
 }
 

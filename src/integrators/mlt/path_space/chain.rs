@@ -3,6 +3,7 @@
 //! the primary-sample-space chains (`pssmlt::run_rounds`).
 
 use super::bidirectional::Bidirectional;
+use super::perturbation::{self, PerturbationSizes};
 use super::{PathSpace, PathVertex};
 use crate::film::Film;
 use crate::integrators::Splat;
@@ -21,10 +22,49 @@ use std::marker::PhantomData;
 const CHAIN_STREAM: u64 = 0x5eed_9a7b_0000_0000;
 const SEED_CHOICE_STREAM: u64 = 0x5eed_9a7c_0000_0000;
 
+/// The mutations of a path-space chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mutation {
+    Bidirectional = 0,
+    Lens = 1,
+    Caustic = 2,
+    MultiChain = 3,
+}
+
+impl Mutation {
+    pub const ALL: [Mutation; 4] = [
+        Mutation::Bidirectional,
+        Mutation::Lens,
+        Mutation::Caustic,
+        Mutation::MultiChain,
+    ];
+}
+
+/// Relative probabilities of the mutations; each step picks among those the current path
+/// admits (the bidirectional mutation always applies; exactly one of the lens and
+/// multi-chain perturbations does; the caustic perturbation needs `… D S+ D E`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MutationWeights(pub [f32; 4]);
+
+impl Default for MutationWeights {
+    fn default() -> Self {
+        MutationWeights([0.5, 0.25, 0.25, 0.25])
+    }
+}
+
+/// Proposals and acceptances per mutation (indexed by `Mutation as usize`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MutationCounts {
+    pub proposed: [u64; 4],
+    pub accepted: [u64; 4],
+}
+
 /// What the chains explore: paths of the scene through the camera, within a depth range.
 pub(crate) struct PathSpaceTarget<'a> {
     pub bdpt: BdptAllStrategies<'a>,
     pub camera: CameraModel,
+    pub weights: MutationWeights,
+    pub sizes: PerturbationSizes,
 }
 
 impl PathSpaceTarget<'_> {
@@ -33,6 +73,20 @@ impl PathSpaceTarget<'_> {
             scene: self.bdpt.0.scene,
             camera: &self.camera,
         }
+    }
+
+    /// The probability of each mutation at path `x`.
+    fn mutation_probabilities(&self, space: &PathSpace, x: &[PathVertex]) -> [f32; 4] {
+        let admits = perturbation::applicable(space, x);
+        let [b, l, c, m] = self.weights.0;
+        let w = [
+            b,
+            if admits.lens { l } else { 0.0 },
+            if admits.caustic { c } else { 0.0 },
+            if admits.lens { 0.0 } else { m },
+        ];
+        let total: f32 = w.iter().sum();
+        w.map(|x| if total > 0.0 { x / total } else { 0.0 })
     }
 
     fn bidirectional(&self) -> Bidirectional {
@@ -52,6 +106,7 @@ pub(crate) struct PathChain<'a> {
     proposal_sample: PathSample,
     eye: Vec<PathVertex>,
     accepted: u64,
+    counts: MutationCounts,
     rays: u64,
     _target: PhantomData<&'a ()>,
 }
@@ -63,14 +118,40 @@ impl<'a> MarkovChain for PathChain<'a> {
     fn mutate(&mut self, target: &PathSpaceTarget<'a>, _: &CameraModel, deposits: &mut Vec<Splat>) {
         let space = target.space();
         self.proposal_sample.clear();
-        let proposal = target.bidirectional().propose(
-            &space,
-            &self.current,
-            &mut self.proposal,
-            &mut self.eye,
-            &mut self.rng,
-            &mut self.rays,
-        );
+        // Pick a mutation among those the current path admits.
+        let probabilities = if self.current.len() >= 2 {
+            target.mutation_probabilities(&space, &self.current)
+        } else {
+            [1.0, 0.0, 0.0, 0.0]
+        };
+        let mut u = self.rng.uniform();
+        let mutation = Mutation::ALL
+            .into_iter()
+            .find(|&m| {
+                u -= probabilities[m as usize];
+                u < 0.0 && probabilities[m as usize] > 0.0
+            })
+            .unwrap_or(Mutation::Bidirectional);
+        self.counts.proposed[mutation as usize] += 1;
+        let (rng, rays) = (&mut self.rng, &mut self.rays);
+        let (x, y) = (&self.current, &mut self.proposal);
+        let proposal = match mutation {
+            Mutation::Bidirectional => target
+                .bidirectional()
+                .propose(&space, x, y, &mut self.eye, rng, rays)
+                .map(|mut p| {
+                    // The bidirectional mutation may change which perturbations apply, and
+                    // with them its own probability of being picked.
+                    let reverse = target.mutation_probabilities(&space, y)[0];
+                    p.ratio *= reverse / probabilities[0];
+                    p
+                }),
+            Mutation::Lens => perturbation::lens(&space, &target.sizes, false, x, y, rng, rays),
+            Mutation::MultiChain => {
+                perturbation::lens(&space, &target.sizes, true, x, y, rng, rays)
+            }
+            Mutation::Caustic => perturbation::caustic(&space, &target.sizes, x, y, rng, rays),
+        };
         let a = match proposal {
             Some(proposal) => {
                 self.proposal_sample.push(proposal.pixel, proposal.value);
@@ -96,6 +177,7 @@ impl<'a> MarkovChain for PathChain<'a> {
             std::mem::swap(&mut self.current, &mut self.proposal);
             std::mem::swap(&mut self.current_sample, &mut self.proposal_sample);
             self.accepted += 1;
+            self.counts.accepted[mutation as usize] += 1;
         }
     }
 
@@ -109,6 +191,10 @@ impl<'a> MarkovChain for PathChain<'a> {
 
     fn max_deposits(&self) -> usize {
         2
+    }
+
+    fn mutation_counts(&self) -> MutationCounts {
+        self.counts
     }
 }
 
@@ -168,6 +254,7 @@ pub(crate) fn run(
                 proposal_sample: PathSample::with_capacity(1),
                 eye: Vec::with_capacity(max_vertices),
                 accepted: 0,
+                counts: MutationCounts::default(),
                 rays,
                 _target: PhantomData,
             };

@@ -29,8 +29,11 @@
 
 mod bidirectional;
 mod chain;
+mod perturbation;
 
+pub use chain::{Mutation, MutationCounts, MutationWeights};
 pub(crate) use chain::{PathSpaceTarget, run};
+pub(crate) use perturbation::PerturbationSizes;
 
 use crate::bsdf::{self, TransportMode};
 use crate::scene::{CameraModel, MaterialKind, Scene};
@@ -54,7 +57,8 @@ pub(crate) struct PathSpace<'a> {
     pub camera: &'a CameraModel,
 }
 
-/// The unit direction from `from` to `to`, or `None` for coincident points.
+/// The unit direction from `from` to `to` and the squared distance, or `None` for
+/// coincident points.
 #[inline]
 fn direction(from: &PathVertex, to: &PathVertex) -> Option<(Vec3A, f32)> {
     let d = to.p - from.p;
@@ -72,6 +76,31 @@ impl PathSpace<'_> {
     #[inline]
     fn is_specular(&self, v: &PathVertex) -> bool {
         self.material(v).kind != MaterialKind::Diffuse
+    }
+
+    /// The vertex `ray` hits first, or `None` if it escapes.
+    #[inline]
+    fn trace(&self, ray: &crate::accel::Ray, rays: &mut u64) -> Option<PathVertex> {
+        *rays += 1;
+        let hit = self.scene.accel.intersect(ray)?;
+        Some(PathVertex {
+            p: ray.origin + ray.direction * hit.t,
+            normal: self.scene.shading[hit.triangle as usize].normal,
+            triangle: hit.triangle,
+        })
+    }
+
+    /// Whether nothing blocks the segment between two vertices (`b_is_lens`: b is the lens,
+    /// which has no surface to offset from).
+    #[inline]
+    fn visible(&self, a: &PathVertex, b: &PathVertex, b_is_lens: bool, rays: &mut u64) -> bool {
+        let normal_b = if b_is_lens { Vec3A::ZERO } else { b.normal };
+        let Some(ray) = crate::integrators::shadow_ray(self.scene, a.p, a.normal, b.p, normal_b)
+        else {
+            return false;
+        };
+        *rays += 1;
+        !self.scene.accel.occluded(&ray)
     }
 
     /// The pixel the path's last edge (from the lens) lands in.
