@@ -3,7 +3,7 @@
 //! the primary-sample-space chains (`pssmlt::run_rounds`).
 
 use super::bidirectional::Bidirectional;
-use super::perturbation::{self, PerturbationSizes};
+use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
 use crate::film::Film;
 use crate::integrators::Splat;
@@ -146,11 +146,21 @@ impl<'a> MarkovChain for PathChain<'a> {
                     p.ratio *= reverse / probabilities[0];
                     p
                 }),
-            Mutation::Lens => perturbation::lens(&space, &target.sizes, false, x, y, rng, rays),
-            Mutation::MultiChain => {
-                perturbation::lens(&space, &target.sizes, true, x, y, rng, rays)
+            Mutation::Lens | Mutation::MultiChain => {
+                let mut kernel = RandomKernel {
+                    sizes: &target.sizes,
+                    rng,
+                };
+                let multi_chain = mutation == Mutation::MultiChain;
+                perturbation::lens(&space, &mut kernel, multi_chain, x, y, rays)
             }
-            Mutation::Caustic => perturbation::caustic(&space, &target.sizes, x, y, rng, rays),
+            Mutation::Caustic => {
+                let mut kernel = RandomKernel {
+                    sizes: &target.sizes,
+                    rng,
+                };
+                perturbation::caustic(&space, &mut kernel, x, y, rays)
+            }
         };
         let a = match proposal {
             Some(proposal) => {

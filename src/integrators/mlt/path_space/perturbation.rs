@@ -93,6 +93,34 @@ fn perturb_direction(w: Vec3A, sizes: &PerturbationSizes, rng: &mut Rng) -> Vec3
     basis.to_world(local).normalize()
 }
 
+/// Where a perturbation's random moves come from.
+pub(crate) trait Kernel {
+    /// An offset of the film position, in pixels.
+    fn film_offset(&mut self) -> [f32; 2];
+    /// A direction near `old`.
+    fn direction(&mut self, old: Vec3A) -> Vec3A;
+}
+
+/// The perturbations' kernels: symmetric, of the given sizes.
+pub(crate) struct RandomKernel<'a> {
+    pub sizes: &'a PerturbationSizes,
+    pub rng: &'a mut Rng,
+}
+
+impl Kernel for RandomKernel<'_> {
+    #[inline]
+    fn film_offset(&mut self) -> [f32; 2] {
+        let radius = log_uniform(self.sizes.film_min, self.sizes.film_max, self.rng.uniform());
+        let phi = TAU * self.rng.uniform();
+        [radius * phi.cos(), radius * phi.sin()]
+    }
+
+    #[inline]
+    fn direction(&mut self, old: Vec3A) -> Vec3A {
+        perturb_direction(old, self.sizes, self.rng)
+    }
+}
+
 /// The first non-specular vertex before the lens (the light, x_0, at the latest).
 #[inline]
 fn first_non_specular_from_lens(space: &PathSpace, x: &[PathVertex]) -> usize {
@@ -150,11 +178,10 @@ fn direction_density(
 /// path's pattern).
 pub(crate) fn lens(
     space: &PathSpace,
-    sizes: &PerturbationSizes,
+    kernel: &mut impl Kernel,
     multi_chain: bool,
     x: &[PathVertex],
     y: &mut Vec<PathVertex>,
-    rng: &mut Rng,
     rays: &mut u64,
 ) -> Option<Proposal> {
     let n = x.len();
@@ -165,9 +192,8 @@ pub(crate) fn lens(
     let lens = &x[n - 1];
     let (to_scene, _) = direction(lens, &x[n - 2])?;
     let [fx, fy] = camera.raster_position(lens.p, to_scene)?;
-    let radius = log_uniform(sizes.film_min, sizes.film_max, rng.uniform());
-    let phi = TAU * rng.uniform();
-    let (fx, fy) = (fx + radius * phi.cos(), fy + radius * phi.sin());
+    let [dx, dy] = kernel.film_offset();
+    let (fx, fy) = (fx + dx, fy + dy);
     if !(0.0..camera.width as f32).contains(&fx) || !(0.0..camera.height as f32).contains(&fy) {
         return None;
     }
@@ -214,7 +240,7 @@ pub(crate) fn lens(
         }
         // Multi-chain: perturb the direction onwards and trace the next specular chain.
         let (old, _) = direction(&x[k], &x[k - 1])?;
-        let new = perturb_direction(old, sizes, rng);
+        let new = kernel.direction(old);
         ray = spawn_ray(space.scene, v.p, v.normal, new);
         // The density C_s divides by at this vertex: the BSDF's, from the lens side.
         density_y *= direction_density(space, Some(&y[k + 1]), &y[k], new);
@@ -227,10 +253,9 @@ pub(crate) fn lens(
 /// The caustic perturbation of `x` into `y` (see the module documentation).
 pub(crate) fn caustic(
     space: &PathSpace,
-    sizes: &PerturbationSizes,
+    kernel: &mut impl Kernel,
     x: &[PathVertex],
     y: &mut Vec<PathVertex>,
-    rng: &mut Rng,
     rays: &mut u64,
 ) -> Option<Proposal> {
     let n = x.len();
@@ -243,7 +268,7 @@ pub(crate) fn caustic(
         .find(|&k| !space.is_specular(&x[k]))
         .unwrap_or(0);
     let (old, _) = direction(&x[c], &x[c + 1])?;
-    let new = perturb_direction(old, sizes, rng);
+    let new = kernel.direction(old);
     let from = c.checked_sub(1).map(|i| &x[i]);
     let density_y = direction_density(space, from, &x[c], new);
     let density_x = direction_density(space, from, &x[c], old);
@@ -295,4 +320,219 @@ fn proposal(
         value,
         pixel,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Backend, Camera, CameraModel, Material, Scene, SceneDesc};
+
+    /// Fixed moves, to set up a given proposal.
+    struct FixedKernel {
+        film_offset: [f32; 2],
+        direction: Vec3A,
+    }
+
+    impl Kernel for FixedKernel {
+        fn film_offset(&mut self) -> [f32; 2] {
+            self.film_offset
+        }
+        fn direction(&mut self, _: Vec3A) -> Vec3A {
+            self.direction
+        }
+    }
+
+    /// A room corner: a diffuse floor (y = 0) and back wall (z = -3), a mirror (x = 2.5,
+    /// facing -x) and a small light under the ceiling facing down; materials 0 diffuse,
+    /// 1 mirror, 2 light.
+    fn corner() -> Scene {
+        let mut positions = Vec::new();
+        let mut indices = Vec::new();
+        let mut material_ids = Vec::new();
+        // A quad from corner `o` spanned by `a` and `b`, front side along a × b.
+        let mut quad = |o: [f32; 3], a: [f32; 3], b: [f32; 3], material: u32| {
+            let base = (positions.len() / 3) as u32;
+            for (s, t) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                for axis in 0..3 {
+                    positions.push(o[axis] + s * a[axis] + t * b[axis]);
+                }
+            }
+            indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+            material_ids.extend_from_slice(&[material, material]);
+        };
+        quad([-3.0, 0.0, 3.0], [6.0, 0.0, 0.0], [0.0, 0.0, -6.0], 0); // floor, up
+        quad([-3.0, 0.0, -3.0], [6.0, 0.0, 0.0], [0.0, 3.0, 0.0], 0); // wall, +z
+        quad([2.5, 0.0, -2.0], [0.0, 0.0, 4.0], [0.0, 2.5, 0.0], 1); // mirror, -x
+        quad([-0.5, 2.9, -2.8], [1.0, 0.0, 0.0], [0.0, 0.0, 0.5], 2); // light, down
+        Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &indices,
+            material_ids: &material_ids,
+            materials: &[
+                Material::diffuse([0.7, 0.6, 0.5]),
+                Material::mirror([0.9, 0.9, 0.9]),
+                Material::diffuse([0.0; 3]).with_emission([5.0, 5.0, 5.0]),
+            ],
+            backend: Backend::Bvh,
+        })
+        .unwrap()
+    }
+
+    fn camera() -> CameraModel {
+        Camera {
+            eye: [-2.0, 1.6, 1.5],
+            target: [2.5, 1.0, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 40.0,
+            lens_radius: 0.0,
+            focus_distance: 0.0,
+        }
+        .model(64, 64)
+    }
+
+    fn vertex(space: &PathSpace, ray: &Ray) -> PathVertex {
+        space.trace(ray, &mut 0).expect("the ray hits")
+    }
+
+    /// G between two surface vertices.
+    fn geometry(a: &PathVertex, b: &PathVertex) -> f32 {
+        let (w, d2) = direction(a, b).unwrap();
+        w.dot(a.normal).abs() * w.dot(b.normal).abs() / d2
+    }
+
+    /// The seed's walk-through: a lens perturbation of an L D D S E path. Parametrized by
+    /// the film point (with the light and wall vertices fixed), the move is symmetric, and
+    /// the path's contribution per unit of film area changes only through the connection
+    /// from the floor to the wall (diffuse BSDFs are constant): the acceptance ratio is
+    /// G(x1, y2) / G(x1, x2), cos θ₁ cos θ₂ / d² of the changed diffuse–diffuse connection.
+    #[test]
+    fn lens_perturbation_of_the_seeds_l_d_d_s_e_path() {
+        let scene = corner();
+        let camera = camera();
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+        };
+        let eye = PathVertex {
+            p: camera.eye,
+            normal: camera.forward,
+            triangle: 0,
+        };
+        // Lens → mirror → floor, then the wall and the light by hand.
+        let to_mirror = camera.direction_through(eye.p, 30.0, 36.0);
+        let mirror = vertex(&space, &Ray::new(eye.p, to_mirror, 0.0, f32::INFINITY));
+        assert!(space.is_specular(&mirror));
+        let reflected = bsdf::reflect(-to_mirror, mirror.normal);
+        let floor = vertex(
+            &space,
+            &spawn_ray(&scene, mirror.p, mirror.normal, reflected),
+        );
+        assert_eq!(floor.normal, Vec3A::Y, "the mirror sees the floor");
+        let wall = vertex(
+            &space,
+            &Ray::new(Vec3A::new(0.0, 1.5, 0.0), -Vec3A::Z, 0.0, f32::INFINITY),
+        );
+        let light = vertex(
+            &space,
+            &Ray::new(Vec3A::new(0.0, 1.0, -2.55), Vec3A::Y, 0.0, f32::INFINITY),
+        );
+        let x = [light, wall, floor, mirror, eye];
+        assert!(space.unweighted_contribution(&x, 2, false).is_some());
+        assert!(applicable(&space, &x).lens);
+        for offset in [[1.5, -0.7], [-4.0, 3.0], [0.3, 0.2]] {
+            let mut kernel = FixedKernel {
+                film_offset: offset,
+                direction: Vec3A::ZERO,
+            };
+            let mut y = Vec::new();
+            let proposal = lens(&space, &mut kernel, false, &x, &mut y, &mut 0)
+                .expect("the perturbed path is valid");
+            assert_eq!(&y[..2], &x[..2], "the light side is kept");
+            assert_eq!(y[4], x[4], "the lens point is kept");
+            assert!(space.is_specular(&y[3]) && y[2].normal == Vec3A::Y);
+            let expected = geometry(&x[1], &y[2]) / geometry(&x[1], &x[2]);
+            assert!(
+                (proposal.ratio / expected - 1.0).abs() < 1e-4,
+                "offset {offset:?}: ratio {} vs {expected}",
+                proposal.ratio
+            );
+            assert!(
+                (expected - 1.0).abs() > 1e-3,
+                "the move changes the connection"
+            );
+        }
+    }
+
+    /// A caustic perturbation of an L S D E path (light → mirror → floor → lens).
+    /// Parametrized by the light point and its emitted direction (projected solid angle),
+    /// the move is symmetric, and the contribution is Le·cos θ_light · ρ · f_floor ·
+    /// G(floor, lens) · We: the ratio is that of cos θ_light · G(floor, lens) · We.
+    #[test]
+    fn caustic_perturbation_matches_the_contribution_per_emitted_direction() {
+        let scene = corner();
+        let camera = camera();
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+        };
+        let eye = PathVertex {
+            p: camera.eye,
+            normal: camera.forward,
+            triangle: 0,
+        };
+        let light = vertex(
+            &space,
+            &Ray::new(Vec3A::new(0.0, 1.0, -2.55), Vec3A::Y, 0.0, f32::INFINITY),
+        );
+        // From the light down to the mirror, reflected onto the floor.
+        let to_mirror = (Vec3A::new(2.5, 0.83, -1.09) - light.p).normalize();
+        let mirror = vertex(&space, &spawn_ray(&scene, light.p, light.normal, to_mirror));
+        assert!(space.is_specular(&mirror));
+        let reflected = bsdf::reflect(-to_mirror, mirror.normal);
+        let floor = vertex(
+            &space,
+            &spawn_ray(&scene, mirror.p, mirror.normal, reflected),
+        );
+        assert_eq!(floor.normal, Vec3A::Y);
+        let x = [light, mirror, floor, eye];
+        assert!(applicable(&space, &x).caustic);
+        assert!(
+            space.unweighted_contribution(&x, 3, false).is_some(),
+            "{x:?} pixel {:?}",
+            space.pixel(&x)
+        );
+        let parametrized = |path: &[PathVertex]| {
+            let (w, _) = direction(&path[0], &path[1]).unwrap();
+            let (to_floor, d2) = direction(&path[3], &path[2]).unwrap();
+            let importance = camera.importance(path[3].p, to_floor).unwrap().importance;
+            let g = to_floor.dot(camera.forward) * to_floor.dot(path[2].normal).abs() / d2;
+            w.dot(path[0].normal) * g * importance
+        };
+        for (angle, axis) in [(0.02f32, Vec3A::X), (0.05, Vec3A::Z), (0.01, Vec3A::Y)] {
+            let rotated =
+                glam::Quat::from_axis_angle(axis.into(), angle) * glam::Vec3::from(to_mirror);
+            let mut kernel = FixedKernel {
+                film_offset: [0.0; 2],
+                direction: Vec3A::from(rotated),
+            };
+            let mut y = Vec::new();
+            let proposal =
+                caustic(&space, &mut kernel, &x, &mut y, &mut 0).expect("a valid caustic path");
+            assert_eq!(
+                (y[0], y[3]),
+                (x[0], x[3]),
+                "the light point and the lens are kept"
+            );
+            let expected = parametrized(&y) / parametrized(&x);
+            assert!(
+                (proposal.ratio / expected - 1.0).abs() < 1e-4,
+                "angle {angle} about {axis}: ratio {} vs {expected}",
+                proposal.ratio
+            );
+            assert!(
+                (expected - 1.0).abs() > 1e-4,
+                "the move changes the contribution"
+            );
+        }
+    }
 }
