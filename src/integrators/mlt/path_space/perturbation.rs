@@ -205,8 +205,6 @@ pub(crate) fn lens(
         0.0,
         f32::INFINITY,
     );
-    // Densities of the perturbed directions (multi-chain), in y and in x.
-    let (mut density_y, mut density_x) = (1.0f32, 1.0f32);
     let mut k = n - 2;
     let s = loop {
         let v = space.trace(&ray, rays)?;
@@ -242,12 +240,26 @@ pub(crate) fn lens(
         let (old, _) = direction(&x[k], &x[k - 1])?;
         let new = kernel.direction(old);
         ray = spawn_ray(space.scene, v.p, v.normal, new);
-        // The density C_s divides by at this vertex: the BSDF's, from the lens side.
-        density_y *= direction_density(space, Some(&y[k + 1]), &y[k], new);
-        density_x *= direction_density(space, Some(&x[k + 1]), &x[k], old);
         k -= 1;
     };
+    let density_y = multi_chain_densities(space, y, s);
+    let density_x = multi_chain_densities(space, x, s);
     proposal(space, x, y, s, density_x, density_y)
+}
+
+/// The product, over the non-specular vertices of the lens side (after the first s) whose
+/// successor towards the light is specular, of the BSDF density of the direction onwards:
+/// the vertices where the multi-chain perturbation turned the path (none for the lens
+/// perturbation). Taken from the vertices, as C_s takes its directions.
+fn multi_chain_densities(space: &PathSpace, path: &[PathVertex], s: usize) -> f32 {
+    let n = path.len();
+    (s.max(1)..n - 1)
+        .filter(|&k| !space.is_specular(&path[k]) && space.is_specular(&path[k - 1]))
+        .map(|k| match direction(&path[k], &path[k - 1]) {
+            Some((onwards, _)) => direction_density(space, Some(&path[k + 1]), &path[k], onwards),
+            None => 0.0,
+        })
+        .product()
 }
 
 /// The caustic perturbation of `x` into `y` (see the module documentation).
@@ -270,9 +282,7 @@ pub(crate) fn caustic(
     let (old, _) = direction(&x[c], &x[c + 1])?;
     let new = kernel.direction(old);
     let from = c.checked_sub(1).map(|i| &x[i]);
-    let density_y = direction_density(space, from, &x[c], new);
-    let density_x = direction_density(space, from, &x[c], old);
-    if density_y <= 0.0 {
+    if direction_density(space, from, &x[c], new) <= 0.0 {
         return None;
     }
     y.clear();
@@ -298,7 +308,12 @@ pub(crate) fn caustic(
     if !space.visible(&y[n - 2], &y[n - 1], true, rays) {
         return None;
     }
-    proposal(space, x, y, n - 1, density_x, density_y)
+    // The densities C_s divided by at x_c, from the vertices as C_s takes them.
+    let density = |path: &[PathVertex]| match direction(&path[c], &path[c + 1]) {
+        Some((onwards, _)) => direction_density(space, from, &path[c], onwards),
+        None => 0.0,
+    };
+    proposal(space, x, y, n - 1, density(x), density(y))
 }
 
 /// The proposal y of a perturbation of x that kept s light vertices, with the densities of
@@ -327,22 +342,24 @@ mod tests {
     use super::*;
     use crate::scene::{Backend, Camera, CameraModel, Material, Scene, SceneDesc};
 
-    /// Fixed moves, to set up a given proposal.
+    /// Fixed moves, to set up a given proposal: a film offset, and directions turned by a
+    /// fixed rotation.
     struct FixedKernel {
         film_offset: [f32; 2],
-        direction: Vec3A,
+        rotation: glam::Quat,
     }
 
     impl Kernel for FixedKernel {
         fn film_offset(&mut self) -> [f32; 2] {
             self.film_offset
         }
-        fn direction(&mut self, _: Vec3A) -> Vec3A {
-            self.direction
+        fn direction(&mut self, old: Vec3A) -> Vec3A {
+            Vec3A::from(self.rotation * glam::Vec3::from(old))
         }
     }
 
-    /// A room corner: a diffuse floor (y = 0) and back wall (z = -3), a mirror (x = 2.5,
+    /// A room corner: a diffuse floor (y = 0), back wall (z = -3) and left wall (x = -3), a
+    /// mirror (x = 2.5,
     /// facing -x) and a small light under the ceiling facing down; materials 0 diffuse,
     /// 1 mirror, 2 light.
     fn corner() -> Scene {
@@ -361,7 +378,8 @@ mod tests {
             material_ids.extend_from_slice(&[material, material]);
         };
         quad([-3.0, 0.0, 3.0], [6.0, 0.0, 0.0], [0.0, 0.0, -6.0], 0); // floor, up
-        quad([-3.0, 0.0, -3.0], [6.0, 0.0, 0.0], [0.0, 3.0, 0.0], 0); // wall, +z
+        quad([-3.0, 0.0, -3.0], [6.0, 0.0, 0.0], [0.0, 3.0, 0.0], 0); // back wall, +z
+        quad([-3.0, 0.0, 3.0], [0.0, 0.0, -6.0], [0.0, 3.0, 0.0], 0); // left wall, +x
         quad([2.5, 0.0, -2.0], [0.0, 0.0, 4.0], [0.0, 2.5, 0.0], 1); // mirror, -x
         quad([-0.5, 2.9, -2.8], [1.0, 0.0, 0.0], [0.0, 0.0, 0.5], 2); // light, down
         Scene::new(&SceneDesc {
@@ -442,7 +460,7 @@ mod tests {
         for offset in [[1.5, -0.7], [-4.0, 3.0], [0.3, 0.2]] {
             let mut kernel = FixedKernel {
                 film_offset: offset,
-                direction: Vec3A::ZERO,
+                rotation: glam::Quat::IDENTITY,
             };
             let mut y = Vec::new();
             let proposal = lens(&space, &mut kernel, false, &x, &mut y, &mut 0)
@@ -509,11 +527,9 @@ mod tests {
             w.dot(path[0].normal) * g * importance
         };
         for (angle, axis) in [(0.02f32, Vec3A::X), (0.05, Vec3A::Z), (0.01, Vec3A::Y)] {
-            let rotated =
-                glam::Quat::from_axis_angle(axis.into(), angle) * glam::Vec3::from(to_mirror);
             let mut kernel = FixedKernel {
                 film_offset: [0.0; 2],
-                direction: Vec3A::from(rotated),
+                rotation: glam::Quat::from_axis_angle(axis.into(), angle),
             };
             let mut y = Vec::new();
             let proposal =
@@ -527,6 +543,87 @@ mod tests {
             assert!(
                 (proposal.ratio / expected - 1.0).abs() < 1e-4,
                 "angle {angle} about {axis}: ratio {} vs {expected}",
+                proposal.ratio
+            );
+            assert!(
+                (expected - 1.0).abs() > 1e-4,
+                "the move changes the contribution"
+            );
+        }
+    }
+
+    /// A multi-chain perturbation of an L D S D S E path (light → left wall → mirror → floor →
+    /// mirror → lens): the film point moves, and at the floor the direction onwards turns
+    /// by a small rotation before the second mirror. Parametrized by the film point and that
+    /// direction (solid angle), with the light point fixed, the move is symmetric, and the
+    /// contribution changes through cos θ at the floor and the wall–light connection.
+    #[test]
+    fn multi_chain_perturbation_matches_the_contribution_per_film_area_and_direction() {
+        let scene = corner();
+        let camera = camera();
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+        };
+        let eye = PathVertex {
+            p: camera.eye,
+            normal: camera.forward,
+            triangle: 0,
+        };
+        let to_mirror = camera.direction_through(eye.p, 30.0, 36.0);
+        let near_mirror = vertex(&space, &Ray::new(eye.p, to_mirror, 0.0, f32::INFINITY));
+        let reflected = bsdf::reflect(-to_mirror, near_mirror.normal);
+        let floor = vertex(
+            &space,
+            &spawn_ray(&scene, near_mirror.p, near_mirror.normal, reflected),
+        );
+        assert_eq!(floor.normal, Vec3A::Y);
+        let up = (Vec3A::new(2.5, 0.6, -1.9) - floor.p).normalize();
+        let far_mirror = vertex(&space, &spawn_ray(&scene, floor.p, floor.normal, up));
+        assert!(space.is_specular(&far_mirror));
+        let back = bsdf::reflect(-up, far_mirror.normal);
+        let wall = vertex(
+            &space,
+            &spawn_ray(&scene, far_mirror.p, far_mirror.normal, back),
+        );
+        assert_eq!(
+            wall.normal,
+            Vec3A::X,
+            "the second mirror sees the left wall"
+        );
+        let light = vertex(
+            &space,
+            &Ray::new(Vec3A::new(0.0, 1.0, -2.55), Vec3A::Y, 0.0, f32::INFINITY),
+        );
+        let x = [light, wall, far_mirror, floor, near_mirror, eye];
+        assert!(
+            !applicable(&space, &x).lens,
+            "the floor cannot connect: multi-chain"
+        );
+        let parametrized = |path: &[PathVertex]| {
+            let (onwards, _) = direction(&path[3], &path[2]).unwrap();
+            onwards.dot(path[3].normal).abs() * geometry(&path[1], &path[0])
+        };
+        for (offset, angle, axis) in [
+            ([0.8f32, -0.5f32], 0.02f32, Vec3A::X),
+            ([-1.5, 0.7], 0.01, Vec3A::Z),
+        ] {
+            let mut kernel = FixedKernel {
+                film_offset: offset,
+                rotation: glam::Quat::from_axis_angle(axis.into(), angle),
+            };
+            let mut y = Vec::new();
+            let proposal = lens(&space, &mut kernel, true, &x, &mut y, &mut 0)
+                .expect("a valid multi-chain path");
+            assert_eq!(
+                (y[0], y[5]),
+                (x[0], x[5]),
+                "the light point and the lens are kept"
+            );
+            let expected = parametrized(&y) / parametrized(&x);
+            assert!(
+                (proposal.ratio / expected - 1.0).abs() < 1e-4,
+                "offset {offset:?}, angle {angle}: ratio {} vs {expected}",
                 proposal.ratio
             );
             assert!(
