@@ -412,6 +412,43 @@ mod tests {
         space.trace(ray, &mut 0).expect("the ray hits")
     }
 
+    /// Asserts a proposal's ratio equals the independently computed one, which is not 1.
+    fn assert_ratio(proposal: &Proposal, expected: f32, case: &str) {
+        assert!(
+            (proposal.ratio / expected - 1.0).abs() < 1e-4,
+            "{case}: ratio {} vs {expected}",
+            proposal.ratio
+        );
+        assert!(
+            (expected - 1.0).abs() > 1e-4,
+            "{case}: the move changes the contribution"
+        );
+    }
+
+    /// The lens vertex of the pinhole camera.
+    fn eye(camera: &CameraModel) -> PathVertex {
+        PathVertex {
+            p: camera.eye,
+            normal: camera.forward,
+            triangle: 0,
+        }
+    }
+
+    /// The mirror and floor vertices seen from the lens through one film point.
+    fn mirror_then_floor(space: &PathSpace) -> (PathVertex, PathVertex) {
+        let camera = space.camera;
+        let to_mirror = camera.direction_through(camera.eye, 30.0, 36.0);
+        let mirror = vertex(space, &Ray::new(camera.eye, to_mirror, 0.0, f32::INFINITY));
+        assert!(space.is_specular(&mirror));
+        let reflected = bsdf::reflect(-to_mirror, mirror.normal);
+        let floor = vertex(
+            space,
+            &spawn_ray(space.scene, mirror.p, mirror.normal, reflected),
+        );
+        assert_eq!(floor.normal, Vec3A::Y, "the mirror sees the floor");
+        (mirror, floor)
+    }
+
     /// G between two surface vertices.
     fn geometry(a: &PathVertex, b: &PathVertex) -> f32 {
         let (w, d2) = direction(a, b).unwrap();
@@ -431,21 +468,9 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let eye = PathVertex {
-            p: camera.eye,
-            normal: camera.forward,
-            triangle: 0,
-        };
+        let eye = eye(&camera);
         // Lens → mirror → floor, then the wall and the light by hand.
-        let to_mirror = camera.direction_through(eye.p, 30.0, 36.0);
-        let mirror = vertex(&space, &Ray::new(eye.p, to_mirror, 0.0, f32::INFINITY));
-        assert!(space.is_specular(&mirror));
-        let reflected = bsdf::reflect(-to_mirror, mirror.normal);
-        let floor = vertex(
-            &space,
-            &spawn_ray(&scene, mirror.p, mirror.normal, reflected),
-        );
-        assert_eq!(floor.normal, Vec3A::Y, "the mirror sees the floor");
+        let (mirror, floor) = mirror_then_floor(&space);
         let wall = vertex(
             &space,
             &Ray::new(Vec3A::new(0.0, 1.5, 0.0), -Vec3A::Z, 0.0, f32::INFINITY),
@@ -493,11 +518,7 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let eye = PathVertex {
-            p: camera.eye,
-            normal: camera.forward,
-            triangle: 0,
-        };
+        let eye = eye(&camera);
         let light = vertex(
             &space,
             &Ray::new(Vec3A::new(0.0, 1.0, -2.55), Vec3A::Y, 0.0, f32::INFINITY),
@@ -540,15 +561,7 @@ mod tests {
                 "the light point and the lens are kept"
             );
             let expected = parametrized(&y) / parametrized(&x);
-            assert!(
-                (proposal.ratio / expected - 1.0).abs() < 1e-4,
-                "angle {angle} about {axis}: ratio {} vs {expected}",
-                proposal.ratio
-            );
-            assert!(
-                (expected - 1.0).abs() > 1e-4,
-                "the move changes the contribution"
-            );
+            assert_ratio(&proposal, expected, &format!("angle {angle} about {axis}"));
         }
     }
 
@@ -565,19 +578,8 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let eye = PathVertex {
-            p: camera.eye,
-            normal: camera.forward,
-            triangle: 0,
-        };
-        let to_mirror = camera.direction_through(eye.p, 30.0, 36.0);
-        let near_mirror = vertex(&space, &Ray::new(eye.p, to_mirror, 0.0, f32::INFINITY));
-        let reflected = bsdf::reflect(-to_mirror, near_mirror.normal);
-        let floor = vertex(
-            &space,
-            &spawn_ray(&scene, near_mirror.p, near_mirror.normal, reflected),
-        );
-        assert_eq!(floor.normal, Vec3A::Y);
+        let eye = eye(&camera);
+        let (near_mirror, floor) = mirror_then_floor(&space);
         let up = (Vec3A::new(2.5, 0.6, -1.9) - floor.p).normalize();
         let far_mirror = vertex(&space, &spawn_ray(&scene, floor.p, floor.normal, up));
         assert!(space.is_specular(&far_mirror));
@@ -621,14 +623,10 @@ mod tests {
                 "the light point and the lens are kept"
             );
             let expected = parametrized(&y) / parametrized(&x);
-            assert!(
-                (proposal.ratio / expected - 1.0).abs() < 1e-4,
-                "offset {offset:?}, angle {angle}: ratio {} vs {expected}",
-                proposal.ratio
-            );
-            assert!(
-                (expected - 1.0).abs() > 1e-4,
-                "the move changes the contribution"
+            assert_ratio(
+                &proposal,
+                expected,
+                &format!("offset {offset:?}, angle {angle}"),
             );
         }
     }
