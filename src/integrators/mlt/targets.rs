@@ -181,21 +181,11 @@ impl BdptAllStrategies<'_> {
         let bdpt = &self.0;
         let mut counters = SampleCounters::default();
         let (x, y, _, _) = start_camera_stream(camera, sampler);
-        let max_depth = bdpt.max_depth as usize;
-        let lengths = bdpt.trace_subpaths(
+        let mut found: Vec<(usize, usize, f32)> = Vec::new();
+        bdpt.sample_all_strategies(
             camera,
             x,
             y,
-            max_depth + 2,
-            max_depth + 1,
-            sampler,
-            &mut scratch.paths,
-            &mut counters,
-        );
-        let mut found: Vec<(usize, usize, f32)> = Vec::new();
-        bdpt.for_each_strategy(
-            camera,
-            lengths,
             sampler,
             &mut scratch.paths,
             &mut counters,
