@@ -1,6 +1,9 @@
 //! Scene loaders and image writers of `mlt::io`.
 #![cfg(feature = "cli")]
 
+mod common;
+
+use common::door_ajar;
 use mlt::io::{self, IoError, SceneData};
 use mlt::{Material, MaterialKind, Scene};
 use std::path::{Path, PathBuf};
@@ -117,6 +120,31 @@ fn cornell_box_obj_loads_triangles_materials_and_camera() {
     let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
     assert_eq!(scene.info().triangle_count, 32);
     assert_eq!(scene.info().emitter_count, 2);
+}
+
+/// The committed door-ajar files are what `tests/common/door_ajar.rs` writes (with
+/// `MLT_WRITE_SCENES=1`, this test writes them instead), and the scene loads with one
+/// light, its camera sidecar and a door standing open.
+#[test]
+fn door_ajar_scene_files_are_what_the_generator_writes() {
+    for (name, text) in door_ajar::files() {
+        let path = scenes().join(name);
+        if std::env::var_os("MLT_WRITE_SCENES").is_some() {
+            std::fs::write(&path, &text).unwrap();
+        }
+        let committed = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            committed == text,
+            "{name} differs from its generator: rewrite it with MLT_WRITE_SCENES=1 cargo test --test io"
+        );
+    }
+    let data = io::load_scene(&scenes().join("door-ajar.obj")).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    assert_eq!(scene.info().emitter_count, 2);
+    assert!(data.camera.is_some());
+    let (door, _) = material_named(&data, "door");
+    let door_faces = data.material_ids.iter().filter(|&&m| m == door).count();
+    assert_eq!(door_faces, 8);
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! Shared helpers of the integration tests: test scenes built in code and image statistics.
 #![allow(dead_code)]
 
+pub mod door_ajar;
 pub mod generate;
 
 use mlt::{Backend, Camera, Material, Scene, SceneDesc};
