@@ -1,6 +1,6 @@
 //! The Metropolis algorithms (PSSMLT over the path tracer, PSSMLT over BDPT, multiplexed MLT,
-//! path-space MLT) against ground truth and the path tracer: the white furnace, the Cornell scenes (image
-//! mean and per-region means within 4 combined standard errors estimated from independent
+//! path-space MLT) against ground truth and the path tracer: the white furnace, the Cornell scenes and
+//! the door-ajar scene (against BDPT there; image mean and per-region means within 4 combined standard errors estimated from independent
 //! renders; a 2% bias resolvable), identical images for any thread count, and a stopped
 //! render normalized by the mutations actually made.
 
@@ -45,24 +45,51 @@ fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
     path_traced_estimate(scene, camera, 64, 256, 1000..1008)
 }
 
+/// BDPT's estimate, the reference where the path tracer is too slow to be sharp (the door-ajar
+/// scene): `tests/bdpt.rs` checks BDPT against the path tracer there.
+fn bdpt_reference(scene: &Scene, camera: &Camera, samples_per_pixel: u32) -> Estimate {
+    let renders: Vec<Vec<f32>> = (1000..1016)
+        .map(|seed| {
+            let settings = RenderSettings {
+                width: 64,
+                height: 64,
+                algorithm: Algorithm::Bdpt,
+                samples_per_pixel,
+                max_depth: 5,
+                seed,
+                ..Default::default()
+            };
+            render_image(scene, camera, &settings)
+        })
+        .collect();
+    // Light-tracing splats correlate a render's pixels.
+    Estimate::from_correlated_renders(64, 64, &renders)
+}
+
+/// Bootstrap samples that make b, and so the image mean, good enough for a 2% error to be
+/// resolvable on the Cornell scenes.
+fn cornell_bootstrap_samples(variant: Variant) -> u32 {
+    // Without the direct pass b also carries the directly seen light, whose bootstrap
+    // estimate is noisy.
+    if variant.direct_samples_per_mutation > 0 {
+        1 << 17
+    } else {
+        1 << 19
+    }
+}
+
 /// The luminance of a Metropolis image's mean is its normalization b plus the chains' noise,
-/// so the image mean is only as good as b: enough bootstrap samples make a 2% error
+/// so the image mean is only as good as b: `bootstrap_samples` must make a 2% error
 /// resolvable.
 fn metropolis_estimate(
     variant: Variant,
     scene: &Scene,
     camera: &Camera,
     mutations_per_pixel: u32,
+    bootstrap_samples: u32,
 ) -> Estimate {
     let renders: Vec<Vec<f32>> = (0..16)
         .map(|seed| {
-            // Without the direct pass b also carries the directly seen light, whose
-            // bootstrap estimate is noisy: more samples keep a 2% bias resolvable.
-            let bootstrap_samples = if variant.direct_samples_per_mutation > 0 {
-                1 << 17
-            } else {
-                1 << 19
-            };
             let settings = RenderSettings {
                 bootstrap_samples,
                 ..metropolis_settings(variant, 64, mutations_per_pixel, seed)
@@ -113,7 +140,8 @@ fn furnace_matches_the_geometric_series(variant: Variant) {
 fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
     let (scene, camera) = load_canonical(scene_name);
     let reference = path_reference(&scene, &camera);
-    let test = metropolis_estimate(variant, &scene, &camera, 64);
+    let bootstrap_samples = cornell_bootstrap_samples(variant);
+    let test = metropolis_estimate(variant, &scene, &camera, 64, bootstrap_samples);
     // 16 renders a side: region variances have 15 degrees of freedom (see
     // `assert_estimates_agree`); 51 comparisons.
     assert_estimates_agree(
@@ -124,6 +152,119 @@ fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
         5.0,
         6.0,
     );
+}
+
+/// The door-ajar scene (tests/common/door_ajar.rs): the near room is lit only through the
+/// crack of a door, mostly after bounces in the far room. No emitter is seen directly, so b
+/// carries the whole image and takes more bootstrap samples to be good to a fraction of 2%.
+fn agrees_with_bdpt_on_the_door_ajar_scene(variant: Variant) {
+    let (scene, camera) = load_canonical("door-ajar");
+    let reference = bdpt_reference(&scene, &camera, 32);
+    let test = metropolis_estimate(variant, &scene, &camera, 64, 1 << 21);
+    assert_estimates_agree(
+        &format!("door-ajar {variant:?}"),
+        &test,
+        &reference,
+        4,
+        5.0,
+        6.0,
+    );
+}
+
+/// A glass ball over a floor under a small, high light: the ball focuses the light into a
+/// caustic on the floor (L S S D E paths) that the camera sees beside the ball. Returns the
+/// scene and a camera looking down at the caustic.
+fn glass_caustic() -> (Scene, Camera) {
+    let mut positions: Vec<f32> = Vec::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let mut material_ids: Vec<u32> = Vec::new();
+    let mut quad = |corners: [[f32; 3]; 4], material: u32| {
+        let base = (positions.len() / 3) as u32;
+        positions.extend(corners.iter().flatten());
+        indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+        material_ids.extend([material, material]);
+    };
+    // Floor facing up, light facing down.
+    quad(
+        [
+            [-4.0, 0.0, -4.0],
+            [-4.0, 0.0, 4.0],
+            [4.0, 0.0, 4.0],
+            [4.0, 0.0, -4.0],
+        ],
+        0,
+    );
+    quad(
+        [
+            [-3.8, 4.0, -0.3],
+            [-3.2, 4.0, -0.3],
+            [-3.2, 4.0, 0.3],
+            [-3.8, 4.0, 0.3],
+        ],
+        1,
+    );
+    // The ball: its front side outside, as dielectrics expect. Its focal length is about
+    // 1.5 radii from the centre, so the caustic on the floor is small and bright.
+    let (ball, ball_indices) = inward_icosphere(3, 1.0);
+    let base = (positions.len() / 3) as u32;
+    positions.extend(ball.chunks_exact(3).flat_map(|p| [p[0], p[1] + 1.6, p[2]]));
+    indices.extend(
+        ball_indices
+            .chunks_exact(3)
+            .flat_map(|t| [base + t[0], base + t[2], base + t[1]]),
+    );
+    material_ids.extend(std::iter::repeat_n(2, ball_indices.len() / 3));
+    let scene = Scene::new(&mlt::SceneDesc {
+        positions: &positions,
+        indices: &indices,
+        material_ids: &material_ids,
+        materials: &[
+            mlt::Material::diffuse([0.8, 0.8, 0.8]),
+            mlt::Material::diffuse([0.0; 3]).with_emission([150.0, 140.0, 120.0]),
+            mlt::Material::dielectric(1.5),
+        ],
+        backend: mlt::Backend::Bvh,
+    })
+    .unwrap();
+    let camera = Camera {
+        eye: [1.0, 2.5, 5.0],
+        target: [1.2, 0.5, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 35.0,
+        lens_radius: 0.0,
+        focus_distance: 0.0,
+    };
+    (scene, camera)
+}
+
+/// Path-space MLT with its perturbations favoured (mostly caustic perturbations) on the glass
+/// caustic, against BDPT: the Cornell images are dominated by paths the bidirectional
+/// mutation handles, so a wrong caustic or multi-chain ratio shows only where caustics
+/// carry the image.
+#[test]
+fn path_space_perturbations_agree_with_bdpt_on_a_glass_caustic() {
+    let (scene, camera) = glass_caustic();
+    let reference = bdpt_reference(&scene, &camera, 128);
+    let renders: Vec<Vec<f32>> = (0..16)
+        .map(|seed| {
+            let settings = RenderSettings {
+                bootstrap_samples: 1 << 20,
+                mutation_weights: mlt::MutationWeights([0.25, 0.25, 1.0, 0.5]),
+                ..metropolis_settings(
+                    Variant {
+                        algorithm: Algorithm::PathSpaceMlt,
+                        direct_samples_per_mutation: DIRECT,
+                    },
+                    64,
+                    256,
+                    seed,
+                )
+            };
+            render_image(&scene, &camera, &settings)
+        })
+        .collect();
+    let test = Estimate::from_correlated_renders(64, 64, &renders);
+    assert_estimates_agree("glass caustic", &test, &reference, 4, 5.0, 6.0);
 }
 
 fn image_is_identical_for_any_thread_count(variant: Variant) {
@@ -205,6 +346,11 @@ macro_rules! metropolis_tests {
             #[test]
             fn agrees_with_the_path_tracer_on_cornell_glass() {
                 super::agrees_with_the_path_tracer(VARIANT, "cornell-glass");
+            }
+
+            #[test]
+            fn agrees_with_bdpt_on_the_door_ajar_scene() {
+                super::agrees_with_bdpt_on_the_door_ajar_scene(VARIANT);
             }
 
             #[test]
