@@ -1,5 +1,7 @@
 //! Equal-time quality: how close each algorithm gets to a converged reference in the same
-//! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings.
+//! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings:
+//! cornell-glass (caustics through a glass sphere) and door-ajar (a room lit through the
+//! crack of a door) by default, cornell-box on request.
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
 //! actual seconds, camera samples and chain mutations per second, RMSE, RMSE corrected for the reference's
@@ -12,17 +14,18 @@
 //! threads at the longest budget (in the table, not the plot). The table notes renders that
 //! overran their budget or finished no sample at all (a black image, left out of the plot).
 //!
-//! The reference is the path tracer on every core, rendered as two halves with different
-//! seeds and averaged. Half of the RMSE between the halves estimates the reference's own
+//! The reference is BDPT on every core (checked against the path tracer on these scenes by
+//! `tests/bdpt.rs`; it converges much faster on caustics and on light through a crack),
+//! rendered as two halves with different seeds and averaged. Half of the RMSE between the halves estimates the reference's own
 //! RMSE; the corrected RMSE is sqrt(max(0, RMSE² − reference RMSE²)). The halves are cached
-//! as PFM in `target/mlt-bench/` (named by scene, size, depth and spp): delete them after a
+//! as PFM in `target/mlt-bench/` (named by scene, size, depth, spp and algorithm): delete them after a
 //! change to the renderer that changes its converged image.
 //!
 //! Environment:
 //! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
-//! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 4096).
+//! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 2048).
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
-//!   `cornell-box,cornell-glass`).
+//!   `cornell-glass,door-ajar`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
 //!   paths); without one the plot is written without text.
@@ -53,14 +56,17 @@ const ALGORITHMS: &[(&str, Algorithm, u32)] = &[
     ("mmlt", Algorithm::Mmlt, DIRECT),
     ("mmlt-no-direct", Algorithm::Mmlt, 0),
     ("pssmlt-no-direct", Algorithm::Pssmlt, 0),
+    ("path-space-mlt", Algorithm::PathSpaceMlt, DIRECT),
+    ("path-space-mlt-no-direct", Algorithm::PathSpaceMlt, 0),
 ];
 
-const DEFAULT_SCENES: &[&str] = &["cornell-box", "cornell-glass"];
+const DEFAULT_SCENES: &[&str] = &["cornell-glass", "door-ajar"];
 const WIDTH: u32 = 256;
 const HEIGHT: u32 = 256;
 const MAX_DEPTH: u32 = 5;
 const DEFAULT_MAX_SECONDS: f64 = 10.0;
-const DEFAULT_REFERENCE_SPP: u32 = 4096;
+const DEFAULT_REFERENCE_SPP: u32 = 2048;
+const REFERENCE_ALGORITHM: (&str, Algorithm) = ("bdpt", Algorithm::Bdpt);
 
 /// Seeds of the two reference halves. The measured renders use seeds 0, 1, 2, …: keeping
 /// these far away means no measured render shares random numbers with the reference, which
@@ -152,19 +158,21 @@ fn reference(name: &str, scene: &Scene, camera: &Camera, spp: u32, dir: &Path) -
         .zip(["a", "b"])
         .map(|(&seed, half)| {
             let path = dir.join(format!(
-                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{half}.pfm"
+                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{}-{half}.pfm",
+                REFERENCE_ALGORITHM.0
             ));
             if let Ok((WIDTH, HEIGHT, image)) = mlt::io::read_pfm(&path) {
                 return image;
             }
             println!(
-                "rendering reference half {half} of {name}: path tracer, {half_spp} spp, all threads"
+                "rendering reference half {half} of {name}: {}, {half_spp} spp, all threads",
+                REFERENCE_ALGORITHM.0
             );
             let settings = RenderSettings {
                 width: WIDTH,
                 height: HEIGHT,
                 max_depth: MAX_DEPTH,
-                algorithm: Algorithm::Path,
+                algorithm: REFERENCE_ALGORITHM.1,
                 samples_per_pixel: half_spp,
                 threads: 0,
                 seed,
@@ -242,7 +250,7 @@ fn measure(
 
 fn print_header() {
     println!(
-        "{:<14} {:<14} {:>7} {:>7} {:>8} {:>12} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
+        "{:<14} {:<24} {:>7} {:>7} {:>8} {:>12} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
         "scene",
         "algo",
         "threads",
@@ -269,7 +277,7 @@ fn print_row(scene: &str, m: &Measurement) {
         notes.push_str("  over budget");
     }
     println!(
-        "{scene:<14} {:<14} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
+        "{scene:<14} {:<24} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
         m.algorithm,
         m.threads,
         m.budget_seconds,
@@ -461,8 +469,8 @@ fn main() {
         let reference = reference(name, &scene, &camera, reference_spp, &dir);
         let [r, g, b] = channel_means(&reference.image);
         println!(
-            "{name}: reference {} spp (two halves), mean RGB {r:.4} {g:.4} {b:.4}, its own RMSE ≈ {:.5}",
-            reference.spp, reference.rmse
+            "{name}: reference {} {} spp (two halves), mean RGB {r:.4} {g:.4} {b:.4}, its own RMSE ≈ {:.5}",
+            REFERENCE_ALGORITHM.0, reference.spp, reference.rmse
         );
         print_header();
         let mut measurements = Vec::new();

@@ -84,6 +84,8 @@ const SERIES_COLORS: &[RGBColor] = &[
     RGBColor(140, 86, 75),
     RGBColor(227, 119, 194),
     RGBColor(23, 190, 207),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
 ];
 
 pub fn series_color(index: usize) -> RGBColor {
