@@ -297,6 +297,7 @@ fn sample_direction(
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_geometry::Rect;
     use super::*;
     use crate::integrators::mlt::acceptance;
     use crate::scene::{Backend, Camera, CameraModel, Material, Scene, SceneDesc};
@@ -338,28 +339,6 @@ mod tests {
     // above both, and a pinhole camera that sees all of the floor and the wall. Nothing
     // occludes anything: every floor, wall and light point sees every other one (front to
     // front) and the lens, so visibility is 1 in the formulas.
-
-    /// A rectangle o + s·a + t·b, s, t ∈ [0, 1], with its front side along a × b.
-    #[derive(Clone, Copy, Debug)]
-    struct Rect {
-        o: DVec3,
-        a: DVec3,
-        b: DVec3,
-    }
-
-    impl Rect {
-        fn point(&self, s: f64, t: f64) -> DVec3 {
-            self.o + self.a * s + self.b * t
-        }
-
-        fn normal(&self) -> DVec3 {
-            self.a.cross(self.b).normalize()
-        }
-
-        fn area(&self) -> f64 {
-            self.a.cross(self.b).length()
-        }
-    }
 
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     enum Surface {

@@ -30,6 +30,8 @@
 mod bidirectional;
 mod chain;
 mod perturbation;
+#[cfg(test)]
+mod test_geometry;
 
 pub use chain::{Mutation, MutationCounts, MutationWeights};
 pub(crate) use chain::{PathSpaceTarget, run};

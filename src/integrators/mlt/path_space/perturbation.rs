@@ -653,50 +653,9 @@ mod tests {
     // its own stationary distribution, as far as it mixes in its steps: the tests run enough
     // steps for the flawed statistics to level off, and require the correct chains to move.
 
+    use super::super::test_geometry::Rect;
     use crate::integrators::mlt::acceptance;
     use glam::DVec3;
-
-    /// A rectangle o + s·a + t·b, s, t ∈ [0, 1], with its front side along a × b.
-    #[derive(Clone, Copy, Debug)]
-    struct Rect {
-        o: DVec3,
-        a: DVec3,
-        b: DVec3,
-    }
-
-    impl Rect {
-        fn point(&self, s: f64, t: f64) -> DVec3 {
-            self.o + self.a * s + self.b * t
-        }
-
-        fn normal(&self) -> DVec3 {
-            self.a.cross(self.b).normalize()
-        }
-
-        fn area(&self) -> f64 {
-            self.a.cross(self.b).length()
-        }
-
-        /// (s, t) of a point of the rectangle's plane.
-        fn coordinates(&self, p: DVec3) -> (f64, f64) {
-            let d = p - self.o;
-            (
-                d.dot(self.a) / self.a.length_squared(),
-                d.dot(self.b) / self.b.length_squared(),
-            )
-        }
-
-        /// Midpoint-rule nodes of `k` × `k` cells: (i, j, point, area weight).
-        fn nodes(&self, k: usize) -> impl Iterator<Item = (usize, usize, DVec3, f64)> + '_ {
-            let weight = self.area() / (k * k) as f64;
-            (0..k * k).map(move |n| {
-                let (i, j) = (n % k, n / k);
-                let s = (i as f64 + 0.5) / k as f64;
-                let t = (j as f64 + 0.5) / k as f64;
-                (i, j, self.point(s, t), weight)
-            })
-        }
-    }
 
     const FLOOR: Rect = Rect {
         o: DVec3::new(-1.0, 0.0, 1.0),
