@@ -149,9 +149,10 @@ impl Bidirectional {
             return None;
         }
         let added = added as usize;
-        // Keeping the whole path (the edge beyond the light or the lens "deleted") and adding
-        // vertices would make the old light or lens an inner vertex: no contribution.
-        if added > 0 && (b == 0 || a + 1 == n as isize) {
+        // Keeping the whole path (the "edge" beyond the lens deleted) and adding vertices
+        // would make the old lens an inner vertex: never a path of the scene. (Beyond the
+        // light it is one: an emitter may also reflect, as in the furnace.)
+        if added > 0 && a + 1 == n as isize {
             return None;
         }
         let n_new = n - deleted + added;
