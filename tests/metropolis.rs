@@ -87,8 +87,9 @@ fn metropolis_estimate(
     camera: &Camera,
     mutations_per_pixel: u32,
     bootstrap_samples: u32,
+    renders: u64,
 ) -> Estimate {
-    let renders: Vec<Vec<f32>> = (0..16)
+    let renders: Vec<Vec<f32>> = (0..renders)
         .map(|seed| {
             let settings = RenderSettings {
                 bootstrap_samples,
@@ -141,7 +142,7 @@ fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
     let (scene, camera) = load_canonical(scene_name);
     let reference = path_reference(&scene, &camera);
     let bootstrap_samples = cornell_bootstrap_samples(variant);
-    let test = metropolis_estimate(variant, &scene, &camera, 64, bootstrap_samples);
+    let test = metropolis_estimate(variant, &scene, &camera, 64, bootstrap_samples, 16);
     // 16 renders a side: region variances have 15 degrees of freedom (see
     // `assert_estimates_agree`); 51 comparisons.
     assert_estimates_agree(
@@ -156,11 +157,14 @@ fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
 
 /// The door-ajar scene (tests/common/door_ajar.rs): the near room is lit only through the
 /// crack of a door, mostly after bounces in the far room. No emitter is seen directly, so b
-/// carries the whole image and takes more bootstrap samples to be good to a fraction of 2%.
+/// carries most of the image and takes more bootstrap samples to be good to a fraction of 2%.
 fn agrees_with_bdpt_on_the_door_ajar_scene(variant: Variant) {
     let (scene, camera) = load_canonical("door-ajar");
     let reference = bdpt_reference(&scene, &camera, 32);
-    let test = metropolis_estimate(variant, &scene, &camera, 64, 1 << 21);
+    // Mutations are cheap next to the bootstrap here; at 64 per pixel the chains' and the
+    // direct pass's noise (light through the crack) left the 2% check too little margin.
+    // 24 renders also steady the variance estimate (23 degrees of freedom).
+    let test = metropolis_estimate(variant, &scene, &camera, 256, 1 << 21, 24);
     assert_estimates_agree(
         &format!("door-ajar {variant:?}"),
         &test,
