@@ -99,6 +99,15 @@
 #define MLT_ALGORITHM_PATH_SPACE_MLT 5
 
 /**
+ * `MltRenderSettings.algorithm`: energy redistribution path tracing (Cline, Talbot & Egbert
+ * 2005): each of `samples_per_pixel` BDPT camera samples per pixel starts short chains of
+ * lens, caustic and multi-chain perturbations that spread its energy over nearby paths.
+ * Unbiased. Uses `erpt_chain_length`, `erpt_deposit_energy` and the perturbation weights
+ * of `mutation_weights`.
+ */
+#define MLT_ALGORITHM_ERPT 6
+
+/**
  * Index of the bidirectional mutation in `MltRenderSettings.mutation_weights` and the
  * per-mutation counts of `MltRenderStats`.
  */
@@ -150,6 +159,16 @@
 #define MLT_MAX_TIME_LIMIT_SECONDS 1.0e7
 
 /**
+ * Largest accepted ERPT chain length.
+ */
+#define MLT_MAX_ERPT_CHAIN_LENGTH (1 << 20)
+
+/**
+ * Largest accepted ERPT deposit energy.
+ */
+#define MLT_MAX_ERPT_DEPOSIT_ENERGY 1.0e30
+
+/**
  * Largest accepted number of Metropolis bootstrap samples.
  */
 #define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
@@ -159,6 +178,11 @@
  * the Cornell scenes (benches/equal_time.rs).
  */
 #define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
+
+/**
+ * The default `erpt_chain_length` (Cline et al. used chains of about this length).
+ */
+#define RenderSettings_DEFAULT_ERPT_CHAIN_LENGTH 100
 
 /**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
@@ -374,6 +398,16 @@ typedef struct MltRenderSettings {
    * positive.
    */
   float mutation_weights[4];
+  /**
+   * `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 100.
+   */
+  uint32_t erpt_chain_length;
+  /**
+   * `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
+   * sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
+   * e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
+   */
+  float erpt_deposit_energy;
 } MltRenderSettings;
 
 /**

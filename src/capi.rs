@@ -57,6 +57,12 @@ pub const MLT_ALGORITHM_PSSMLT_BDPT: i32 = 4;
 /// normalized by a bidirectional bootstrap. Uses `mutations_per_pixel`, `bootstrap_samples`
 /// and `chains`.
 pub const MLT_ALGORITHM_PATH_SPACE_MLT: i32 = 5;
+/// `MltRenderSettings.algorithm`: energy redistribution path tracing (Cline, Talbot & Egbert
+/// 2005): each of `samples_per_pixel` BDPT camera samples per pixel starts short chains of
+/// lens, caustic and multi-chain perturbations that spread its energy over nearby paths.
+/// Unbiased. Uses `erpt_chain_length`, `erpt_deposit_energy` and the perturbation weights
+/// of `mutation_weights`.
+pub const MLT_ALGORITHM_ERPT: i32 = 6;
 
 /// Index of the bidirectional mutation in `MltRenderSettings.mutation_weights` and the
 /// per-mutation counts of `MltRenderStats`.
@@ -177,6 +183,12 @@ pub struct MltRenderSettings {
     /// those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
     /// positive.
     pub mutation_weights: [f32; 4],
+    /// `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 100.
+    pub erpt_chain_length: u32,
+    /// `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
+    /// sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
+    /// e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
+    pub erpt_deposit_energy: f32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -413,6 +425,7 @@ fn algorithm_to_c(algorithm: Algorithm) -> i32 {
         Algorithm::Mmlt => MLT_ALGORITHM_MMLT,
         Algorithm::PssmltBdpt => MLT_ALGORITHM_PSSMLT_BDPT,
         Algorithm::PathSpaceMlt => MLT_ALGORITHM_PATH_SPACE_MLT,
+        Algorithm::Erpt => MLT_ALGORITHM_ERPT,
     }
 }
 
@@ -424,9 +437,10 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         MLT_ALGORITHM_MMLT => Algorithm::Mmlt,
         MLT_ALGORITHM_PSSMLT_BDPT => Algorithm::PssmltBdpt,
         MLT_ALGORITHM_PATH_SPACE_MLT => Algorithm::PathSpaceMlt,
+        MLT_ALGORITHM_ERPT => Algorithm::Erpt,
         other => {
             return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4) or MLT_ALGORITHM_PATH_SPACE_MLT (5)"
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4), MLT_ALGORITHM_PATH_SPACE_MLT (5) or MLT_ALGORITHM_ERPT (6)"
             )));
         }
     };
@@ -446,6 +460,8 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         small_step_sigma: s.small_step_sigma,
         direct_samples_per_mutation: s.direct_samples_per_mutation,
         mutation_weights: MutationWeights(s.mutation_weights),
+        erpt_chain_length: s.erpt_chain_length,
+        erpt_deposit_energy: s.erpt_deposit_energy,
     })
 }
 
@@ -585,6 +601,8 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             small_step_sigma: d.small_step_sigma,
             direct_samples_per_mutation: d.direct_samples_per_mutation,
             mutation_weights: d.mutation_weights.0,
+            erpt_chain_length: d.erpt_chain_length,
+            erpt_deposit_energy: d.erpt_deposit_energy,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;

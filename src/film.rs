@@ -55,6 +55,17 @@ impl Film {
         self.add_weighted_splats(splats, 1.0);
     }
 
+    /// Adds per-pixel splat sums (one RGB triple per pixel, in pixel order) that stand for
+    /// `light_paths` light paths.
+    pub fn add_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>, light_paths: u64) {
+        self.light_paths += light_paths;
+        for (total, sum) in self.splats.iter_mut().zip(sums) {
+            for (t, s) in total.iter_mut().zip(sum) {
+                *t += s;
+            }
+        }
+    }
+
     /// Adds `weight` × the splats of a work unit, in the unit's order.
     pub fn add_weighted_splats(&mut self, splats: &[crate::integrators::Splat], weight: f64) {
         for splat in splats {

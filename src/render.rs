@@ -39,6 +39,10 @@ pub enum Algorithm {
     /// Path-space MLT (Veach & Guibas 1997): the chains' states are light paths, changed by
     /// Veach's mutations.
     PathSpaceMlt,
+    /// Energy redistribution path tracing (Cline, Talbot & Egbert 2005): BDPT camera
+    /// samples whose energy short path-space chains of perturbations spread over nearby
+    /// paths (`erpt_chain_length`, `erpt_deposit_energy`). Unbiased, like the path tracer.
+    Erpt,
 }
 
 impl Algorithm {
@@ -59,6 +63,7 @@ enum Estimator<'a> {
     Mmlt(&'a BdptMultiplexed<'a>),
     PssmltBdpt(&'a BdptAllStrategies<'a>),
     PathSpaceMlt(&'a Bdpt<'a>),
+    Erpt(&'a Bdpt<'a>),
 }
 
 /// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
@@ -132,6 +137,16 @@ impl Estimator<'_> {
                 };
                 path_space::run(&target, &chains, film, control, &mut keep_pace)
             }
+            Estimator::Erpt(bdpt) => {
+                let erpt = path_space::ErptSettings {
+                    samples_per_pixel: spp,
+                    chain_length: settings.erpt_chain_length,
+                    deposit_energy: settings.erpt_deposit_energy,
+                    seed,
+                    weights: settings.mutation_weights,
+                };
+                path_space::run_erpt(bdpt, camera, &erpt, film, control)
+            }
         }
     }
 }
@@ -152,6 +167,10 @@ pub const MLT_MAX_DEPTH_LIMIT: u32 = 1024;
 pub const MLT_MAX_THREADS: u32 = 4096;
 /// Largest accepted time limit in seconds.
 pub const MLT_MAX_TIME_LIMIT_SECONDS: f64 = 1.0e7;
+/// Largest accepted ERPT chain length.
+pub const MLT_MAX_ERPT_CHAIN_LENGTH: u32 = 1 << 20;
+/// Largest accepted ERPT deposit energy.
+pub const MLT_MAX_ERPT_DEPOSIT_ENERGY: f32 = 1.0e30;
 /// Largest accepted number of Metropolis bootstrap samples.
 pub const MLT_MAX_BOOTSTRAP_SAMPLES: u32 = 1 << 28;
 
@@ -191,6 +210,13 @@ pub struct RenderSettings {
     /// picks among those the current path admits. The bidirectional weight must be
     /// positive: it alone makes every path reachable.
     pub mutation_weights: MutationWeights,
+    /// ERPT: perturbations per chain (L). Each camera sample's energy e starts
+    /// ⌊e / (L·e_d) + ξ⌋ chains.
+    pub erpt_chain_length: u32,
+    /// ERPT: the energy (luminance) e_d each chain step deposits; 0 picks it so that a
+    /// camera sample starts one chain on average (from a pre-pass estimating the mean
+    /// energy of a sample: e_d = mean / L). Smaller values start more chains.
+    pub erpt_deposit_energy: f32,
 }
 
 impl Default for RenderSettings {
@@ -211,6 +237,8 @@ impl Default for RenderSettings {
             small_step_sigma: 0.01,
             direct_samples_per_mutation: Self::DEFAULT_DIRECT_SAMPLES_PER_MUTATION,
             mutation_weights: MutationWeights::default(),
+            erpt_chain_length: Self::DEFAULT_ERPT_CHAIN_LENGTH,
+            erpt_deposit_energy: 0.0,
         }
     }
 }
@@ -219,6 +247,8 @@ impl RenderSettings {
     /// The default `direct_samples_per_mutation`: one, the best measured at equal time on
     /// the Cornell scenes (benches/equal_time.rs).
     pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
+    /// The default `erpt_chain_length` (Cline et al. used chains of about this length).
+    pub const DEFAULT_ERPT_CHAIN_LENGTH: u32 = 100;
 
     pub fn validate(&self) -> Result<()> {
         for (name, side) in [("width", self.width), ("height", self.height)] {
@@ -316,6 +346,18 @@ impl RenderSettings {
                 "settings.mutation_weights[0] (the bidirectional mutation) is 0; it must be positive, or the chains cannot reach every path",
             ));
         }
+        let length = self.erpt_chain_length;
+        if length == 0 || length > MLT_MAX_ERPT_CHAIN_LENGTH {
+            return Err(Error::invalid(format!(
+                "settings.erpt_chain_length is {length}; it must be between 1 and {MLT_MAX_ERPT_CHAIN_LENGTH}"
+            )));
+        }
+        let e_d = self.erpt_deposit_energy;
+        if !(e_d.is_finite() && (0.0..=MLT_MAX_ERPT_DEPOSIT_ENERGY).contains(&e_d)) {
+            return Err(Error::invalid(format!(
+                "settings.erpt_deposit_energy is {e_d}; it must be 0 (automatic) or a positive number up to {MLT_MAX_ERPT_DEPOSIT_ENERGY:e}"
+            )));
+        }
         Ok(())
     }
 
@@ -358,7 +400,8 @@ pub struct RenderStats {
     pub threads: u32,
     /// Metropolis: accepted mutations.
     pub accepted_mutations: u64,
-    /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by.
+    /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by. ERPT: the
+    /// deposit energy e_d the chains used.
     pub normalization: f64,
     /// Path-space MLT: proposals and acceptances per mutation.
     pub mutation_counts: MutationCounts,
@@ -421,6 +464,7 @@ pub fn render(
         mutations_done: AtomicU64::new(0),
         rays: AtomicU64::new(0),
         invalid: AtomicU64::new(0),
+        mutations_are_work: settings.algorithm.is_metropolis(),
     };
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
@@ -461,6 +505,7 @@ pub fn render(
             Estimator::PssmltBdpt(&all_strategies)
         }
         Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
+        Algorithm::Erpt => Estimator::Erpt(&bdpt),
     };
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit
@@ -594,7 +639,10 @@ pub(crate) struct Control {
     pub(crate) samples_done: AtomicU64,
     pub(crate) mutations_done: AtomicU64,
     pub(crate) rays: AtomicU64,
-    invalid: AtomicU64,
+    pub(crate) invalid: AtomicU64,
+    /// Whether progress counts mutations (Metropolis) or camera samples only (ERPT, whose
+    /// mutations per sample are not known in advance).
+    mutations_are_work: bool,
 }
 
 impl Control {
@@ -611,7 +659,12 @@ impl Control {
 
     /// Camera samples and mutations: the units of a render's plan.
     fn work_done(&self) -> u64 {
-        self.samples_done.load(Ordering::Relaxed) + self.mutations_done.load(Ordering::Relaxed)
+        let mutations = if self.mutations_are_work {
+            self.mutations_done.load(Ordering::Relaxed)
+        } else {
+            0
+        };
+        self.samples_done.load(Ordering::Relaxed) + mutations
     }
 
     /// Fraction done: by samples when a count was asked for, else by time.

@@ -63,6 +63,7 @@ fn allocations_do_not_grow_with_samples() {
         Algorithm::PssmltBdpt,
         Algorithm::Mmlt,
         Algorithm::PathSpaceMlt,
+        Algorithm::Erpt,
     ] {
         // 32 x 32 pixels: both renders take the same number of passes (one sample, then up
         // to 64 per pass) and rounds, so only per-sample allocations could differ.

@@ -9,8 +9,8 @@ mod common;
 use mlt::capi::*;
 use mlt::error::*;
 use mlt::render::{
-    MLT_MAX_DEPTH_LIMIT, MLT_MAX_IMAGE_SIDE, MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS,
-    MLT_MAX_TIME_LIMIT_SECONDS,
+    MLT_MAX_DEPTH_LIMIT, MLT_MAX_ERPT_CHAIN_LENGTH, MLT_MAX_IMAGE_SIDE, MLT_MAX_SAMPLES_PER_PIXEL,
+    MLT_MAX_THREADS, MLT_MAX_TIME_LIMIT_SECONDS,
 };
 use std::ffi::{CStr, c_void};
 use std::ptr::{null, null_mut};
@@ -355,6 +355,7 @@ fn defaults_are_valid_and_documented() {
         ),
         (0.3, 0.01, 1)
     );
+    assert_eq!((s.erpt_chain_length, s.erpt_deposit_energy), (100, 0.0));
 }
 
 #[test]
@@ -1125,7 +1126,7 @@ fn zero_samples_without_time_limit() {
 #[test]
 fn unknown_algorithm() {
     let scene = HostScene::floor_and_light().create();
-    for bad in [6, -1, i32::MAX] {
+    for bad in [7, -1, i32::MAX] {
         let s = MltRenderSettings {
             algorithm: bad,
             ..small_settings(4, 4, 1)
@@ -1135,6 +1136,105 @@ fn unknown_algorithm() {
             &s,
             &["algorithm", &bad.to_string(), "MLT_ALGORITHM_PATH"],
         );
+    }
+}
+
+#[test]
+fn erpt_settings_out_of_range() {
+    let scene = HostScene::floor_and_light().create();
+    let erpt = MltRenderSettings {
+        algorithm: MLT_ALGORITHM_ERPT,
+        ..small_settings(4, 4, 1)
+    };
+    let cases: [(MltRenderSettings, &[&str]); 8] = [
+        (
+            MltRenderSettings {
+                erpt_chain_length: 0,
+                ..erpt
+            },
+            &["erpt_chain_length is 0", "between 1 and 1048576"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_chain_length: MLT_MAX_ERPT_CHAIN_LENGTH + 1,
+                ..erpt
+            },
+            &["erpt_chain_length is 1048577"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_chain_length: u32::MAX,
+                ..erpt
+            },
+            &["erpt_chain_length is 4294967295"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_deposit_energy: -1.0,
+                ..erpt
+            },
+            &["erpt_deposit_energy is -1"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_deposit_energy: f32::NAN,
+                ..erpt
+            },
+            &["erpt_deposit_energy is NaN"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_deposit_energy: f32::INFINITY,
+                ..erpt
+            },
+            &["erpt_deposit_energy is inf"],
+        ),
+        (
+            MltRenderSettings {
+                erpt_deposit_energy: 1e31,
+                ..erpt
+            },
+            &["erpt_deposit_energy", "1e30"],
+        ),
+        (
+            MltRenderSettings {
+                samples_per_pixel: 0,
+                ..erpt
+            },
+            &["samples_per_pixel is 0", "time limit"],
+        ),
+    ];
+    for (settings, needles) in &cases {
+        scene.render_fails(&floor_camera(), settings, needles);
+    }
+    // In range, with an explicit deposit energy and the shortest chains, it renders.
+    for (erpt_chain_length, erpt_deposit_energy) in [(1, 0.0), (100, 1e-3), (1, 1e30)] {
+        let settings = MltRenderSettings {
+            erpt_chain_length,
+            erpt_deposit_energy,
+            ..erpt
+        };
+        let mut rgb = vec![0.0f32; 4 * 4 * 3];
+        let mut stats = MltRenderStats::default();
+        // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
+        let status = unsafe {
+            mlt_render_ex(
+                scene.0,
+                &floor_camera(),
+                &settings,
+                rgb.as_mut_ptr(),
+                rgb.len(),
+                None,
+                null_mut(),
+                &mut stats,
+            )
+        };
+        assert_eq!(
+            status, MLT_STATUS_OK,
+            "{erpt_chain_length}, {erpt_deposit_energy}"
+        );
+        assert_eq!(stats.samples, 16);
+        assert!(rgb.iter().all(|v| v.is_finite()));
     }
 }
 

@@ -24,6 +24,8 @@ enum AlgorithmArg {
     PssmltBdpt,
     /// Path-space MLT (Veach): chains over light paths, changed by Veach's mutations.
     PathSpaceMlt,
+    /// Energy redistribution path tracing: BDPT samples spread by chains of perturbations.
+    Erpt,
 }
 
 // The kernel's `Algorithm` has no clap dependency; exhaustive matches keep the two in step.
@@ -36,6 +38,7 @@ impl From<AlgorithmArg> for mlt::Algorithm {
             AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
             AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
             AlgorithmArg::PathSpaceMlt => mlt::Algorithm::PathSpaceMlt,
+            AlgorithmArg::Erpt => mlt::Algorithm::Erpt,
         }
     }
 }
@@ -49,6 +52,7 @@ impl From<mlt::Algorithm> for AlgorithmArg {
             mlt::Algorithm::Mmlt => AlgorithmArg::Mmlt,
             mlt::Algorithm::PssmltBdpt => AlgorithmArg::PssmltBdpt,
             mlt::Algorithm::PathSpaceMlt => AlgorithmArg::PathSpaceMlt,
+            mlt::Algorithm::Erpt => AlgorithmArg::Erpt,
         }
     }
 }
@@ -128,6 +132,13 @@ struct Args {
     /// lens, caustic and multi-chain perturbations.
     #[arg(long, value_name = "B,L,C,M", default_value_t = WeightsArg(RenderSettings::default().mutation_weights.0))]
     mutation_weights: WeightsArg,
+    /// ERPT: perturbations per chain.
+    #[arg(long, value_name = "L", default_value_t = RenderSettings::default().erpt_chain_length)]
+    erpt_chain_length: u32,
+    /// ERPT: energy (luminance) each chain step deposits (0: automatic, one chain per camera
+    /// sample on average).
+    #[arg(long, value_name = "E", default_value_t = RenderSettings::default().erpt_deposit_energy)]
+    erpt_deposit: f32,
     /// Stop after this many seconds (0: no limit).
     #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
     time_limit: f64,
@@ -259,6 +270,8 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         small_step_sigma: args.small_step,
         direct_samples_per_mutation: args.direct_per_mutation,
         mutation_weights: MutationWeights(args.mutation_weights.0),
+        erpt_chain_length: args.erpt_chain_length,
+        erpt_deposit_energy: args.erpt_deposit,
     }
 }
 
@@ -343,7 +356,7 @@ fn print_summary(
         stats.samples as f64 / pixels
     );
     println!("  samples/s  {:.3} M", stats.samples as f64 / seconds / 1e6);
-    if settings.algorithm.is_metropolis() {
+    if settings.algorithm.is_metropolis() || settings.algorithm == mlt::Algorithm::Erpt {
         println!(
             "  mutations  {} ({:.2} per pixel)",
             stats.mutations,
@@ -360,7 +373,13 @@ fn print_summary(
         stats.rays as f64 / seconds / 1e6
     );
     println!("  threads    {}", stats.threads);
-    if stats.normalization > 0.0 {
+    if settings.algorithm == mlt::Algorithm::Erpt {
+        println!(
+            "  erpt e_d = {:.6}, {:.1}% of mutations accepted",
+            stats.normalization,
+            100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
+        );
+    } else if stats.normalization > 0.0 {
         println!(
             "  metropolis b = {:.6}, {:.1}% of mutations accepted",
             stats.normalization,

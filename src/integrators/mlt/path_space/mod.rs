@@ -29,12 +29,14 @@
 
 mod bidirectional;
 mod chain;
+mod erpt;
 mod perturbation;
 #[cfg(test)]
 mod test_geometry;
 
 pub use chain::{Mutation, MutationCounts, MutationWeights};
 pub(crate) use chain::{PathSpaceTarget, run};
+pub(crate) use erpt::{ErptSettings, run as run_erpt};
 pub(crate) use perturbation::PerturbationSizes;
 
 use crate::bsdf::{self, TransportMode};
