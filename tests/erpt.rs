@@ -7,7 +7,8 @@
 mod common;
 
 use common::*;
-use mlt::{Algorithm, Camera, RenderSettings, Scene, render};
+use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
+use std::time::{Duration, Instant};
 
 fn erpt_settings(size: u32, samples_per_pixel: u32, seed: u64) -> RenderSettings {
     RenderSettings {
@@ -141,4 +142,64 @@ fn chains_run_and_a_huge_deposit_energy_starts_none() {
     let stats = render(&scene, &camera, &none, &mut image, None).unwrap();
     assert_eq!(stats.mutations, 0);
     assert!(image.iter().all(|&v| v == 0.0));
+}
+
+/// A time limit and a cancel both stop a render soon, with an image still near the path
+/// tracer's mean (chains cut short leave their energy at their current state), and progress
+/// goes up to 1 for a finished render.
+#[test]
+fn time_limit_cancel_and_progress() {
+    let (scene, camera) = load_canonical("cornell-box");
+    let reference = mean(&path_traced_image(&scene, &camera, 64, 64, 9));
+    let near = |image: &[f32], label: &str| {
+        let got = mean(image);
+        for c in 0..3 {
+            assert!(
+                (got[c] - reference[c]).abs() < 0.1 * reference[c],
+                "{label} channel {c}: {} vs {}",
+                got[c],
+                reference[c]
+            );
+        }
+    };
+    let mut image = vec![0.0; 64 * 64 * 3];
+    let timed = RenderSettings {
+        time_limit_seconds: 0.5,
+        ..erpt_settings(64, 0, 2)
+    };
+    let start = Instant::now();
+    let stats = render(&scene, &camera, &timed, &mut image, None).unwrap();
+    assert!(start.elapsed() < Duration::from_secs(5));
+    assert_eq!(stats.stop, StopReason::TimeLimitReached);
+    assert!(stats.samples >= 64 * 64 && stats.mutations > 0);
+    near(&image, "time limit");
+
+    let mut calls = 0;
+    let mut cancel_soon = |_: f32| {
+        calls += 1;
+        calls < 3
+    };
+    let long = erpt_settings(64, 1 << 20, 3);
+    let stats = render(&scene, &camera, &long, &mut image, Some(&mut cancel_soon)).unwrap();
+    assert_eq!(stats.stop, StopReason::Cancelled);
+    assert!(stats.samples < (1u64 << 20) * 64 * 64);
+    near(&image, "cancelled");
+
+    let mut last = 0.0;
+    let mut record = |fraction: f32| {
+        assert!(fraction >= last && fraction <= 1.0);
+        last = fraction;
+        true
+    };
+    let stats = render(
+        &scene,
+        &camera,
+        &erpt_settings(32, 4, 4),
+        &mut image[..32 * 32 * 3],
+        Some(&mut record),
+    )
+    .unwrap();
+    assert_eq!(stats.stop, StopReason::Completed);
+    assert_eq!(stats.samples, 4 * 32 * 32);
+    assert_eq!(last, 1.0);
 }

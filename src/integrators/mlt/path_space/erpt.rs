@@ -29,7 +29,8 @@
 //!
 //! A stopped render keeps this: a chain cut short deposits its remaining energy at its
 //! current state (whose energy density is already f), and unstarted chains deposit theirs at
-//! the initial path (L = 0).
+//! the initial path (L = 0). The pass of camera samples under way is finished that way, so
+//! every pixel has as many camera samples as every other.
 //!
 //! # Determinism
 //!
@@ -70,7 +71,7 @@ const SEED_SALT: u64 = 0xe397_5a17_0000_0001;
 const PREPASS_SAMPLES: u64 = 1 << 14;
 const PREPASS_CHUNK: u64 = 256;
 /// Target camera samples per pass over the image (after the first).
-const PASS_SAMPLES: u64 = 1 << 16;
+const PASS_SAMPLES: u64 = 1 << 15;
 /// Rows per work unit.
 const BAND_ROWS: u32 = 2;
 /// Fixed-point units per e_d of the accumulators.
@@ -401,9 +402,11 @@ pub(crate) fn run(
         normalization: deposit_energy as f64,
         ..Default::default()
     };
-    // The first pass takes one sample per pixel and always covers the image (its chains
-    // cut short if the render stops); later passes take up to `batch` and stop at any
-    // pixel sample.
+    // The first pass takes one sample per pixel, later ones up to `batch`. A pass always
+    // completes, so every pixel has the same number of camera samples and the splat
+    // normalization is exact; once the render stops, the rest of the pass only takes the
+    // BDPT samples and leaves their energy where it is (chains of length 0), which bounds
+    // how long a stop takes by one pass of camera samples.
     let batch = (PASS_SAMPLES.div_ceil(pixels as u64)).clamp(1, 64) as u32;
     let total = if settings.samples_per_pixel > 0 {
         settings.samples_per_pixel
@@ -422,15 +425,12 @@ pub(crate) fn run(
             let mut counters = SampleCounters::default();
             let (mut taken, mut mutations, mut accepted, mut invalid) = (0, 0, 0, 0);
             let first_row = band as u32 * BAND_ROWS;
-            'pixels: for y in first_row..(first_row + BAND_ROWS).min(height) {
+            for y in first_row..(first_row + BAND_ROWS).min(height) {
                 for x in 0..width {
                     let pixel = y as u64 * width as u64 + x as u64;
                     let mut shift = Rng::new(seed, PIXEL_SHIFT_STREAM + pixel);
                     let shift = [shift.next_u32(), shift.next_u32()];
                     for sample in first..end {
-                        if first > 0 && control.should_stop() {
-                            break 'pixels;
-                        }
                         let [jx, jy] = shifted_sobol_2d(sample, shift);
                         let mut rng = Rng::for_pixel_sample(seed, pixel, sample as u64);
                         let (m, a, valid) = redistributor.sample(
