@@ -182,6 +182,56 @@ fn path_space_mlt_takes_mutation_weights_and_reports_each_mutation() {
 }
 
 #[test]
+fn erpt_takes_its_settings_and_reports_mutations() {
+    let out = temp_path("erpt.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"erpt",
+        &"--spp",
+        &"2",
+        &"--erpt-chain-length",
+        &"10",
+        &"--erpt-deposit",
+        &"0.0005",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    assert!(stdout.contains("erpt e_d = 0.000500"), "{stdout}");
+    let mutations: u64 = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("mutations "))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no mutations line in:\n{stdout}"));
+    // Chains of 10 steps.
+    assert!(mutations > 0 && mutations.is_multiple_of(10), "{stdout}");
+    let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
+    assert_eq!((w, h), (32, 32));
+    assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+    std::fs::remove_file(&out).unwrap();
+    // A chain length of 0 is refused with the reason.
+    let refused = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"erpt",
+        &"--erpt-chain-length",
+        &"0",
+        &"--out",
+        &out,
+    ]);
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("erpt_chain_length"), "{stderr}");
+}
+
+#[test]
 fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
     let out = temp_path("timed.png");
     let output = mlt_render(&[

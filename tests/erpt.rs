@@ -108,6 +108,40 @@ fn cornell_glass_agrees_with_the_path_tracer() {
     agrees_with_the_path_tracer("cornell-glass", 8);
 }
 
+/// The door-ajar scene (tests/common/door_ajar.rs), lit only through the crack of a door,
+/// against BDPT (`tests/bdpt.rs` checks BDPT against the path tracer there).
+#[test]
+fn door_ajar_agrees_with_bdpt() {
+    let (scene, camera) = load_canonical("door-ajar");
+    let renders: Vec<Vec<f32>> = (1000..1016)
+        .map(|seed| {
+            let settings = RenderSettings {
+                algorithm: Algorithm::Bdpt,
+                ..erpt_settings(64, 64, seed)
+            };
+            render_image(&scene, &camera, &settings)
+        })
+        .collect();
+    // Light-tracing splats correlate a render's pixels.
+    let reference = Estimate::from_correlated_renders(64, 64, &renders);
+    let test = erpt_estimate(&scene, &camera, DOOR_AJAR_SAMPLES);
+    let (tm, tv) = test.mean();
+    let (rm, rv) = reference.mean();
+    for c in 0..3 {
+        let se = (tv[c] + rv[c]).sqrt();
+        eprintln!(
+            "door-ajar channel {c}: ERPT {} BDPT {} (difference {:.2} standard errors; standard error {:.3}% of the mean)",
+            tm[c],
+            rm[c],
+            (tm[c] - rm[c]) / se,
+            100.0 * se / rm[c]
+        );
+    }
+    assert_estimates_agree("door-ajar ERPT", &test, &reference, 4, 5.0, 6.0);
+}
+
+const DOOR_AJAR_SAMPLES: u32 = 24;
+
 #[test]
 fn image_is_identical_for_any_thread_count() {
     let (scene, camera) = load_canonical("cornell-glass");
