@@ -208,7 +208,8 @@ pub struct RenderSettings {
     /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
     /// lens, caustic and multi-chain perturbations (`Mutation as usize` order). Each step
     /// picks among those the current path admits. The bidirectional weight must be
-    /// positive: it alone makes every path reachable.
+    /// positive: it alone makes every path reachable. ERPT uses the perturbations' weights
+    /// (its chains only perturb).
     pub mutation_weights: MutationWeights,
     /// ERPT: perturbations per chain (L). Each camera sample's energy e starts
     /// ⌊e / (L·e_d) + ξ⌋ chains.

@@ -176,6 +176,18 @@ fn chains_run_and_a_huge_deposit_energy_starts_none() {
     let stats = render(&scene, &camera, &none, &mut image, None).unwrap();
     assert_eq!(stats.mutations, 0);
     assert!(image.iter().all(|&v| v == 0.0));
+    // Through glass every perturbation applies somewhere; the bidirectional mutation never
+    // runs, and the counts add up.
+    let (scene, camera) = load_canonical("cornell-glass");
+    let stats = render(&scene, &camera, &settings, &mut image, None).unwrap();
+    let counts = stats.mutation_counts;
+    assert_eq!(counts.proposed[0], 0);
+    assert!(counts.proposed[1..].iter().all(|&n| n > 0), "{counts:?}");
+    assert_eq!(counts.proposed.iter().sum::<u64>(), stats.mutations);
+    assert_eq!(
+        counts.accepted.iter().sum::<u64>(),
+        stats.accepted_mutations
+    );
 }
 
 /// A time limit and a cancel both stop a render soon, with an image still near the path

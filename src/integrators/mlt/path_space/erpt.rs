@@ -131,9 +131,12 @@ impl Redistributor<'_> {
     fn flush(&self, pending: &mut Pending) {
         let sums = &self.sums[pending.pixel as usize];
         for (sum, value) in sums.iter().zip(pending.value) {
-            let units = (value * self.scale).round();
-            if units > 0.0 {
-                sum.fetch_add(units as u64, Ordering::Relaxed);
+            // `as` saturates; so does the sum (only reachable with an absurdly small e_d).
+            let units = (value * self.scale).round() as u64;
+            if units > 0 {
+                let _ = sum.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |s| {
+                    Some(s.saturating_add(units))
+                });
             }
         }
         pending.value = [0.0; 3];
