@@ -58,6 +58,7 @@ const ALGORITHMS: &[(&str, Algorithm, u32)] = &[
     ("pssmlt-no-direct", Algorithm::Pssmlt, 0),
     ("path-space-mlt", Algorithm::PathSpaceMlt, DIRECT),
     ("path-space-mlt-no-direct", Algorithm::PathSpaceMlt, 0),
+    ("erpt", Algorithm::Erpt, 0),
 ];
 
 const DEFAULT_SCENES: &[&str] = &["cornell-glass", "door-ajar"];
