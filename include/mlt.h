@@ -408,6 +408,19 @@ typedef struct MltRenderSettings {
    * e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
    */
   float erpt_deposit_energy;
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT`, 0 or 1: run a warm-up of about one mutation per pixel
+   * with `mutation_weights`, then weight each mutation by its acceptance rate there
+   * (within a factor of 8) for the rest of the render, on chains seeded anew. The weights
+   * used are reported in `MltRenderStats::mutation_weights`. Default 0.
+   */
+  uint32_t adapt_mutation_weights;
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT` and `MLT_ALGORITHM_ERPT`, 0 or 1: perturb directions at
+   * diffuse vertices and lights by small steps in their cosine-weighted sample space
+   * instead of within a cone. Default 0.
+   */
+  uint32_t perturb_in_sample_space;
 } MltRenderSettings;
 
 /**
@@ -485,6 +498,11 @@ typedef struct MltRenderStats {
    * `MLT_ALGORITHM_PATH_SPACE_MLT`: accepted proposals of each mutation.
    */
   uint64_t mutations_accepted[4];
+  /**
+   * `MLT_ALGORITHM_PATH_SPACE_MLT`: the mutation weights the chains ran with (after the
+   * warm-up, with `adapt_mutation_weights`). `MLT_ALGORITHM_ERPT`: its weights.
+   */
+  float mutation_weights[4];
 } MltRenderStats;
 
 /**

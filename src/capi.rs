@@ -189,6 +189,15 @@ pub struct MltRenderSettings {
     /// sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
     /// e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
     pub erpt_deposit_energy: f32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`, 0 or 1: run a warm-up of about one mutation per pixel
+    /// with `mutation_weights`, then weight each mutation by its acceptance rate there
+    /// (within a factor of 8) for the rest of the render, on chains seeded anew. The weights
+    /// used are reported in `MltRenderStats::mutation_weights`. Default 0.
+    pub adapt_mutation_weights: u32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT` and `MLT_ALGORITHM_ERPT`, 0 or 1: perturb directions at
+    /// diffuse vertices and lights by small steps in their cosine-weighted sample space
+    /// instead of within a cone. Default 0.
+    pub perturb_in_sample_space: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -218,6 +227,9 @@ pub struct MltRenderStats {
     pub mutations_proposed: [u64; 4],
     /// `MLT_ALGORITHM_PATH_SPACE_MLT`: accepted proposals of each mutation.
     pub mutations_accepted: [u64; 4],
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: the mutation weights the chains ran with (after the
+    /// warm-up, with `adapt_mutation_weights`). `MLT_ALGORITHM_ERPT`: its weights.
+    pub mutation_weights: [f32; 4],
 }
 
 /// Facts about a created scene.
@@ -462,7 +474,20 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         mutation_weights: MutationWeights(s.mutation_weights),
         erpt_chain_length: s.erpt_chain_length,
         erpt_deposit_energy: s.erpt_deposit_energy,
+        adapt_mutation_weights: flag(s.adapt_mutation_weights, "adapt_mutation_weights")?,
+        perturb_in_sample_space: flag(s.perturb_in_sample_space, "perturb_in_sample_space")?,
     })
+}
+
+/// A C boolean setting: 0 or 1, anything else is a mistake.
+fn flag(value: u32, name: &str) -> Result<bool> {
+    match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        other => Err(Error::invalid(format!(
+            "settings.{name} is {other}; it must be 0 or 1"
+        ))),
+    }
 }
 
 /// The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
@@ -603,6 +628,8 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             mutation_weights: d.mutation_weights.0,
             erpt_chain_length: d.erpt_chain_length,
             erpt_deposit_energy: d.erpt_deposit_energy,
+            adapt_mutation_weights: d.adapt_mutation_weights as u32,
+            perturb_in_sample_space: d.perturb_in_sample_space as u32,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;
@@ -797,6 +824,7 @@ pub unsafe extern "C" fn mlt_render_ex(
                 mutations: stats.mutations,
                 mutations_proposed: stats.mutation_counts.proposed,
                 mutations_accepted: stats.mutation_counts.accepted,
+                mutation_weights: stats.mutation_weights.0,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };

@@ -134,8 +134,10 @@ impl Estimator<'_> {
                     camera: *camera,
                     weights: settings.mutation_weights,
                     sizes: PerturbationSizes::for_image(camera.width, camera.height),
+                    perturb_in_sample_space: settings.perturb_in_sample_space,
                 };
-                path_space::run(&target, &chains, film, control, &mut keep_pace)
+                let adapt = settings.adapt_mutation_weights;
+                path_space::run(&target, &chains, adapt, film, control, &mut keep_pace)
             }
             Estimator::Erpt(bdpt) => {
                 let erpt = path_space::ErptSettings {
@@ -144,6 +146,7 @@ impl Estimator<'_> {
                     deposit_energy: settings.erpt_deposit_energy,
                     seed,
                     weights: settings.mutation_weights,
+                    perturb_in_sample_space: settings.perturb_in_sample_space,
                 };
                 path_space::run_erpt(bdpt, camera, &erpt, film, control)
             }
@@ -211,6 +214,16 @@ pub struct RenderSettings {
     /// positive: it alone makes every path reachable. ERPT uses the perturbations' weights
     /// (its chains only perturb).
     pub mutation_weights: MutationWeights,
+    /// Path-space MLT: run a warm-up of about one mutation per pixel with
+    /// `mutation_weights`, then adapt each weight to its mutation's acceptance rate there
+    /// (within a factor of 8) and run the rest of the render with those weights frozen, on
+    /// chains seeded anew (so every chain is a valid Metropolis chain; see
+    /// `path_space::chain::adapted_weights`). `RenderStats::mutation_weights` reports them.
+    pub adapt_mutation_weights: bool,
+    /// Path-space MLT and ERPT: perturb directions at diffuse vertices and lights by small
+    /// steps in their own (cosine-weighted) sample space instead of within a cone, so the
+    /// steps follow the BSDF's shape and its density cancels from the transfer ratio.
+    pub perturb_in_sample_space: bool,
     /// ERPT: perturbations per chain (L). Each camera sample's energy e starts
     /// ⌊e / (L·e_d) + ξ⌋ chains.
     pub erpt_chain_length: u32,
@@ -240,6 +253,8 @@ impl Default for RenderSettings {
             mutation_weights: MutationWeights::default(),
             erpt_chain_length: Self::DEFAULT_ERPT_CHAIN_LENGTH,
             erpt_deposit_energy: 0.0,
+            adapt_mutation_weights: false,
+            perturb_in_sample_space: false,
         }
     }
 }
@@ -404,8 +419,11 @@ pub struct RenderStats {
     /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by. ERPT: the
     /// deposit energy e_d the chains used.
     pub normalization: f64,
-    /// Path-space MLT: proposals and acceptances per mutation.
+    /// Path-space MLT: proposals and acceptances per mutation …
     pub mutation_counts: MutationCounts,
+    /// … and the weights the chains ran with (after the warm-up, if adapted). ERPT: the
+    /// weights of its perturbations.
+    pub mutation_weights: MutationWeights,
 }
 
 /// Called from the rendering call's own thread with the fraction done; return `false` to stop.
@@ -584,6 +602,7 @@ pub fn render(
         accepted_mutations: metropolis.accepted,
         normalization: metropolis.normalization,
         mutation_counts: metropolis.mutation_counts,
+        mutation_weights: metropolis.mutation_weights,
     })
 }
 

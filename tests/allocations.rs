@@ -39,9 +39,12 @@ fn allocations_do_not_grow_with_samples() {
     let scene = furnace_scene([0.5; 3], [1.0; 3]);
     let camera = furnace_camera();
     let mut image = vec![0.0; 32 * 32 * 3];
-    let mut count = |algorithm: Algorithm, per_pixel: u32| {
+    // `options`: path-space MLT's and ERPT's adapted weights and sample-space perturbations.
+    let mut count = |(algorithm, options): (Algorithm, bool), per_pixel: u32| {
         let settings = RenderSettings {
             algorithm,
+            adapt_mutation_weights: options,
+            perturb_in_sample_space: options,
             width: 32,
             height: 32,
             samples_per_pixel: per_pixel,
@@ -57,13 +60,15 @@ fn allocations_do_not_grow_with_samples() {
         ALLOCATIONS.load(Ordering::SeqCst) - before
     };
     for algorithm in [
-        Algorithm::Path,
-        Algorithm::Bdpt,
-        Algorithm::Pssmlt,
-        Algorithm::PssmltBdpt,
-        Algorithm::Mmlt,
-        Algorithm::PathSpaceMlt,
-        Algorithm::Erpt,
+        (Algorithm::Path, false),
+        (Algorithm::Bdpt, false),
+        (Algorithm::Pssmlt, false),
+        (Algorithm::PssmltBdpt, false),
+        (Algorithm::Mmlt, false),
+        (Algorithm::PathSpaceMlt, false),
+        (Algorithm::PathSpaceMlt, true),
+        (Algorithm::Erpt, false),
+        (Algorithm::Erpt, true),
     ] {
         // 32 x 32 pixels: both renders take the same number of passes (one sample, then up
         // to 64 per pass) and rounds, so only per-sample allocations could differ.

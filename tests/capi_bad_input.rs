@@ -356,6 +356,10 @@ fn defaults_are_valid_and_documented() {
         (0.3, 0.01, 1)
     );
     assert_eq!((s.erpt_chain_length, s.erpt_deposit_energy), (100, 0.0));
+    assert_eq!(
+        (s.adapt_mutation_weights, s.perturb_in_sample_space),
+        (0, 0)
+    );
 }
 
 #[test]
@@ -1248,7 +1252,7 @@ fn metropolis_settings_out_of_range() {
         chains: 4,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 13] = [
+    let cases: [(MltRenderSettings, &[&str]); 15] = [
         (
             MltRenderSettings {
                 mutations_per_pixel: 0,
@@ -1341,6 +1345,20 @@ fn metropolis_settings_out_of_range() {
                 ..metropolis
             },
             &["mutation_weights[0]", "bidirectional", "positive"],
+        ),
+        (
+            MltRenderSettings {
+                adapt_mutation_weights: 2,
+                ..metropolis
+            },
+            &["adapt_mutation_weights is 2", "0 or 1"],
+        ),
+        (
+            MltRenderSettings {
+                perturb_in_sample_space: u32::MAX,
+                ..metropolis
+            },
+            &["perturb_in_sample_space is 4294967295", "0 or 1"],
         ),
     ];
     for (settings, needles) in &cases {

@@ -181,6 +181,58 @@ fn path_space_mlt_takes_mutation_weights_and_reports_each_mutation() {
     std::fs::remove_file(&out).unwrap();
 }
 
+/// `--adapt-mutation-weights` reports the weights the chains ran with after the warm-up:
+/// on cornell-glass the lens perturbation, accepted far more often than the bidirectional
+/// mutation, gains weight on it. `--perturb-in-sample-space` is taken.
+#[test]
+fn path_space_mlt_adapts_its_mutation_weights_and_reports_them() {
+    let out = temp_path("path-space-adapted.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"path-space-mlt",
+        &"--mutation-weights",
+        &"1,1,1,1",
+        &"--adapt-mutation-weights",
+        &"--perturb-in-sample-space",
+        &"--mutations-per-pixel",
+        &"4",
+        &"--bootstrap",
+        &"4096",
+        &"--chains",
+        &"64",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    let line = |name: &str| -> Vec<String> {
+        stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with(name) && l.contains("proposed"))
+            .unwrap_or_else(|| panic!("no {name:?} line in:\n{stdout}"))
+            .split_whitespace()
+            .map(str::to_owned)
+            .collect()
+    };
+    let weight = |name: &str| -> f32 { line(name).last().unwrap().parse().unwrap() };
+    let proposed = |name: &str| -> u64 { line(name)[1].parse().unwrap() };
+    let names = ["bidirectional", "lens", "caustic", "multichain"];
+    assert_eq!(
+        names.map(proposed).iter().sum::<u64>(),
+        4 * 32 * 32,
+        "{stdout}"
+    );
+    let weights = names.map(weight);
+    assert!(weights[1] > 1.5 * weights[0], "{weights:?} in:\n{stdout}");
+    assert!(weights != [1.0; 4], "{stdout}");
+    std::fs::remove_file(&out).unwrap();
+}
+
 #[test]
 fn erpt_takes_its_settings_and_reports_mutations() {
     let out = temp_path("erpt.pfm");

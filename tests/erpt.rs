@@ -28,9 +28,20 @@ fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Ve
     image
 }
 
-fn erpt_estimate(scene: &Scene, camera: &Camera, samples_per_pixel: u32) -> Estimate {
+fn erpt_estimate(
+    scene: &Scene,
+    camera: &Camera,
+    samples_per_pixel: u32,
+    perturb_in_sample_space: bool,
+) -> Estimate {
     let renders: Vec<Vec<f32>> = (0..16)
-        .map(|seed| render_image(scene, camera, &erpt_settings(64, samples_per_pixel, seed)))
+        .map(|seed| {
+            let settings = RenderSettings {
+                perturb_in_sample_space,
+                ..erpt_settings(64, samples_per_pixel, seed)
+            };
+            render_image(scene, camera, &settings)
+        })
         .collect();
     Estimate::from_correlated_renders(64, 64, &renders)
 }
@@ -70,10 +81,14 @@ fn furnace_matches_the_geometric_series() {
     }
 }
 
-fn agrees_with_the_path_tracer(scene_name: &str, samples_per_pixel: u32) {
+fn agrees_with_the_path_tracer(
+    scene_name: &str,
+    samples_per_pixel: u32,
+    perturb_in_sample_space: bool,
+) {
     let (scene, camera) = load_canonical(scene_name);
     let reference = path_traced_estimate(&scene, &camera, 64, 256, 1000..1008);
-    let test = erpt_estimate(&scene, &camera, samples_per_pixel);
+    let test = erpt_estimate(&scene, &camera, samples_per_pixel, perturb_in_sample_space);
     let (tm, tv) = test.mean();
     let (rm, rv) = reference.mean();
     for c in 0..3 {
@@ -100,12 +115,19 @@ fn agrees_with_the_path_tracer(scene_name: &str, samples_per_pixel: u32) {
 
 #[test]
 fn cornell_box_agrees_with_the_path_tracer() {
-    agrees_with_the_path_tracer("cornell-box", 8);
+    agrees_with_the_path_tracer("cornell-box", 8, false);
 }
 
 #[test]
 fn cornell_glass_agrees_with_the_path_tracer() {
-    agrees_with_the_path_tracer("cornell-glass", 8);
+    agrees_with_the_path_tracer("cornell-glass", 8, false);
+}
+
+/// With the perturbations stepping in the BSDF's sample space (the caustic and multi-chain
+/// perturbations carry the light through the glass here).
+#[test]
+fn cornell_glass_in_sample_space_agrees_with_the_path_tracer() {
+    agrees_with_the_path_tracer("cornell-glass", 8, true);
 }
 
 /// The door-ajar scene (tests/common/door_ajar.rs), lit only through the crack of a door,
@@ -124,7 +146,7 @@ fn door_ajar_agrees_with_bdpt() {
         .collect();
     // Light-tracing splats correlate a render's pixels.
     let reference = Estimate::from_correlated_renders(64, 64, &renders);
-    let test = erpt_estimate(&scene, &camera, DOOR_AJAR_SAMPLES);
+    let test = erpt_estimate(&scene, &camera, DOOR_AJAR_SAMPLES, false);
     let (tm, tv) = test.mean();
     let (rm, rv) = reference.mean();
     for c in 0..3 {

@@ -9,11 +9,13 @@ mod common;
 use common::*;
 use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
 
-/// An algorithm with its direct pass (`direct_samples_per_mutation`).
+/// An algorithm with its direct pass (`direct_samples_per_mutation`); path-space MLT also
+/// with both its options (`adapt_mutation_weights`, `perturb_in_sample_space`).
 #[derive(Clone, Copy, Debug)]
 struct Variant {
     algorithm: Algorithm,
     direct_samples_per_mutation: u32,
+    adapted_in_sample_space: bool,
 }
 
 fn metropolis_settings(
@@ -27,6 +29,8 @@ fn metropolis_settings(
         height: size,
         algorithm: variant.algorithm,
         direct_samples_per_mutation: variant.direct_samples_per_mutation,
+        adapt_mutation_weights: variant.adapted_in_sample_space,
+        perturb_in_sample_space: variant.adapted_in_sample_space,
         mutations_per_pixel,
         bootstrap_samples: 1 << 16,
         chains: 256,
@@ -247,6 +251,16 @@ fn glass_caustic() -> (Scene, Camera) {
 /// carry the image.
 #[test]
 fn path_space_perturbations_agree_with_bdpt_on_a_glass_caustic() {
+    perturbations_agree_with_bdpt_on_a_glass_caustic(false);
+}
+
+/// The same with the perturbations stepping in sample space and the weights adapted.
+#[test]
+fn path_space_perturbations_in_sample_space_agree_with_bdpt_on_a_glass_caustic() {
+    perturbations_agree_with_bdpt_on_a_glass_caustic(true);
+}
+
+fn perturbations_agree_with_bdpt_on_a_glass_caustic(adapted_in_sample_space: bool) {
     let (scene, camera) = glass_caustic();
     let reference = bdpt_reference(&scene, &camera, 128);
     let renders: Vec<Vec<f32>> = (0..16)
@@ -258,6 +272,7 @@ fn path_space_perturbations_agree_with_bdpt_on_a_glass_caustic() {
                     Variant {
                         algorithm: Algorithm::PathSpaceMlt,
                         direct_samples_per_mutation: DIRECT,
+                        adapted_in_sample_space,
                     },
                     64,
                     256,
@@ -329,12 +344,16 @@ fn cancelled_render_is_normalized_by_the_mutations_made(variant: Variant) {
 /// module named after it.
 macro_rules! metropolis_tests {
     ($module:ident, $algorithm:expr, $direct:expr) => {
+        metropolis_tests!($module, $algorithm, $direct, false);
+    };
+    ($module:ident, $algorithm:expr, $direct:expr, $adapted_in_sample_space:expr) => {
         mod $module {
             use super::*;
 
             const VARIANT: Variant = Variant {
                 algorithm: $algorithm,
                 direct_samples_per_mutation: $direct,
+                adapted_in_sample_space: $adapted_in_sample_space,
             };
 
             #[test]
@@ -382,6 +401,12 @@ metropolis_tests!(
     path_space_mlt_without_direct_pass,
     Algorithm::PathSpaceMlt,
     0
+);
+metropolis_tests!(
+    path_space_mlt_adapted_in_sample_space,
+    Algorithm::PathSpaceMlt,
+    DIRECT,
+    true
 );
 
 /// The acceptance criterion for the defaults: with `RenderSettings::default()` (the

@@ -132,6 +132,14 @@ struct Args {
     /// lens, caustic and multi-chain perturbations.
     #[arg(long, value_name = "B,L,C,M", default_value_t = WeightsArg(RenderSettings::default().mutation_weights.0))]
     mutation_weights: WeightsArg,
+    /// Path-space MLT: after a warm-up of one mutation per pixel, weight each mutation by
+    /// its acceptance rate there (the summary lists the weights used).
+    #[arg(long)]
+    adapt_mutation_weights: bool,
+    /// Path-space MLT and ERPT: perturb directions by small steps in the BSDF's sample
+    /// space instead of within a cone.
+    #[arg(long)]
+    perturb_in_sample_space: bool,
     /// ERPT: perturbations per chain.
     #[arg(long, value_name = "L", default_value_t = RenderSettings::default().erpt_chain_length)]
     erpt_chain_length: u32,
@@ -272,6 +280,8 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         mutation_weights: MutationWeights(args.mutation_weights.0),
         erpt_chain_length: args.erpt_chain_length,
         erpt_deposit_energy: args.erpt_deposit,
+        adapt_mutation_weights: args.adapt_mutation_weights,
+        perturb_in_sample_space: args.perturb_in_sample_space,
     }
 }
 
@@ -394,9 +404,10 @@ fn print_summary(
                 counts.accepted[mutation as usize],
             );
             println!(
-                "  {:<13} {proposed} proposed, {:.1}% accepted",
+                "  {:<13} {proposed} proposed, {:.1}% accepted, weight {:.3}",
                 format!("{mutation:?}").to_lowercase(),
-                100.0 * accepted as f64 / proposed.max(1) as f64
+                100.0 * accepted as f64 / proposed.max(1) as f64,
+                stats.mutation_weights.0[mutation as usize]
             );
         }
     }

@@ -27,7 +27,7 @@
 //! to the film in chain order after the round.
 
 use super::acceptance;
-use super::path_space::MutationCounts;
+use super::path_space::{MutationCounts, MutationWeights};
 use super::pss::PssSampler;
 use crate::film::Film;
 use crate::integrators::Splat;
@@ -72,8 +72,10 @@ pub struct PssmltOutcome {
     pub accepted: u64,
     /// The normalization b = ∫ f (summed over chain groups) the image is scaled by.
     pub normalization: f64,
-    /// Path-space chains: proposals and acceptances per mutation.
+    /// Path-space chains: proposals and acceptances per mutation …
     pub mutation_counts: MutationCounts,
+    /// … and the weights they ran with (after the warm-up, if adapted).
+    pub mutation_weights: MutationWeights,
 }
 
 /// What one state of a chain contributes to the image: a few (pixel, value) entries and the
@@ -446,6 +448,7 @@ pub(crate) fn resample_seeds(
 }
 
 /// What a render's chains are to do: their total mutations and how they are split.
+#[derive(Clone)]
 pub(crate) struct ChainPlan {
     pub chains_per_group: Vec<u64>,
     pub chain_count: u64,
@@ -471,6 +474,19 @@ impl ChainPlan {
             chain_count,
             pixels,
         }
+    }
+
+    /// The same chains making `mutations_per_chain` each: one phase of the render.
+    pub fn phase(&self, mutations_per_chain: u64) -> Self {
+        ChainPlan {
+            mutations_per_chain,
+            ..self.clone()
+        }
+    }
+
+    /// About one mutation per pixel for each chain: the first round of a render.
+    pub fn first_round(&self) -> u64 {
+        self.pixels.div_ceil(self.chain_count.max(1))
     }
 }
 
@@ -565,6 +581,7 @@ where
         camera,
         &mut chains,
         &plan,
+        0,
         film,
         control,
         after_round,
@@ -578,12 +595,15 @@ where
 /// so that each chain's deposits count with its weight per mutation.
 ///
 /// The first round, about one mutation per pixel, always runs, so a stopped render still
-/// has an image.
+/// has an image. `done_before`: mutations per chain made in an earlier phase of the render
+/// by as many chains of the same weights, whose deposits are already on the film.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn run_rounds<C: MarkovChain>(
     target: &C::Target,
     camera: &CameraModel,
     chains: &mut [WeightedChain<C>],
     plan: &ChainPlan,
+    done_before: u64,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
@@ -599,9 +619,9 @@ pub(crate) fn run_rounds<C: MarkovChain>(
         chain.deposits = Vec::with_capacity((per_round * deposits_per_mutation) as usize);
     }
     let mut mutations_done = 0u64;
-    let first_round = plan.pixels.div_ceil(chain_count.max(1)).min(per_round);
+    let first_round = plan.first_round().min(per_round);
     while mutations_done < plan.mutations_per_chain
-        && (mutations_done == 0 || !control.should_stop())
+        && (mutations_done + done_before == 0 || !control.should_stop())
     {
         let round = if mutations_done == 0 {
             first_round
@@ -624,7 +644,7 @@ pub(crate) fn run_rounds<C: MarkovChain>(
         }
         after_round(
             film,
-            (mutations_done * chain_count) as f64 / plan.pixels as f64,
+            ((done_before + mutations_done) * chain_count) as f64 / plan.pixels as f64,
         );
     }
 
@@ -637,15 +657,11 @@ pub(crate) fn run_rounds<C: MarkovChain>(
     for chain in chains.iter() {
         outcome.accepted += chain.chain.accepted();
         rays += chain.chain.rays();
-        let counts = chain.chain.mutation_counts();
-        for m in 0..counts.proposed.len() {
-            outcome.mutation_counts.proposed[m] += counts.proposed[m];
-            outcome.mutation_counts.accepted[m] += counts.accepted[m];
-        }
+        outcome.mutation_counts.add(&chain.chain.mutation_counts());
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
-    if mutations_done > 0 {
-        film.set_splat_scale(plan.pixels as f64 / mutations_done as f64);
+    if done_before + mutations_done > 0 {
+        film.set_splat_scale(plan.pixels as f64 / (done_before + mutations_done) as f64);
     }
     outcome
 }

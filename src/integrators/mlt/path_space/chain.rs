@@ -7,6 +7,7 @@ use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
 use crate::film::Film;
 use crate::integrators::Splat;
+use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::pssmlt::{
     self, ChainPlan, MarkovChain, PathSample, PssmltOutcome, PssmltSettings, WeightedChain,
@@ -59,12 +60,23 @@ pub struct MutationCounts {
     pub accepted: [u64; 4],
 }
 
+impl MutationCounts {
+    pub fn add(&mut self, other: &MutationCounts) {
+        for m in 0..4 {
+            self.proposed[m] += other.proposed[m];
+            self.accepted[m] += other.accepted[m];
+        }
+    }
+}
+
 /// What the chains explore: paths of the scene through the camera, within a depth range.
 pub(crate) struct PathSpaceTarget<'a> {
     pub bdpt: BdptAllStrategies<'a>,
     pub camera: CameraModel,
     pub weights: MutationWeights,
     pub sizes: PerturbationSizes,
+    /// Perturb directions in the BSDF's sample space (`perturbation` module docs).
+    pub perturb_in_sample_space: bool,
 }
 
 impl PathSpaceTarget<'_> {
@@ -149,6 +161,7 @@ impl<'a> MarkovChain for PathChain<'a> {
             Mutation::Lens | Mutation::MultiChain => {
                 let mut kernel = RandomKernel {
                     sizes: &target.sizes,
+                    in_sample_space: target.perturb_in_sample_space,
                     rng,
                 };
                 let multi_chain = mutation == Mutation::MultiChain;
@@ -157,6 +170,7 @@ impl<'a> MarkovChain for PathChain<'a> {
             Mutation::Caustic => {
                 let mut kernel = RandomKernel {
                     sizes: &target.sizes,
+                    in_sample_space: target.perturb_in_sample_space,
                     rng,
                 };
                 perturbation::caustic(&space, &mut kernel, x, y, rays)
@@ -208,10 +222,12 @@ impl<'a> MarkovChain for PathChain<'a> {
     }
 }
 
-/// Runs path-space MLT; see `pssmlt::run` for `after_round`.
+/// Runs path-space MLT; see `pssmlt::run` for `after_round`. With `adapt_weights`, the
+/// mutation weights are adapted after a warm-up (see `adapted_weights`).
 pub(crate) fn run(
     target: &PathSpaceTarget,
     settings: &PssmltSettings,
+    adapt_weights: bool,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
@@ -222,66 +238,218 @@ pub(crate) fn run(
     let boot = pssmlt::bootstrap(&target.bdpt, camera, settings, control);
     let b = boot.sums[0] / boot.samples as f64;
     if b <= 0.0 || !b.is_finite() {
-        return pssmlt::finish_without_light(camera, settings, film, control, after_round);
+        let mut outcome =
+            pssmlt::finish_without_light(camera, settings, film, control, after_round);
+        outcome.mutation_weights = target.weights;
+        return outcome;
     }
 
     // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution.
     let plan = ChainPlan::new(&[b], camera, settings);
-    let seeds = pssmlt::resample_seeds(&boot, &plan.chains_per_group, settings.seed);
-    drop(boot);
-    let max_vertices = target.bdpt.0.max_depth as usize + 2;
-    let space = target.space();
-    let mut chains: Vec<WeightedChain<PathChain>> = seeds
-        .into_par_iter()
-        .enumerate()
-        .map(|(c, (_, index))| {
-            let mut sampler = pssmlt::new_sampler(&target.bdpt, settings);
-            pssmlt::restart_as_bootstrap(&mut sampler, settings, camera, index, n);
-            let mut scratch =
-                crate::integrators::mlt::pssmlt::PrimarySpaceTarget::scratch(&target.bdpt);
-            let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + c as u64);
-            let mut current = Vec::with_capacity(max_vertices);
-            let mut current_sample = PathSample::with_capacity(1);
-            let mut rays = 0;
-            let seeded = target.bdpt.seed_path(
-                camera,
-                &mut sampler,
-                &mut scratch,
-                choice.uniform(),
-                &mut current,
-                &mut rays,
-            );
-            if let Some((value, pixel)) =
-                seeded.and_then(|s| space.unweighted_contribution(&current, s, true))
-            {
-                current_sample.push(pixel, value);
-            }
-            let chain = PathChain {
-                rng: Rng::new(settings.seed, CHAIN_STREAM + c as u64),
-                current,
-                current_sample,
-                proposal: Vec::with_capacity(max_vertices),
-                proposal_sample: PathSample::with_capacity(1),
-                eye: Vec::with_capacity(max_vertices),
-                accepted: 0,
-                counts: MutationCounts::default(),
-                rays,
-                _target: PhantomData,
-            };
-            WeightedChain::new(chain, b / plan.chain_count as f64)
-        })
-        .collect();
+    let weight = b / plan.chain_count as f64;
+    let seed_chains = |seed: u64, first_stream: u64| -> Vec<WeightedChain<PathChain>> {
+        let seeds = pssmlt::resample_seeds(&boot, &plan.chains_per_group, seed);
+        seeds
+            .into_par_iter()
+            .enumerate()
+            .map(|(c, (_, index))| {
+                let stream = first_stream + c as u64;
+                WeightedChain::new(seed_chain(target, settings, index, n, stream), weight)
+            })
+            .collect()
+    };
 
-    // 3. Rounds of mutations.
+    // 3. Rounds of mutations: in one phase, or a warm-up with the given weights and a
+    // second phase with the adapted ones.
+    let warmup = plan.first_round();
+    if !adapt_weights || plan.mutations_per_chain <= warmup {
+        let mut chains = seed_chains(settings.seed, 0);
+        drop(boot);
+        let mut outcome = pssmlt::run_rounds(
+            target,
+            camera,
+            &mut chains,
+            &plan,
+            0,
+            film,
+            control,
+            after_round,
+        );
+        outcome.normalization = b;
+        outcome.mutation_weights = target.weights;
+        return outcome;
+    }
+    let mut chains = seed_chains(settings.seed, 0);
+    let warmup_plan = plan.phase(warmup);
     let mut outcome = pssmlt::run_rounds(
         target,
         camera,
         &mut chains,
-        &plan,
+        &warmup_plan,
+        0,
         film,
         control,
         after_round,
     );
+    let mut counts = MutationCounts::default();
+    for chain in &chains {
+        counts.add(&chain.chain.counts);
+    }
+    let adapted = PathSpaceTarget {
+        bdpt: BdptAllStrategies(Bdpt {
+            scene: target.bdpt.0.scene,
+            max_depth: target.bdpt.0.max_depth,
+            min_depth: target.bdpt.0.min_depth,
+        }),
+        camera: target.camera,
+        weights: adapted_weights(target.weights, &counts),
+        sizes: target.sizes,
+        perturb_in_sample_space: target.perturb_in_sample_space,
+    };
+    outcome.mutation_weights = adapted.weights;
     outcome.normalization = b;
+    if control.should_stop() {
+        return outcome;
+    }
+    // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
+    let mut chains = seed_chains(settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
+    drop(boot);
+    let rest = pssmlt::run_rounds(
+        &adapted,
+        camera,
+        &mut chains,
+        &plan.phase(plan.mutations_per_chain - warmup),
+        warmup,
+        film,
+        control,
+        after_round,
+    );
+    outcome.mutations += rest.mutations;
+    outcome.accepted += rest.accepted;
+    outcome.mutation_counts.add(&rest.mutation_counts);
     outcome
+}
+
+/// Distinguishes the seeds of the chains after a warm-up from the warm-up's own.
+const ADAPTED_PHASE_SEED: u64 = 0xada7_7ed0_0000_0000;
+
+/// Mutation weights adapted to the acceptance counted over a warm-up: each weight times its
+/// mutation's acceptance rate, within a factor of `MAX_ADAPTATION` of the given weight (a
+/// mutation never proposed keeps its weight times the overall rate).
+///
+/// Why the chains stay valid: a chain whose kernel changes with its own history is no longer
+/// a Markov chain, and f need not be its stationary density. Here every chain runs with one
+/// fixed mixture of mutations: the warm-up chains with the given weights, then new chains
+/// with the adapted weights, frozen for the rest of the render and seeded from the bootstrap
+/// anew, not from the warm-up chains' states (whose distribution, given the counts that set
+/// the weights, is no longer f). Each mixture of mutations that all satisfy detailed balance
+/// with respect to f does too, whatever its weights, and both phases' deposits count with
+/// the same weight per mutation. The bidirectional mutation keeps a positive weight, so the
+/// adapted chains stay ergodic.
+pub(crate) fn adapted_weights(
+    weights: MutationWeights,
+    counts: &MutationCounts,
+) -> MutationWeights {
+    let proposed: u64 = counts.proposed.iter().sum();
+    let accepted: u64 = counts.accepted.iter().sum();
+    if proposed == 0 {
+        return weights;
+    }
+    let overall = accepted as f32 / proposed as f32;
+    let mut adapted = weights.0;
+    for (m, w) in adapted.iter_mut().enumerate() {
+        let rate = if counts.proposed[m] > 0 {
+            counts.accepted[m] as f32 / counts.proposed[m] as f32
+        } else {
+            overall
+        };
+        let factor =
+            (rate / overall.max(f32::MIN_POSITIVE)).clamp(1.0 / MAX_ADAPTATION, MAX_ADAPTATION);
+        *w *= factor;
+    }
+    MutationWeights(adapted)
+}
+
+/// How far adaptation may move a weight (a factor either way).
+const MAX_ADAPTATION: f32 = 8.0;
+
+/// A chain seeded from bootstrap sample `index` (of `bootstrap_samples`), moving with random
+/// stream `stream`.
+fn seed_chain<'a>(
+    target: &PathSpaceTarget<'a>,
+    settings: &PssmltSettings,
+    index: u64,
+    bootstrap_samples: u64,
+    stream: u64,
+) -> PathChain<'a> {
+    let camera = &target.camera;
+    let space = target.space();
+    let max_vertices = target.bdpt.0.max_depth as usize + 2;
+    let mut sampler = pssmlt::new_sampler(&target.bdpt, settings);
+    pssmlt::restart_as_bootstrap(&mut sampler, settings, camera, index, bootstrap_samples);
+    let mut scratch = crate::integrators::mlt::pssmlt::PrimarySpaceTarget::scratch(&target.bdpt);
+    let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + stream);
+    let mut current = Vec::with_capacity(max_vertices);
+    let mut current_sample = PathSample::with_capacity(1);
+    let mut rays = 0;
+    let seeded = target.bdpt.seed_path(
+        camera,
+        &mut sampler,
+        &mut scratch,
+        choice.uniform(),
+        &mut current,
+        &mut rays,
+    );
+    if let Some((value, pixel)) =
+        seeded.and_then(|s| space.unweighted_contribution(&current, s, true))
+    {
+        current_sample.push(pixel, value);
+    }
+    PathChain {
+        rng: Rng::new(settings.seed, CHAIN_STREAM + stream),
+        current,
+        current_sample,
+        proposal: Vec::with_capacity(max_vertices),
+        proposal_sample: PathSample::with_capacity(1),
+        eye: Vec::with_capacity(max_vertices),
+        accepted: 0,
+        counts: MutationCounts::default(),
+        rays,
+        _target: PhantomData,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each weight follows its mutation's acceptance rate relative to the overall rate,
+    /// within a factor of `MAX_ADAPTATION`; a mutation never proposed keeps its weight.
+    #[test]
+    fn adapted_weights_follow_the_acceptance_rates() {
+        let counts = MutationCounts {
+            proposed: [1000, 1000, 0, 1000],
+            accepted: [100, 800, 0, 0],
+        };
+        let overall = 900.0 / 3000.0;
+        let adapted = adapted_weights(MutationWeights([0.5, 0.25, 0.25, 0.25]), &counts);
+        let expected = [
+            0.5 * 0.1 / overall,
+            0.25 * 0.8 / overall,
+            0.25,
+            0.25 / MAX_ADAPTATION,
+        ];
+        for (got, want) in adapted.0.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-6, "{:?} vs {expected:?}", adapted.0);
+        }
+        assert!(
+            adapted.0[0] > 0.0,
+            "the bidirectional mutation keeps a weight"
+        );
+        let none = MutationCounts::default();
+        assert_eq!(
+            adapted_weights(MutationWeights::default(), &none),
+            MutationWeights::default()
+        );
+    }
 }

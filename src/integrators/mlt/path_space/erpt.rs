@@ -86,6 +86,8 @@ pub(crate) struct ErptSettings {
     pub deposit_energy: f32,
     pub seed: u64,
     pub weights: MutationWeights,
+    /// Perturb directions in the BSDF's sample space (`perturbation` module docs).
+    pub perturb_in_sample_space: bool,
 }
 
 /// Per-work-unit memory, made once per render.
@@ -112,6 +114,7 @@ struct Redistributor<'a> {
     bdpt: &'a Bdpt<'a>,
     space: PathSpace<'a>,
     sizes: PerturbationSizes,
+    perturb_in_sample_space: bool,
     weights: MutationWeights,
     chain_length: u32,
     deposit_energy: f32,
@@ -211,6 +214,7 @@ impl Redistributor<'_> {
                     .unwrap_or_else(|| (0..3).rev().find(|&m| choice[m] > 0.0).unwrap_or(0));
                 let mut kernel = RandomKernel {
                     sizes: &self.sizes,
+                    in_sample_space: self.perturb_in_sample_space,
                     rng,
                 };
                 let (x, y) = (&scratch.current, &mut scratch.proposal);
@@ -380,6 +384,7 @@ pub(crate) fn run(
             camera,
         },
         sizes: PerturbationSizes::for_image(width, height),
+        perturb_in_sample_space: settings.perturb_in_sample_space,
         weights: settings.weights,
         chain_length,
         deposit_energy,
@@ -469,11 +474,9 @@ pub(crate) fn run(
         first = end;
     }
     for unit in &units {
-        for m in 0..4 {
-            outcome.mutation_counts.proposed[m] += unit.counts.proposed[m];
-            outcome.mutation_counts.accepted[m] += unit.counts.accepted[m];
-        }
+        outcome.mutation_counts.add(&unit.counts);
     }
+    outcome.mutation_weights = settings.weights;
     // The film divides splats by (samples taken / pixels): one camera sample per pixel.
     let unit = deposit_energy as f64 / FIXED_POINT;
     film.add_splat_sums(

@@ -34,6 +34,17 @@
 //! density of that direction, which C_s divided by). The film offset needs no such factor:
 //! the camera samples film points uniformly, and C_s's camera factor is already per unit of
 //! film area.
+//!
+//! # Steps in the BSDF's sample space
+//!
+//! With `RandomKernel::in_sample_space`, a direction is perturbed where the vertex samples
+//! it: its coordinates u in the vertex's cosine-weighted sampling (the BSDF's of a diffuse
+//! surface, the emission's of a light; p_σ = cos θ / π either way) take a small symmetric
+//! step, and the new direction is the sampling's image of the new u at the new vertex. The
+//! steps are then shaped by the BSDF: wide where it is wide, fine towards grazing angles,
+//! where cos θ changes fast. The map from u to directions has Jacobian 1 / p_σ, so
+//! T(x→y) = k(u_y − u_x) · p_σ(y, ω_d) per unit solid angle, and in the ratio above the
+//! p_σ of both paths cancel against the kernel's: it is |C_s(y)| / |C_s(x)|.
 
 use super::bidirectional::Proposal;
 use super::{PathSpace, PathVertex, direction};
@@ -93,17 +104,63 @@ fn perturb_direction(w: Vec3A, sizes: &PerturbationSizes, rng: &mut Rng) -> Vec3
     basis.to_world(local).normalize()
 }
 
+/// The coordinates (sin² θ, φ / 2π) of direction `w` in the cosine-weighted sampling of the
+/// hemisphere around `normal`: the inverse of `from_sample_space`.
+#[inline]
+fn to_sample_space(normal: Vec3A, w: Vec3A) -> [f32; 2] {
+    let basis = OrthonormalBasis::from_normal(normal);
+    let (x, y) = (basis.tangent.dot(w), basis.bitangent.dot(w));
+    let phi = y.atan2(x) * (1.0 / TAU);
+    [
+        (x * x + y * y).min(1.0),
+        if phi < 0.0 { phi + 1.0 } else { phi },
+    ]
+}
+
+/// The direction with sample-space coordinates `u` in the hemisphere around `normal`; its
+/// density per unit solid angle is cos θ / π when u is uniform.
+#[inline]
+fn from_sample_space(normal: Vec3A, [u1, u2]: [f32; 2]) -> Vec3A {
+    let basis = OrthonormalBasis::from_normal(normal);
+    let (sin_theta, cos_theta) = (u1.sqrt(), (1.0 - u1).max(0.0).sqrt());
+    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
+    basis
+        .to_world(Vec3A::new(
+            sin_theta * cos_phi,
+            sin_theta * sin_phi,
+            cos_theta,
+        ))
+        .normalize()
+}
+
+/// `u` folded back into [0, 1] by reflection at both ends: with a symmetric step, the
+/// folded walk is symmetric too (each image of the step has its mirror image).
+#[inline]
+fn reflect_into_unit(u: f32) -> f32 {
+    let v = u.rem_euclid(2.0);
+    if v > 1.0 { 2.0 - v } else { v }
+}
+
 /// Where a perturbation's random moves come from.
 pub(crate) trait Kernel {
     /// An offset of the film position, in pixels.
     fn film_offset(&mut self) -> [f32; 2];
-    /// A direction near `old`.
-    fn direction(&mut self, old: Vec3A) -> Vec3A;
+    /// A direction near `old`, which left a vertex sampling directions around `old_side`
+    /// (its sampling hemisphere's normal), for a vertex sampling around `new_side`.
+    /// `None`: the new direction has no density there (the move is refused).
+    fn direction(&mut self, old: Vec3A, old_side: Vec3A, new_side: Vec3A) -> Option<Vec3A>;
+    /// Whether the direction's density is the vertex's sampling density p_σ times a
+    /// symmetric factor, so that the p_σ cancel from the ratio (see the module docs).
+    fn follows_sampling_density(&self) -> bool {
+        false
+    }
 }
 
-/// The perturbations' kernels: symmetric, of the given sizes.
+/// The perturbations' kernels: symmetric, of the given sizes; directions turned within a
+/// cone or, `in_sample_space`, stepped in the vertex's sample space (module docs).
 pub(crate) struct RandomKernel<'a> {
     pub sizes: &'a PerturbationSizes,
+    pub in_sample_space: bool,
     pub rng: &'a mut Rng,
 }
 
@@ -116,8 +173,36 @@ impl Kernel for RandomKernel<'_> {
     }
 
     #[inline]
-    fn direction(&mut self, old: Vec3A) -> Vec3A {
-        perturb_direction(old, self.sizes, self.rng)
+    fn direction(&mut self, old: Vec3A, old_side: Vec3A, new_side: Vec3A) -> Option<Vec3A> {
+        if !self.in_sample_space {
+            return Some(perturb_direction(old, self.sizes, self.rng));
+        }
+        // A step of log-uniform length towards a uniform angle: symmetric in u.
+        let [u1, u2] = to_sample_space(old_side, old);
+        let length = log_uniform(
+            self.sizes.angle_min,
+            self.sizes.angle_max,
+            self.rng.uniform(),
+        );
+        let (sin, cos) = (TAU * self.rng.uniform()).sin_cos();
+        let u1 = reflect_into_unit(u1 + length * cos);
+        let u2 = (u2 + length * sin).rem_euclid(1.0);
+        // At u1 = 1 the direction is tangent to the surface: density 0.
+        (u1 < 1.0).then(|| from_sample_space(new_side, [u1, u2]))
+    }
+
+    fn follows_sampling_density(&self) -> bool {
+        self.in_sample_space
+    }
+}
+
+/// The normal of the hemisphere vertex `at` samples directions in: a light's front, or a
+/// diffuse surface's side facing the vertex `from` it was arrived at from.
+#[inline]
+fn sampling_side(from: Option<&PathVertex>, at: &PathVertex) -> Vec3A {
+    match from {
+        Some(from) if at.normal.dot(from.p - at.p) < 0.0 => -at.normal,
+        _ => at.normal,
     }
 }
 
@@ -238,10 +323,17 @@ pub(crate) fn lens(
         }
         // Multi-chain: perturb the direction onwards and trace the next specular chain.
         let (old, _) = direction(&x[k], &x[k - 1])?;
-        let new = kernel.direction(old);
+        let new = kernel.direction(
+            old,
+            sampling_side(Some(&x[k + 1]), &x[k]),
+            sampling_side(Some(&y[k + 1]), &y[k]),
+        )?;
         ray = spawn_ray(space.scene, v.p, v.normal, new);
         k -= 1;
     };
+    if kernel.follows_sampling_density() {
+        return proposal(space, x, y, s, 1.0, 1.0);
+    }
     let density_y = multi_chain_densities(space, y, s);
     let density_x = multi_chain_densities(space, x, s);
     proposal(space, x, y, s, density_x, density_y)
@@ -280,8 +372,9 @@ pub(crate) fn caustic(
         .find(|&k| !space.is_specular(&x[k]))
         .unwrap_or(0);
     let (old, _) = direction(&x[c], &x[c + 1])?;
-    let new = kernel.direction(old);
     let from = c.checked_sub(1).map(|i| &x[i]);
+    let side = sampling_side(from, &x[c]);
+    let new = kernel.direction(old, side, side)?;
     if direction_density(space, from, &x[c], new) <= 0.0 {
         return None;
     }
@@ -307,6 +400,9 @@ pub(crate) fn caustic(
     }
     if !space.visible(&y[n - 2], &y[n - 1], true, rays) {
         return None;
+    }
+    if kernel.follows_sampling_density() {
+        return proposal(space, x, y, n - 1, 1.0, 1.0);
     }
     // The densities C_s divided by at x_c, from the vertices as C_s takes them.
     let density = |path: &[PathVertex]| match direction(&path[c], &path[c + 1]) {
@@ -353,8 +449,8 @@ mod tests {
         fn film_offset(&mut self) -> [f32; 2] {
             self.film_offset
         }
-        fn direction(&mut self, old: Vec3A) -> Vec3A {
-            Vec3A::from(self.rotation * glam::Vec3::from(old))
+        fn direction(&mut self, old: Vec3A, _: Vec3A, _: Vec3A) -> Option<Vec3A> {
+            Some(Vec3A::from(self.rotation * glam::Vec3::from(old)))
         }
     }
 
@@ -938,6 +1034,9 @@ mod tests {
         /// Without the density of the perturbed direction: the caustic perturbation's at
         /// the light, the multi-chain perturbation's `multi_chain_densities` at the floor.
         WithoutDirectionDensity,
+        /// Steps in sample space with the cone's ratio: the densities of the perturbed
+        /// directions, which the sample-space kernel's own density cancels, left in.
+        WithConeDensities,
         /// The lens perturbation without the changed connection's G ratio …
         WithoutG,
         /// … or with it twice.
@@ -1005,6 +1104,12 @@ mod tests {
     /// 200, 481 at 400 steps); 200 are run.
     #[test]
     fn caustic_chain_samples_f_and_a_ratio_without_the_direction_density_does_not() {
+        caustic_chains_sample_f(false);
+    }
+
+    /// Caustic perturbation chains (see above), with cone or sample-space steps: the
+    /// correct ratio passes and the other kernel's density factor fails.
+    fn caustic_chains_sample_f(in_sample_space: bool) {
         let scene = balance_scene();
         let camera = balance_camera();
         let space = PathSpace {
@@ -1023,21 +1128,28 @@ mod tests {
             angle_min: 0.01,
             angle_max: 0.5,
         };
-        assert_balance(
-            "caustic",
-            &target,
-            &[Flaw::WithoutDirectionDensity],
-            |flaw| {
-                final_cells(&starts, 200, |x, y, rng| {
-                    let mut kernel = RandomKernel { sizes: &sizes, rng };
-                    let p = caustic(&space, &mut kernel, x, y, &mut 0)?;
-                    Some(match flaw {
-                        None => p.ratio,
-                        Some(_) => p.ratio * emitted_cosine(x) / emitted_cosine(y),
-                    })
+        let (name, flaw) = if in_sample_space {
+            ("caustic in sample space", Flaw::WithConeDensities)
+        } else {
+            ("caustic", Flaw::WithoutDirectionDensity)
+        };
+        assert_balance(name, &target, &[flaw], |flaw| {
+            final_cells(&starts, 200, |x, y, rng| {
+                let mut kernel = RandomKernel {
+                    sizes: &sizes,
+                    in_sample_space,
+                    rng,
+                };
+                let p = caustic(&space, &mut kernel, x, y, &mut 0)?;
+                Some(match flaw {
+                    None => p.ratio,
+                    Some(Flaw::WithConeDensities) => {
+                        p.ratio * emitted_cosine(y) / emitted_cosine(x)
+                    }
+                    Some(_) => p.ratio * emitted_cosine(x) / emitted_cosine(y),
                 })
-            },
-        );
+            })
+        });
     }
 
     /// Multi-chain perturbations of L S D E paths (E D S L from the lens: the floor cannot
@@ -1051,6 +1163,12 @@ mod tests {
     /// about 200 steps (185, 417, 420 and 439 at 100, 200, 400 and 1000 steps); 400 are run.
     #[test]
     fn multi_chain_samples_f_and_a_ratio_without_the_direction_densities_does_not() {
+        multi_chains_sample_f(false);
+    }
+
+    /// Multi-chain perturbation chains (see above), with cone or sample-space steps: the
+    /// correct ratio passes and the other kernel's density factor fails.
+    fn multi_chains_sample_f(in_sample_space: bool) {
         let scene = balance_scene();
         let camera = balance_camera();
         let space = PathSpace {
@@ -1069,21 +1187,28 @@ mod tests {
             angle_min: 0.005,
             angle_max: 0.3,
         };
-        assert_balance(
-            "multi-chain",
-            &target,
-            &[Flaw::WithoutDirectionDensity],
-            |flaw| {
-                final_cells(&starts, 400, |x, y, rng| {
-                    let mut kernel = RandomKernel { sizes: &sizes, rng };
-                    let p = lens(&space, &mut kernel, true, x, y, &mut 0)?;
-                    Some(match flaw {
-                        None => p.ratio,
-                        Some(_) => p.ratio * onwards_cosine(x) / onwards_cosine(y),
-                    })
+        let (name, flaw) = if in_sample_space {
+            ("multi-chain in sample space", Flaw::WithConeDensities)
+        } else {
+            ("multi-chain", Flaw::WithoutDirectionDensity)
+        };
+        assert_balance(name, &target, &[flaw], |flaw| {
+            final_cells(&starts, 400, |x, y, rng| {
+                let mut kernel = RandomKernel {
+                    sizes: &sizes,
+                    in_sample_space,
+                    rng,
+                };
+                let p = lens(&space, &mut kernel, true, x, y, &mut 0)?;
+                Some(match flaw {
+                    None => p.ratio,
+                    Some(Flaw::WithConeDensities) => {
+                        p.ratio * onwards_cosine(y) / onwards_cosine(x)
+                    }
+                    Some(_) => p.ratio * onwards_cosine(x) / onwards_cosine(y),
                 })
-            },
-        );
+            })
+        });
     }
 
     /// Lens perturbations of L D E paths sample f: the chains move the film point (up to 8
@@ -1112,14 +1237,57 @@ mod tests {
         let g = |path: &[PathVertex]| geometry(&path[0], &path[1]);
         assert_balance("lens", &target, &[Flaw::WithoutG, Flaw::ExtraG], |flaw| {
             final_cells(&starts, 200, |x, y, rng| {
-                let mut kernel = RandomKernel { sizes: &sizes, rng };
+                let mut kernel = RandomKernel {
+                    sizes: &sizes,
+                    in_sample_space: false,
+                    rng,
+                };
                 let p = lens(&space, &mut kernel, false, x, y, &mut 0)?;
                 Some(match flaw {
                     None | Some(Flaw::WithoutDirectionDensity) => p.ratio,
                     Some(Flaw::WithoutG) => p.ratio * g(x) / g(y),
                     Some(Flaw::ExtraG) => p.ratio * g(y) / g(x),
+                    Some(Flaw::WithConeDensities) => unreachable!(),
                 })
             })
         });
+    }
+
+    /// Sample-space coordinates and directions invert each other, on both sides of a
+    /// surface, and a step folded at u1 = 0 and 1 stays in [0, 1].
+    #[test]
+    fn sample_space_coordinates_round_trip() {
+        let mut rng = Rng::new(7, 0);
+        for normal in [Vec3A::Y, -Vec3A::Z, Vec3A::new(0.48, -0.6, 0.64)] {
+            for _ in 0..1000 {
+                let u = [rng.uniform() * 0.999, rng.uniform()];
+                let w = from_sample_space(normal, u);
+                assert!(w.dot(normal) > 0.0, "in the hemisphere");
+                let back = to_sample_space(normal, w);
+                assert!((back[0] - u[0]).abs() < 1e-4, "{u:?} → {back:?}");
+                let d = (back[1] - u[1]).abs();
+                assert!(d.min(1.0 - d) < 1e-4, "{u:?} → {back:?}");
+            }
+        }
+        for (u, folded) in [(-0.25, 0.25), (1.25, 0.75), (2.5, 0.5), (0.5, 0.5)] {
+            assert!((reflect_into_unit(u) - folded).abs() < 1e-6);
+        }
+    }
+
+    /// As `caustic_chain_samples_f_…`, with the direction at the light stepped in its
+    /// sample space (steps of 0.01 to 0.5 in u): the chains sample f with the ratio
+    /// |C_s(y)| / |C_s(x)|; chains that keep the cone's density factor cos θ_light / π in
+    /// the ratio sample f · cos θ_light instead.
+    #[test]
+    fn caustic_chain_in_sample_space_samples_f_and_the_cone_ratio_does_not() {
+        caustic_chains_sample_f(true);
+    }
+
+    /// As `multi_chain_samples_f_…`, with the direction onwards from the floor stepped in
+    /// the floor's sample space (0.005 to 0.3 in u), at the floor point the chain moved to;
+    /// the cone's density factor left in the ratio makes the chains sample f · cos θ_floor.
+    #[test]
+    fn multi_chain_in_sample_space_samples_f_and_the_cone_ratio_does_not() {
+        multi_chains_sample_f(true);
     }
 }
