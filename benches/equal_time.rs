@@ -4,8 +4,9 @@
 //! crack of a door) by default, cornell-box on request.
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
-//! actual seconds, camera samples and chain mutations per second, RMSE, RMSE corrected for the reference's
-//! own noise, and the per-channel mean brightness difference to the reference) and writes a
+//! actual seconds, camera samples and chain mutations per second, the share of mutations
+//! accepted, RMSE, RMSE corrected for the reference's own noise, and the per-channel mean
+//! brightness difference to the reference) and writes a
 //! log-log plot of RMSE against seconds, one line per algorithm and one panel per scene, to
 //! `target/mlt-bench/convergence.png`. Numbers are reported, never asserted.
 //!
@@ -44,21 +45,57 @@ use std::error::Error;
 use std::io::Write;
 use std::path::Path;
 
-/// The algorithms compared, by the name the table, the plot and `MLT_BENCH_ALGORITHMS` use,
-/// with their `direct_samples_per_mutation` (Metropolis: the default direct pass, or 0 for
-/// chains over every depth). A new algorithm is one more line here.
+/// An algorithm as compared: the name the table, the plot and `MLT_BENCH_ALGORITHMS` use,
+/// its `direct_samples_per_mutation` (Metropolis: the default direct pass, or 0 for chains
+/// over every depth) and path-space MLT's and ERPT's options.
+#[derive(Clone, Copy)]
+struct Compared {
+    name: &'static str,
+    algorithm: Algorithm,
+    direct_samples_per_mutation: u32,
+    adapt_mutation_weights: bool,
+    perturb_in_sample_space: bool,
+}
+
+const fn compared(name: &'static str, algorithm: Algorithm, direct: u32) -> Compared {
+    Compared {
+        name,
+        algorithm,
+        direct_samples_per_mutation: direct,
+        adapt_mutation_weights: false,
+        perturb_in_sample_space: false,
+    }
+}
+
+/// The algorithms compared. A new algorithm is one more line here.
 const DIRECT: u32 = RenderSettings::DEFAULT_DIRECT_SAMPLES_PER_MUTATION;
-const ALGORITHMS: &[(&str, Algorithm, u32)] = &[
-    ("path", Algorithm::Path, 0),
-    ("bdpt", Algorithm::Bdpt, 0),
-    ("pssmlt", Algorithm::Pssmlt, DIRECT),
-    ("pssmlt-bdpt", Algorithm::PssmltBdpt, DIRECT),
-    ("mmlt", Algorithm::Mmlt, DIRECT),
-    ("mmlt-no-direct", Algorithm::Mmlt, 0),
-    ("pssmlt-no-direct", Algorithm::Pssmlt, 0),
-    ("path-space-mlt", Algorithm::PathSpaceMlt, DIRECT),
-    ("path-space-mlt-no-direct", Algorithm::PathSpaceMlt, 0),
-    ("erpt", Algorithm::Erpt, 0),
+const ALGORITHMS: &[Compared] = &[
+    compared("path", Algorithm::Path, 0),
+    compared("bdpt", Algorithm::Bdpt, 0),
+    compared("pssmlt", Algorithm::Pssmlt, DIRECT),
+    compared("pssmlt-bdpt", Algorithm::PssmltBdpt, DIRECT),
+    compared("mmlt", Algorithm::Mmlt, DIRECT),
+    compared("mmlt-no-direct", Algorithm::Mmlt, 0),
+    compared("pssmlt-no-direct", Algorithm::Pssmlt, 0),
+    compared("path-space-mlt", Algorithm::PathSpaceMlt, DIRECT),
+    compared("path-space-mlt-no-direct", Algorithm::PathSpaceMlt, 0),
+    Compared {
+        adapt_mutation_weights: true,
+        ..compared("path-space-mlt-adapted", Algorithm::PathSpaceMlt, DIRECT)
+    },
+    Compared {
+        perturb_in_sample_space: true,
+        ..compared(
+            "path-space-mlt-sample-space",
+            Algorithm::PathSpaceMlt,
+            DIRECT,
+        )
+    },
+    compared("erpt", Algorithm::Erpt, 0),
+    Compared {
+        perturb_in_sample_space: true,
+        ..compared("erpt-sample-space", Algorithm::Erpt, 0)
+    },
 ];
 
 const DEFAULT_SCENES: &[&str] = &["cornell-glass", "door-ajar"];
@@ -206,24 +243,27 @@ fn measure(
     scene: &Scene,
     camera: &Camera,
     reference: &Reference,
-    (name, algorithm, direct_samples_per_mutation): (&'static str, Algorithm, u32),
+    compared: Compared,
     threads: u32,
     budget_seconds: f64,
     seed: u64,
 ) -> Measurement {
+    let name = compared.name;
     // Everything else stays at the defaults: they are what is being judged.
     let settings = RenderSettings {
         width: WIDTH,
         height: HEIGHT,
         max_depth: MAX_DEPTH,
-        algorithm,
+        algorithm: compared.algorithm,
         threads,
         seed,
         time_limit_seconds: budget_seconds,
         // 0: until the time limit.
         samples_per_pixel: 0,
         mutations_per_pixel: 0,
-        direct_samples_per_mutation,
+        direct_samples_per_mutation: compared.direct_samples_per_mutation,
+        adapt_mutation_weights: compared.adapt_mutation_weights,
+        perturb_in_sample_space: compared.perturb_in_sample_space,
         ..Default::default()
     };
     let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
@@ -251,7 +291,7 @@ fn measure(
 
 fn print_header() {
     println!(
-        "{:<14} {:<24} {:>7} {:>7} {:>8} {:>12} {:>12} {:>10} {:>10}  mean vs reference (R/G/B)",
+        "{:<14} {:<28} {:>7} {:>7} {:>8} {:>12} {:>12} {:>9} {:>10} {:>10}  mean vs reference (R/G/B)",
         "scene",
         "algo",
         "threads",
@@ -259,6 +299,7 @@ fn print_header() {
         "seconds",
         "samples/s",
         "mutations/s",
+        "accepted",
         "RMSE",
         "corrected",
     );
@@ -278,13 +319,14 @@ fn print_row(scene: &str, m: &Measurement) {
         notes.push_str("  over budget");
     }
     println!(
-        "{scene:<14} {:<24} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
+        "{scene:<14} {:<28} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>8.1}% {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
         m.algorithm,
         m.threads,
         m.budget_seconds,
         m.stats.seconds,
         m.stats.samples as f64 / m.stats.seconds,
         m.stats.mutations as f64 / m.stats.seconds,
+        100.0 * m.stats.accepted_mutations as f64 / m.stats.mutations.max(1) as f64,
         m.rmse,
         m.corrected_rmse,
     );
@@ -409,7 +451,7 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
                 .label("reference noise")
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], noise_style));
         }
-        for (index, &(name, _, _)) in ALGORITHMS.iter().enumerate() {
+        for (index, &Compared { name, .. }) in ALGORITHMS.iter().enumerate() {
             let mut points: Vec<(f64, f64)> = plotted
                 .iter()
                 .filter(|m| m.algorithm == name)
@@ -442,21 +484,18 @@ fn main() {
     let max_seconds = env_value("MLT_BENCH_SECONDS", DEFAULT_MAX_SECONDS);
     let reference_spp = env_value("MLT_BENCH_REFERENCE_SPP", DEFAULT_REFERENCE_SPP);
     let scenes = env_names("MLT_BENCH_SCENES", DEFAULT_SCENES);
-    let all_algorithms: Vec<&str> = ALGORITHMS.iter().map(|&(name, _, _)| name).collect();
-    let algorithms: Vec<(&'static str, Algorithm, u32)> =
-        env_names("MLT_BENCH_ALGORITHMS", &all_algorithms)
-            .iter()
-            .map(|wanted| {
-                *ALGORITHMS
-                    .iter()
-                    .find(|(name, _, _)| name == wanted)
-                    .unwrap_or_else(|| {
-                        panic!(
-                            "MLT_BENCH_ALGORITHMS: unknown {wanted:?}; known: {all_algorithms:?}"
-                        )
-                    })
-            })
-            .collect();
+    let all_algorithms: Vec<&str> = ALGORITHMS.iter().map(|c| c.name).collect();
+    let algorithms: Vec<Compared> = env_names("MLT_BENCH_ALGORITHMS", &all_algorithms)
+        .iter()
+        .map(|wanted| {
+            *ALGORITHMS
+                .iter()
+                .find(|c| c.name == wanted)
+                .unwrap_or_else(|| {
+                    panic!("MLT_BENCH_ALGORITHMS: unknown {wanted:?}; known: {all_algorithms:?}")
+                })
+        })
+        .collect();
     let budgets = time_budgets(max_seconds);
     let dir = output_dir();
     std::fs::create_dir_all(&dir).expect("output directory");
@@ -501,7 +540,7 @@ fn main() {
         });
     }
 
-    let with_text = plot_font_or_color_key(ALGORITHMS.iter().map(|&(name, _, _)| name));
+    let with_text = plot_font_or_color_key(ALGORITHMS.iter().map(|c| c.name));
     let plot_path = dir.join("convergence.png");
     match plot(&plot_path, &results, with_text) {
         Ok(()) => println!("plot: {}", plot_path.display()),

@@ -86,6 +86,9 @@ const SERIES_COLORS: &[RGBColor] = &[
     RGBColor(23, 190, 207),
     RGBColor(127, 127, 127),
     RGBColor(188, 189, 34),
+    RGBColor(0, 0, 0),
+    RGBColor(255, 187, 120),
+    RGBColor(174, 199, 232),
 ];
 
 pub fn series_color(index: usize) -> RGBColor {
