@@ -247,8 +247,8 @@ pub(crate) fn run(
     // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution.
     let plan = ChainPlan::new(&[b], camera, settings);
     let weight = b / plan.chain_count as f64;
-    let seed_chains = |seed: u64, first_stream: u64| -> Vec<WeightedChain<PathChain>> {
-        let seeds = pssmlt::resample_seeds(&boot, &plan.chains_per_group, seed);
+    let seed_chains = |boot: &pssmlt::Bootstrap, seed: u64, first_stream: u64| {
+        let seeds = pssmlt::resample_seeds(boot, &plan.chains_per_group, seed);
         seeds
             .into_par_iter()
             .enumerate()
@@ -256,41 +256,36 @@ pub(crate) fn run(
                 let stream = first_stream + c as u64;
                 WeightedChain::new(seed_chain(target, settings, index, n, stream), weight)
             })
-            .collect()
+            .collect::<Vec<WeightedChain<PathChain>>>()
     };
 
-    // 3. Rounds of mutations: in one phase, or a warm-up with the given weights and a
-    // second phase with the adapted ones.
+    // 3. Rounds of mutations: all with the given weights, or a warm-up with them and the
+    // rest with the adapted ones.
     let warmup = plan.first_round();
-    if !adapt_weights || plan.mutations_per_chain <= warmup {
-        let mut chains = seed_chains(settings.seed, 0);
-        drop(boot);
-        let mut outcome = pssmlt::run_rounds(
-            target,
-            camera,
-            &mut chains,
-            &plan,
-            0,
-            film,
-            control,
-            after_round,
-        );
-        outcome.normalization = b;
-        outcome.mutation_weights = target.weights;
-        return outcome;
-    }
-    let mut chains = seed_chains(settings.seed, 0);
-    let warmup_plan = plan.phase(warmup);
+    let adapting = adapt_weights && plan.mutations_per_chain > warmup;
+    let first_phase = if adapting {
+        warmup
+    } else {
+        plan.mutations_per_chain
+    };
+    let mut chains = seed_chains(&boot, settings.seed, 0);
+    // The second phase seeds its chains from the bootstrap too; otherwise free it now.
+    let boot = adapting.then_some(boot);
     let mut outcome = pssmlt::run_rounds(
         target,
         camera,
         &mut chains,
-        &warmup_plan,
+        &plan.phase(first_phase),
         0,
         film,
         control,
         after_round,
     );
+    outcome.normalization = b;
+    outcome.mutation_weights = target.weights;
+    let Some(boot) = boot.filter(|_| !control.should_stop()) else {
+        return outcome;
+    };
     let mut counts = MutationCounts::default();
     for chain in &chains {
         counts.add(&chain.chain.counts);
@@ -307,12 +302,8 @@ pub(crate) fn run(
         perturb_in_sample_space: target.perturb_in_sample_space,
     };
     outcome.mutation_weights = adapted.weights;
-    outcome.normalization = b;
-    if control.should_stop() {
-        return outcome;
-    }
     // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
-    let mut chains = seed_chains(settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
+    let mut chains = seed_chains(&boot, settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
     drop(boot);
     let rest = pssmlt::run_rounds(
         &adapted,
