@@ -600,9 +600,9 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
 }
 
 /// Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
-/// pass (32 mutations and 8 direct samples per pixel, 2^18 bootstrap samples, 1024 chains,
-/// large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and BDPT, max
-/// depth 5, seed 0, all cores, no time limit.
+/// pass (32 mutations per pixel and one direct-pass sample per mutation, 2^18 bootstrap
+/// samples, 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path
+/// tracing and BDPT, max depth 5, seed 0, all cores, no time limit.
 ///
 /// # Safety
 /// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
