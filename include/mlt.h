@@ -134,6 +134,26 @@
 #define MLT_INVALID_ID UINT32_MAX
 
 /**
+ * Fewest partial images the filter accepts: two already give a spread.
+ */
+#define MLT_MIN_FILTER_BUFFERS 2
+
+/**
+ * Most partial images the filter accepts (each costs 12 bytes per pixel).
+ */
+#define MLT_MAX_FILTER_BUFFERS 32
+
+/**
+ * Largest accepted filter strength.
+ */
+#define MLT_MAX_FILTER_STRENGTH 100.0
+
+/**
+ * Largest accepted filter search radius in pixels.
+ */
+#define MLT_MAX_FILTER_RADIUS 32
+
+/**
  * Largest accepted image width or height.
  */
 #define MLT_MAX_IMAGE_SIDE (1 << 16)
@@ -183,6 +203,23 @@
  * The default `erpt_chain_length` (Cline et al. used chains of about this length).
  */
 #define RenderSettings_DEFAULT_ERPT_CHAIN_LENGTH 100
+
+/**
+ * The partial images a filtered render uses unless told otherwise (the CLI's
+ * `--filter`): enough that one blotch is a clear minority, few enough to keep memory low.
+ */
+#define RenderSettings_DEFAULT_FILTER_BUFFERS 8
+
+/**
+ * The default `filter_strength` (Rousselle et al.'s choice, and the best of those
+ * measured in `tests/filter.rs`).
+ */
+#define RenderSettings_DEFAULT_FILTER_STRENGTH 0.45
+
+/**
+ * The default `filter_radius`: a 15 × 15 search window.
+ */
+#define RenderSettings_DEFAULT_FILTER_RADIUS 7
 
 /**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
@@ -421,6 +458,25 @@ typedef struct MltRenderSettings {
    * instead of within a cone. Default 0.
    */
   uint32_t perturb_in_sample_space;
+  /**
+   * Metropolis algorithms and `MLT_ALGORITHM_ERPT`: the post-process filter for blotchy
+   * noise, non-local means guided by per-pixel variances measured from partial images.
+   * 0 (the default) turns it off; otherwise the number of partial images the deposits are
+   * split into, from `MLT_MIN_FILTER_BUFFERS` to `MLT_MAX_FILTER_BUFFERS` (8 is a good
+   * start; each costs 12 bytes per pixel). The image keeps its total: the filter moves
+   * energy between pixels (a local bias) to lower the error. `MltRenderStats` reports
+   * what it did.
+   */
+  uint32_t filter_buffers;
+  /**
+   * The filter's strength, in (0, `MLT_MAX_FILTER_STRENGTH`]; default 0.45. Higher
+   * smooths more.
+   */
+  float filter_strength;
+  /**
+   * The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
+   */
+  uint32_t filter_radius;
 } MltRenderSettings;
 
 /**
@@ -503,6 +559,15 @@ typedef struct MltRenderStats {
    * warm-up, with `adapt_mutation_weights`). `MLT_ALGORITHM_ERPT`: its weights.
    */
   float mutation_weights[4];
+  /**
+   * With `filter_buffers`: the luminance the filter moved, Σ|change| / Σ luminance (the
+   * total is kept) …
+   */
+  double filter_changed_fraction;
+  /**
+   * … and about how many pixels each pixel was averaged over (the mean sum of weights).
+   */
+  double filter_mean_neighbours;
 } MltRenderStats;
 
 /**
@@ -601,9 +666,10 @@ enum MltStatus mlt_camera_default(struct MltCamera *out);
 
 /**
  * Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
- * pass (32 mutations per pixel and one direct-pass sample per mutation, 2^18 bootstrap
- * samples, 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path
- * tracing and BDPT, max depth 5, seed 0, all cores, no time limit.
+ * pass (32 mutations per pixel and one direct sample per mutation, 2^18 bootstrap samples,
+ * 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
+ * BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
+ * 0.45 and radius 7 when `filter_buffers` turns it on).
  *
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltRenderSettings`.

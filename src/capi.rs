@@ -198,6 +198,19 @@ pub struct MltRenderSettings {
     /// diffuse vertices and lights by small steps in their cosine-weighted sample space
     /// instead of within a cone. Default 0.
     pub perturb_in_sample_space: u32,
+    /// Metropolis algorithms and `MLT_ALGORITHM_ERPT`: the post-process filter for blotchy
+    /// noise, non-local means guided by per-pixel variances measured from partial images.
+    /// 0 (the default) turns it off; otherwise the number of partial images the deposits are
+    /// split into, from `MLT_MIN_FILTER_BUFFERS` to `MLT_MAX_FILTER_BUFFERS` (8 is a good
+    /// start; each costs 12 bytes per pixel). The image keeps its total: the filter moves
+    /// energy between pixels (a local bias) to lower the error. `MltRenderStats` reports
+    /// what it did.
+    pub filter_buffers: u32,
+    /// The filter's strength, in (0, `MLT_MAX_FILTER_STRENGTH`]; default 0.45. Higher
+    /// smooths more.
+    pub filter_strength: f32,
+    /// The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
+    pub filter_radius: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -230,6 +243,11 @@ pub struct MltRenderStats {
     /// `MLT_ALGORITHM_PATH_SPACE_MLT`: the mutation weights the chains ran with (after the
     /// warm-up, with `adapt_mutation_weights`). `MLT_ALGORITHM_ERPT`: its weights.
     pub mutation_weights: [f32; 4],
+    /// With `filter_buffers`: the luminance the filter moved, Σ|change| / Σ luminance (the
+    /// total is kept) …
+    pub filter_changed_fraction: f64,
+    /// … and about how many pixels each pixel was averaged over (the mean sum of weights).
+    pub filter_mean_neighbours: f64,
 }
 
 /// Facts about a created scene.
@@ -476,6 +494,9 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         erpt_deposit_energy: s.erpt_deposit_energy,
         adapt_mutation_weights: flag(s.adapt_mutation_weights, "adapt_mutation_weights")?,
         perturb_in_sample_space: flag(s.perturb_in_sample_space, "perturb_in_sample_space")?,
+        filter_buffers: s.filter_buffers,
+        filter_strength: s.filter_strength,
+        filter_radius: s.filter_radius,
     })
 }
 
@@ -600,9 +621,10 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
 }
 
 /// Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
-/// pass (32 mutations per pixel and one direct-pass sample per mutation, 2^18 bootstrap
-/// samples, 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path
-/// tracing and BDPT, max depth 5, seed 0, all cores, no time limit.
+/// pass (32 mutations per pixel and one direct sample per mutation, 2^18 bootstrap samples,
+/// 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
+/// BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
+/// 0.45 and radius 7 when `filter_buffers` turns it on).
 ///
 /// # Safety
 /// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
@@ -630,6 +652,9 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             erpt_deposit_energy: d.erpt_deposit_energy,
             adapt_mutation_weights: d.adapt_mutation_weights as u32,
             perturb_in_sample_space: d.perturb_in_sample_space as u32,
+            filter_buffers: d.filter_buffers,
+            filter_strength: d.filter_strength,
+            filter_radius: d.filter_radius,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;
@@ -825,6 +850,8 @@ pub unsafe extern "C" fn mlt_render_ex(
                 mutations_proposed: stats.mutation_counts.proposed,
                 mutations_accepted: stats.mutation_counts.accepted,
                 mutation_weights: stats.mutation_weights.0,
+                filter_changed_fraction: stats.filter.changed_fraction,
+                filter_mean_neighbours: stats.filter.mean_neighbours,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };

@@ -1,6 +1,7 @@
 //! The film: per-pixel sums of radiance samples and the number of samples taken, turned into
 //! an image normalized pixel by pixel (so a partial render is still a valid estimate).
 
+use crate::filter::{FilterStats, filter_splats};
 use rayon::prelude::*;
 
 pub struct Film {
@@ -16,6 +17,13 @@ pub struct Film {
     light_paths: u64,
     /// Overrides the splat normalization (Metropolis: b / mutations per pixel).
     splat_scale: Option<f64>,
+    /// The splats again, split into `filter_buffers` partial images for the post-process
+    /// filter (`crate::filter`): `partials[pixel * filter_buffers + buffer]`. Empty when
+    /// the filter is off.
+    partials: Vec<[f32; 3]>,
+    filter_buffers: usize,
+    filter_strength: f32,
+    filter_radius: u32,
 }
 
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
@@ -41,6 +49,28 @@ impl Film {
             },
             light_paths: 0,
             splat_scale: None,
+            partials: Vec::new(),
+            filter_buffers: 0,
+            filter_strength: 0.0,
+            filter_radius: 0,
+        }
+    }
+
+    /// Turns the post-process filter on: splats are also kept in `buffers` partial images,
+    /// and the written image is filtered with `strength` and `radius` (`crate::filter`).
+    pub fn enable_filter(&mut self, buffers: u32, strength: f32, radius: u32) {
+        self.filter_buffers = buffers as usize;
+        self.filter_strength = strength;
+        self.filter_radius = radius;
+        self.partials = vec![[0.0; 3]; self.splats.len() * buffers as usize];
+    }
+
+    /// The number of partial images splats are split into; 0 when the filter is off.
+    pub fn filter_buffers(&self) -> usize {
+        if self.partials.is_empty() {
+            0
+        } else {
+            self.filter_buffers
         }
     }
 
@@ -68,10 +98,41 @@ impl Film {
 
     /// Adds `weight` × the splats of a work unit, in the unit's order.
     pub fn add_weighted_splats(&mut self, splats: &[crate::integrators::Splat], weight: f64) {
+        self.add_weighted_splats_to(splats, weight, 0);
+    }
+
+    /// Adds `weight` × the splats of a work unit, in the unit's order, and with the filter
+    /// on also to partial image `buffer` (taken modulo their number).
+    pub fn add_weighted_splats_to(
+        &mut self,
+        splats: &[crate::integrators::Splat],
+        weight: f64,
+        buffer: usize,
+    ) {
         for splat in splats {
             let sum = &mut self.splats[splat.pixel as usize];
             for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
                 *s += v as f64 * weight;
+            }
+        }
+        if !self.partials.is_empty() {
+            let (buffers, buffer) = (self.filter_buffers, buffer % self.filter_buffers);
+            for splat in splats {
+                let partial = &mut self.partials[splat.pixel as usize * buffers + buffer];
+                for (s, v) in partial.iter_mut().zip(splat.value.to_array()) {
+                    *s += (v as f64 * weight) as f32;
+                }
+            }
+        }
+    }
+
+    /// Adds per-(pixel, partial image) splat sums, in `partials` order (pixel by pixel, each
+    /// pixel's `filter_buffers()` partials in turn); their total must also be added with
+    /// `add_splat_sums`.
+    pub fn add_partial_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>) {
+        for (partial, sum) in self.partials.iter_mut().zip(sums) {
+            for (p, s) in partial.iter_mut().zip(sum) {
+                *p += s as f32;
             }
         }
     }
@@ -94,8 +155,33 @@ impl Film {
 
     /// Writes the estimate per pixel as RGB floats, rows top to bottom: the mean of the
     /// pixel's own samples plus the splats, which are normalized by the light paths per
-    /// pixel (each light path's splats estimate the whole film once).
-    pub fn write_rgb(&self, out: &mut [f32]) {
+    /// pixel (each light path's splats estimate the whole film once). With the filter on,
+    /// the splats are filtered (the pixels' own samples are not: they are a Metropolis
+    /// render's direct pass), and `unfiltered`, if given, receives the image without it.
+    pub fn write_rgb(&self, out: &mut [f32], unfiltered: Option<&mut [f32]>) -> FilterStats {
+        if self.partials.is_empty() {
+            self.write_rgb_with(out, &self.splats);
+            if let Some(unfiltered) = unfiltered {
+                unfiltered.copy_from_slice(out);
+            }
+            return FilterStats::default();
+        }
+        let (filtered, stats) = filter_splats(
+            self.width as usize,
+            self.filter_buffers,
+            &self.partials,
+            &self.splats,
+            self.filter_strength,
+            self.filter_radius,
+        );
+        self.write_rgb_with(out, &filtered);
+        if let Some(unfiltered) = unfiltered {
+            self.write_rgb_with(unfiltered, &self.splats);
+        }
+        stats
+    }
+
+    fn write_rgb_with(&self, out: &mut [f32], splats: &[[f64; 3]]) {
         let pixels = self.counts.len() as f64;
         let splat_scale = if let Some(scale) = self.splat_scale {
             scale
@@ -111,7 +197,7 @@ impl Film {
             .enumerate()
         {
             let scale = if count > 0 { 1.0 / count as f64 } else { 0.0 };
-            let splat = self.splats.get(i).copied().unwrap_or([0.0; 3]);
+            let splat = splats.get(i).copied().unwrap_or([0.0; 3]);
             for c in 0..3 {
                 pixel[c] = (sum[c] * scale + splat[c] * splat_scale) as f32;
             }

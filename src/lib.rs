@@ -30,6 +30,7 @@ pub mod bsdf;
 pub mod capi;
 pub mod error;
 pub mod film;
+pub mod filter;
 pub mod integrators;
 pub mod render;
 pub mod sampling;
@@ -39,8 +40,11 @@ pub mod scene;
 pub mod io;
 
 pub use error::{Error, MltStatus, Result};
+pub use filter::FilterStats;
 pub use integrators::mlt::path_space::{Mutation, MutationCounts, MutationWeights};
-pub use render::{Algorithm, RenderSettings, RenderStats, StopReason, render};
+pub use render::{
+    Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
+};
 pub use scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
 
 // One scene serves renders and queries from many threads at once.

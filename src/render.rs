@@ -3,6 +3,10 @@
 
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::Film;
+use crate::filter::{
+    FilterStats, MLT_MAX_FILTER_BUFFERS, MLT_MAX_FILTER_RADIUS, MLT_MAX_FILTER_STRENGTH,
+    MLT_MIN_FILTER_BUFFERS,
+};
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::path_space::{
     self, MutationCounts, MutationWeights, PathSpaceTarget, PerturbationSizes,
@@ -231,6 +235,18 @@ pub struct RenderSettings {
     /// camera sample starts one chain on average (from a pre-pass estimating the mean
     /// energy of a sample: e_d = mean / L). Smaller values start more chains.
     pub erpt_deposit_energy: f32,
+    /// Metropolis and ERPT: the post-process filter for blotchy noise (`crate::filter`):
+    /// non-local means guided by per-pixel variances measured from partial images. 0 turns
+    /// it off (the default); otherwise the number of partial images the deposits are split
+    /// into, from 2 to 32 (8 is a good start; each costs 12 bytes per pixel). The filter
+    /// moves energy between pixels, keeping the image's total: it trades a local bias (blur
+    /// of what the noise hides) for lower error. `RenderStats::filter` reports what it did.
+    pub filter_buffers: u32,
+    /// The filter's strength k: patch differences up to about k standard deviations count
+    /// as noise. Higher smooths more (more bias, less noise).
+    pub filter_strength: f32,
+    /// The filter's search radius in pixels: each pixel averages pixels up to this far.
+    pub filter_radius: u32,
 }
 
 impl Default for RenderSettings {
@@ -255,6 +271,9 @@ impl Default for RenderSettings {
             erpt_deposit_energy: 0.0,
             adapt_mutation_weights: false,
             perturb_in_sample_space: false,
+            filter_buffers: 0,
+            filter_strength: Self::DEFAULT_FILTER_STRENGTH,
+            filter_radius: Self::DEFAULT_FILTER_RADIUS,
         }
     }
 }
@@ -265,6 +284,14 @@ impl RenderSettings {
     pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
     /// The default `erpt_chain_length` (Cline et al. used chains of about this length).
     pub const DEFAULT_ERPT_CHAIN_LENGTH: u32 = 100;
+    /// The partial images a filtered render uses unless told otherwise (the CLI's
+    /// `--filter`): enough that one blotch is a clear minority, few enough to keep memory low.
+    pub const DEFAULT_FILTER_BUFFERS: u32 = 8;
+    /// The default `filter_strength` (Rousselle et al.'s choice, and the best of those
+    /// measured in `tests/filter.rs`).
+    pub const DEFAULT_FILTER_STRENGTH: f32 = 0.45;
+    /// The default `filter_radius`: a 15 × 15 search window.
+    pub const DEFAULT_FILTER_RADIUS: u32 = 7;
 
     pub fn validate(&self) -> Result<()> {
         for (name, side) in [("width", self.width), ("height", self.height)] {
@@ -374,6 +401,32 @@ impl RenderSettings {
                 "settings.erpt_deposit_energy is {e_d}; it must be 0 (automatic) or a positive number up to {MLT_MAX_ERPT_DEPOSIT_ENERGY:e}"
             )));
         }
+        let buffers = self.filter_buffers;
+        if buffers != 0 {
+            if !(MLT_MIN_FILTER_BUFFERS..=MLT_MAX_FILTER_BUFFERS).contains(&buffers) {
+                return Err(Error::invalid(format!(
+                    "settings.filter_buffers is {buffers}; it must be 0 (no filter) or from {MLT_MIN_FILTER_BUFFERS} to {MLT_MAX_FILTER_BUFFERS}"
+                )));
+            }
+            if !(self.algorithm.is_metropolis() || self.algorithm == Algorithm::Erpt) {
+                return Err(Error::invalid(format!(
+                    "settings.filter_buffers is {buffers} but the algorithm is {:?}; the filter is for Metropolis and ERPT images (set it to 0)",
+                    self.algorithm
+                )));
+            }
+        }
+        let k = self.filter_strength;
+        if !(k.is_finite() && k > 0.0 && k <= MLT_MAX_FILTER_STRENGTH) {
+            return Err(Error::invalid(format!(
+                "settings.filter_strength is {k}; it must be positive, up to {MLT_MAX_FILTER_STRENGTH}"
+            )));
+        }
+        let radius = self.filter_radius;
+        if radius == 0 || radius > MLT_MAX_FILTER_RADIUS {
+            return Err(Error::invalid(format!(
+                "settings.filter_radius is {radius}; it must be from 1 to {MLT_MAX_FILTER_RADIUS} pixels"
+            )));
+        }
         Ok(())
     }
 
@@ -424,6 +477,8 @@ pub struct RenderStats {
     /// … and the weights the chains ran with (after the warm-up, if adapted). ERPT: the
     /// weights of its perturbations.
     pub mutation_weights: MutationWeights,
+    /// What the post-process filter did (zeros when it is off).
+    pub filter: FilterStats,
 }
 
 /// Called from the rendering call's own thread with the fraction done; return `false` to stop.
@@ -445,22 +500,51 @@ pub fn render(
     rgb_out: &mut [f32],
     progress: Option<Progress>,
 ) -> Result<RenderStats> {
+    render_into(scene, camera, settings, rgb_out, None, progress)
+}
+
+/// Renders like [`render`], and also writes the image as it was before the post-process
+/// filter into `unfiltered_out` (the same image when the filter is off): what measuring the
+/// filter's bias and gain on one render takes.
+pub fn render_with_unfiltered(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    unfiltered_out: &mut [f32],
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    render_into(
+        scene,
+        camera,
+        settings,
+        rgb_out,
+        Some(unfiltered_out),
+        progress,
+    )
+}
+
+fn render_into(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    unfiltered_out: Option<&mut [f32]>,
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
     settings.validate()?;
     camera.validate()?;
     let needed = settings.output_len()?;
-    if rgb_out.len() < needed {
+    let shortest = rgb_out
+        .len()
+        .min(unfiltered_out.as_ref().map_or(usize::MAX, |u| u.len()));
+    if shortest < needed {
         return Err(Error::invalid(format!(
-            "the output buffer holds {} floats but a {} x {} RGB image needs {needed}",
-            rgb_out.len(),
-            settings.width,
-            settings.height
+            "the output buffer holds {shortest} floats but a {} x {} RGB image needs {needed}",
+            settings.width, settings.height
         )));
     }
-    let mut film = try_film(
-        settings.width,
-        settings.height,
-        settings.algorithm != Algorithm::Path,
-    )?;
+    let mut film = try_film(settings)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads as usize)
         .build()
@@ -579,7 +663,10 @@ pub fn render(
             "a rendering thread panicked; this is a bug in mlt",
         ));
     };
-    film.write_rgb(&mut rgb_out[..needed]);
+    let filter = film.write_rgb(
+        &mut rgb_out[..needed],
+        unfiltered_out.map(|u| &mut u[..needed]),
+    );
     let stop = if control.cancelled.load(Ordering::Relaxed) {
         StopReason::Cancelled
     } else if planned == 0 || control.work_done() < planned {
@@ -603,6 +690,7 @@ pub fn render(
         normalization: metropolis.normalization,
         mutation_counts: metropolis.mutation_counts,
         mutation_weights: metropolis.mutation_weights,
+        filter,
     })
 }
 
@@ -636,18 +724,32 @@ impl Drop for SignalOnDrop<'_> {
 }
 
 /// Allocates the film, reporting failure as a status instead of aborting.
-fn try_film(width: u32, height: u32, with_splats: bool) -> Result<Film> {
+fn try_film(settings: &RenderSettings) -> Result<Film> {
+    let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;
-    // Probe the two large allocations first: `vec!` would abort the process on failure.
-    let mut probe: Vec<[f64; 3]> = Vec::new();
-    probe.try_reserve_exact(pixels).map_err(|_| {
+    // Probe the largest allocations first: `vec!` would abort the process on failure.
+    let out_of_memory = || {
         Error::new(
             MLT_STATUS_OUT_OF_MEMORY,
             format!("could not allocate the film for {width} x {height} pixels"),
         )
-    })?;
+    };
+    let mut probe: Vec<[f64; 3]> = Vec::new();
+    probe
+        .try_reserve_exact(pixels)
+        .map_err(|_| out_of_memory())?;
     drop(probe);
-    Ok(Film::new(width, height, with_splats))
+    let buffers = settings.filter_buffers;
+    let mut partials: Vec<[f32; 3]> = Vec::new();
+    partials
+        .try_reserve_exact(pixels * buffers as usize)
+        .map_err(|_| out_of_memory())?;
+    drop(partials);
+    let mut film = Film::new(width, height, settings.algorithm != Algorithm::Path);
+    if buffers > 0 {
+        film.enable_filter(buffers, settings.filter_strength, settings.filter_radius);
+    }
+    Ok(film)
 }
 
 /// Shared state between the workers and the calling thread.

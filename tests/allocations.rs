@@ -39,12 +39,14 @@ fn allocations_do_not_grow_with_samples() {
     let scene = furnace_scene([0.5; 3], [1.0; 3]);
     let camera = furnace_camera();
     let mut image = vec![0.0; 32 * 32 * 3];
-    // `options`: path-space MLT's and ERPT's adapted weights and sample-space perturbations.
+    // `options`: path-space MLT's and ERPT's adapted weights and sample-space perturbations,
+    // and the post-process filter (which allocates once per render, after the sampling).
     let mut count = |(algorithm, options): (Algorithm, bool), per_pixel: u32| {
         let settings = RenderSettings {
             algorithm,
             adapt_mutation_weights: options,
             perturb_in_sample_space: options,
+            filter_buffers: if options { 4 } else { 0 },
             width: 32,
             height: 32,
             samples_per_pixel: per_pixel,
@@ -63,6 +65,7 @@ fn allocations_do_not_grow_with_samples() {
         (Algorithm::Path, false),
         (Algorithm::Bdpt, false),
         (Algorithm::Pssmlt, false),
+        (Algorithm::Pssmlt, true),
         (Algorithm::PssmltBdpt, false),
         (Algorithm::Mmlt, false),
         (Algorithm::PathSpaceMlt, false),

@@ -230,6 +230,32 @@ impl Handle {
         (status, image)
     }
 
+    /// A render of 4 × 4 pixels that must succeed: the image and the stats.
+    #[track_caller]
+    fn render_4x4_with_stats(
+        &self,
+        camera: &MltCamera,
+        settings: &MltRenderSettings,
+    ) -> (Vec<f32>, MltRenderStats) {
+        let mut rgb = vec![0.0f32; 4 * 4 * 3];
+        let mut stats = MltRenderStats::default();
+        // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
+        let status = unsafe {
+            mlt_render_ex(
+                self.0,
+                camera,
+                settings,
+                rgb.as_mut_ptr(),
+                rgb.len(),
+                None,
+                null_mut(),
+                &mut stats,
+            )
+        };
+        assert_eq!(status, MLT_STATUS_OK, "algorithm {}", settings.algorithm);
+        (rgb, stats)
+    }
+
     /// A render that must fail: status, message, and the image buffer untouched.
     #[track_caller]
     fn render_fails(&self, camera: &MltCamera, settings: &MltRenderSettings, needles: &[&str]) {
@@ -359,6 +385,10 @@ fn defaults_are_valid_and_documented() {
     assert_eq!(
         (s.adapt_mutation_weights, s.perturb_in_sample_space),
         (0, 0)
+    );
+    assert_eq!(
+        (s.filter_buffers, s.filter_strength, s.filter_radius),
+        (0, 0.45, 7)
     );
 }
 
@@ -1243,6 +1273,106 @@ fn erpt_settings_out_of_range() {
 }
 
 #[test]
+fn filter_settings_out_of_range() {
+    let scene = HostScene::floor_and_light().create();
+    let metropolis = MltRenderSettings {
+        algorithm: MLT_ALGORITHM_PSSMLT,
+        mutations_per_pixel: 1,
+        bootstrap_samples: 64,
+        chains: 4,
+        filter_buffers: 8,
+        ..small_settings(4, 4, 1)
+    };
+    let cases: [(MltRenderSettings, &[&str]); 9] = [
+        (
+            MltRenderSettings {
+                filter_buffers: 1,
+                ..metropolis
+            },
+            &["filter_buffers is 1", "0 (no filter) or from 2 to 32"],
+        ),
+        (
+            MltRenderSettings {
+                filter_buffers: 33,
+                ..metropolis
+            },
+            &["filter_buffers is 33"],
+        ),
+        (
+            MltRenderSettings {
+                filter_strength: f32::NAN,
+                ..metropolis
+            },
+            &["filter_strength is NaN"],
+        ),
+        (
+            MltRenderSettings {
+                filter_strength: 0.0,
+                ..metropolis
+            },
+            &["filter_strength is 0", "positive"],
+        ),
+        (
+            MltRenderSettings {
+                filter_strength: -1.0,
+                ..metropolis
+            },
+            &["filter_strength is -1"],
+        ),
+        (
+            MltRenderSettings {
+                filter_strength: 1e9,
+                ..metropolis
+            },
+            &["filter_strength is 1000000000", "up to 100"],
+        ),
+        (
+            MltRenderSettings {
+                filter_radius: 0,
+                ..metropolis
+            },
+            &["filter_radius is 0", "from 1 to 32"],
+        ),
+        (
+            MltRenderSettings {
+                filter_radius: u32::MAX,
+                ..metropolis
+            },
+            &["filter_radius is 4294967295"],
+        ),
+        (
+            MltRenderSettings {
+                algorithm: MLT_ALGORITHM_PATH,
+                ..metropolis
+            },
+            &["filter_buffers is 8", "Path", "Metropolis and ERPT"],
+        ),
+    ];
+    for (settings, needles) in &cases {
+        scene.render_fails(&floor_camera(), settings, needles);
+    }
+    // In range, every algorithm the filter applies to renders and reports it.
+    for algorithm in [
+        MLT_ALGORITHM_PSSMLT,
+        MLT_ALGORITHM_MMLT,
+        MLT_ALGORITHM_PSSMLT_BDPT,
+        MLT_ALGORITHM_PATH_SPACE_MLT,
+        MLT_ALGORITHM_ERPT,
+    ] {
+        let settings = MltRenderSettings {
+            algorithm,
+            filter_buffers: 2,
+            filter_strength: 100.0,
+            filter_radius: 32,
+            ..metropolis
+        };
+        let (rgb, stats) = scene.render_4x4_with_stats(&floor_camera(), &settings);
+        assert!(rgb.iter().all(|v| v.is_finite()), "algorithm {algorithm}");
+        assert!(stats.filter_changed_fraction.is_finite() && stats.filter_mean_neighbours >= 0.0);
+    }
+}
+
+#[test]
 fn metropolis_settings_out_of_range() {
     let scene = HostScene::floor_and_light().create();
     let metropolis = MltRenderSettings {
@@ -1375,22 +1505,7 @@ fn metropolis_settings_out_of_range() {
             algorithm,
             ..metropolis
         };
-        let mut rgb = vec![0.0f32; 4 * 4 * 3];
-        let mut stats = MltRenderStats::default();
-        // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
-        let status = unsafe {
-            mlt_render_ex(
-                scene.0,
-                &floor_camera(),
-                &settings,
-                rgb.as_mut_ptr(),
-                rgb.len(),
-                None,
-                null_mut(),
-                &mut stats,
-            )
-        };
-        assert_eq!(status, MLT_STATUS_OK, "algorithm {algorithm}");
+        let (rgb, stats) = scene.render_4x4_with_stats(&floor_camera(), &settings);
         // One mutation per pixel by the chains, one direct-pass camera sample per mutation.
         assert_eq!(stats.mutations, 16, "algorithm {algorithm}");
         assert_eq!(stats.samples, 16, "algorithm {algorithm}");

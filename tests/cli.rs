@@ -424,3 +424,55 @@ fn invalid_settings_and_arguments_are_one_line_errors() {
     let line = assert_one_line_error(&output);
     assert!(line.contains("--spp"), "{line}");
 }
+
+#[test]
+fn the_filter_is_reported_and_refused_where_it_does_not_apply() {
+    let out = temp_path("filtered.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"erpt",
+        &"--spp",
+        &"2",
+        &"--filter",
+        &"--filter-buffers",
+        &"4",
+        &"--filter-strength",
+        &"0.6",
+        &"--width",
+        &"32",
+        &"--height",
+        &"32",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    let line = stdout
+        .lines()
+        .find(|l| l.trim_start().starts_with("filter"))
+        .unwrap_or_else(|| panic!("no filter line in:\n{stdout}"));
+    assert!(
+        line.contains("4 partial images, strength 0.6, radius 7"),
+        "{line}"
+    );
+    let averaged: f64 = line
+        .split(": ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no pixel count in {line}"));
+    assert!(averaged > 1.0, "{line}");
+
+    let output = mlt_render(&[
+        &scene("cornell-glass.obj"),
+        &"--algorithm",
+        &"path",
+        &"--filter",
+        &"--out",
+        &out,
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success());
+    assert!(stderr.contains("Metropolis and ERPT"), "{stderr}");
+}

@@ -140,6 +140,19 @@ struct Args {
     /// space instead of within a cone.
     #[arg(long)]
     perturb_in_sample_space: bool,
+    /// Metropolis and ERPT: filter the image's blotchy noise after the render (non-local
+    /// means guided by variances measured from partial images; keeps the total).
+    #[arg(long)]
+    filter: bool,
+    /// With --filter: partial images the deposits are split into (2 to 32).
+    #[arg(long, value_name = "N", default_value_t = RenderSettings::DEFAULT_FILTER_BUFFERS)]
+    filter_buffers: u32,
+    /// With --filter: its strength (higher smooths more).
+    #[arg(long, value_name = "K", default_value_t = RenderSettings::DEFAULT_FILTER_STRENGTH)]
+    filter_strength: f32,
+    /// With --filter: its search radius in pixels.
+    #[arg(long, value_name = "PIXELS", default_value_t = RenderSettings::DEFAULT_FILTER_RADIUS)]
+    filter_radius: u32,
     /// ERPT: perturbations per chain.
     #[arg(long, value_name = "L", default_value_t = RenderSettings::default().erpt_chain_length)]
     erpt_chain_length: u32,
@@ -282,6 +295,9 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         erpt_deposit_energy: args.erpt_deposit,
         adapt_mutation_weights: args.adapt_mutation_weights,
         perturb_in_sample_space: args.perturb_in_sample_space,
+        filter_buffers: if args.filter { args.filter_buffers } else { 0 },
+        filter_strength: args.filter_strength,
+        filter_radius: args.filter_radius,
     }
 }
 
@@ -410,6 +426,16 @@ fn print_summary(
                 stats.mutation_weights.0[mutation as usize]
             );
         }
+    }
+    if settings.filter_buffers > 0 {
+        println!(
+            "  filter     {} partial images, strength {}, radius {}: {:.1} pixels averaged per pixel, {:.2}% of the luminance moved (total kept)",
+            settings.filter_buffers,
+            settings.filter_strength,
+            settings.filter_radius,
+            stats.filter.mean_neighbours,
+            100.0 * stats.filter.changed_fraction
+        );
     }
     if stats.invalid_samples > 0 {
         println!(

@@ -639,8 +639,10 @@ pub(crate) fn run_rounds<C: MarkovChain>(
             control.mutations_done.fetch_add(steps, Ordering::Relaxed);
         });
         mutations_done += steps;
-        for chain in chains.iter() {
-            film.add_weighted_splats(&chain.deposits, chain.weight);
+        // Chains are independent, so chain i's deposits also make partial image i mod K
+        // of the post-process filter.
+        for (i, chain) in chains.iter().enumerate() {
+            film.add_weighted_splats_to(&chain.deposits, chain.weight, i);
         }
         after_round(
             film,

@@ -67,6 +67,8 @@ const PREPASS_STREAM: u64 = 0x5eed_e398_0000_0000;
 /// Mixed into the seed of the (pixel, sample) streams, so an ERPT render's camera samples
 /// are not BDPT's with the same seed.
 const SEED_SALT: u64 = 0xe397_5a17_0000_0001;
+/// Salt of the hash that assigns camera samples to the filter's partial images.
+const BUFFER_SALT: u64 = 0xe397_b0ff_0000_0002;
 /// Camera samples of the pre-pass that estimates the mean energy per sample.
 const PREPASS_SAMPLES: u64 = 1 << 14;
 const PREPASS_CHUNK: u64 = 256;
@@ -107,6 +109,8 @@ struct UnitScratch {
 /// same pixel are summed first.
 struct Pending {
     pixel: u32,
+    /// The partial image of the post-process filter the deposits also go to.
+    buffer: usize,
     value: [f64; 3],
 }
 
@@ -118,8 +122,9 @@ struct Redistributor<'a> {
     weights: MutationWeights,
     chain_length: u32,
     deposit_energy: f32,
-    /// Fixed-point sums per pixel and channel.
+    /// Fixed-point sums per pixel, partial image (`buffers` per pixel) and channel.
     sums: &'a [[AtomicU64; 3]],
+    buffers: usize,
     scale: f64,
 }
 
@@ -132,7 +137,7 @@ fn unit_colour(value: Vec3A) -> Option<Vec3A> {
 
 impl Redistributor<'_> {
     fn flush(&self, pending: &mut Pending) {
-        let sums = &self.sums[pending.pixel as usize];
+        let sums = &self.sums[pending.pixel as usize * self.buffers + pending.buffer];
         for (sum, value) in sums.iter().zip(pending.value) {
             // `as` saturates; so does the sum (only reachable with an absurdly small e_d).
             let units = (value * self.scale).round() as u64;
@@ -164,6 +169,7 @@ impl Redistributor<'_> {
         &self,
         chains: u64,
         pixel: u32,
+        buffer: usize,
         colour: Vec3A,
         rng: &mut Rng,
         scratch: &mut UnitScratch,
@@ -174,6 +180,7 @@ impl Redistributor<'_> {
         let length = self.chain_length;
         let mut pending = Pending {
             pixel,
+            buffer,
             value: [0.0; 3],
         };
         let admits = perturbation::applicable(&self.space, &scratch.initial);
@@ -252,13 +259,15 @@ impl Redistributor<'_> {
         (mutations, accepted)
     }
 
-    /// One camera sample through film position (x, y) and the chains of its strategies.
-    /// Returns (mutations, accepted, whether the sample was valid).
+    /// One camera sample through film position (x, y) and the chains of its strategies,
+    /// whose deposits also go to partial image `buffer`. Returns (mutations, accepted,
+    /// whether the sample was valid).
     #[allow(clippy::too_many_arguments)]
     fn sample(
         &self,
         x: f32,
         y: f32,
+        buffer: usize,
         rng: &mut Rng,
         scratch: &mut UnitScratch,
         counters: &mut SampleCounters,
@@ -308,6 +317,7 @@ impl Redistributor<'_> {
                 let (m, a) = self.redistribute(
                     chains,
                     pixel,
+                    buffer,
                     colour,
                     rng,
                     scratch,
@@ -376,7 +386,11 @@ pub(crate) fn run(
             1.0
         }
     };
-    let sums: Vec<[AtomicU64; 3]> = (0..pixels).map(|_| Default::default()).collect();
+    // With the filter on, each camera sample's chains also deposit into one partial image
+    // (by a hash of pixel and sample, so every partial sees every region); the film's
+    // splats are the partials' sums.
+    let buffers = film.filter_buffers().max(1);
+    let sums: Vec<[AtomicU64; 3]> = (0..pixels * buffers).map(|_| Default::default()).collect();
     let redistributor = Redistributor {
         bdpt,
         space: PathSpace {
@@ -389,6 +403,7 @@ pub(crate) fn run(
         chain_length,
         deposit_energy,
         sums: &sums,
+        buffers,
         scale: FIXED_POINT / deposit_energy as f64,
     };
     let bands = height.div_ceil(BAND_ROWS);
@@ -441,9 +456,17 @@ pub(crate) fn run(
                     for sample in first..end {
                         let [jx, jy] = shifted_sobol_2d(sample, shift);
                         let mut rng = Rng::for_pixel_sample(seed, pixel, sample as u64);
+                        let buffer = if buffers > 1 {
+                            let mut hash =
+                                Rng::for_pixel_sample(seed ^ BUFFER_SALT, pixel, sample as u64);
+                            hash.next_u32() as usize % buffers
+                        } else {
+                            0
+                        };
                         let (m, a, valid) = redistributor.sample(
                             x as f32 + jx,
                             y as f32 + jy,
+                            buffer,
                             &mut rng,
                             unit,
                             &mut counters,
@@ -479,10 +502,24 @@ pub(crate) fn run(
     outcome.mutation_weights = settings.weights;
     // The film divides splats by (samples taken / pixels): one camera sample per pixel.
     let unit = deposit_energy as f64 / FIXED_POINT;
+    let value = |s: &[AtomicU64; 3]| -> [f64; 3] {
+        std::array::from_fn(|c| s[c].load(Ordering::Relaxed) as f64 * unit)
+    };
     film.add_splat_sums(
-        sums.iter()
-            .map(|s| std::array::from_fn(|c| s[c].load(Ordering::Relaxed) as f64 * unit)),
+        sums.chunks_exact(buffers).map(|pixel| {
+            // Integer sums first, so the total does not depend on the number of partials.
+            std::array::from_fn(|c| {
+                pixel
+                    .iter()
+                    .map(|s| s[c].load(Ordering::Relaxed))
+                    .fold(0u64, u64::saturating_add) as f64
+                    * unit
+            })
+        }),
         samples_taken,
     );
+    if buffers > 1 {
+        film.add_partial_splat_sums(sums.iter().map(value));
+    }
     outcome
 }
