@@ -14,6 +14,15 @@
 //! default: the 1-2-5 series from a tenth of the longest budget up to it), then once with two
 //! threads at the longest budget (in the table, not the plot). The table notes renders that
 //! overran their budget or finished no sample at all (a black image, left out of the plot).
+//! With `MLT_BENCH_REPEATS` = R > 1 the longest budget is rendered R times on each thread
+//! count (seeds differ), and a second table gives the medians over those renders: a single
+//! render's RMSE is too noisy to rank options that differ by 10–20%.
+//!
+//! The `-filtered` algorithms run the post-process filter (`mlt::filter`, default settings,
+//! 8 partial images). Their rows give the RMSE of the filtered image, the RMSE of the same
+//! render unfiltered, and the filter's bias: the largest shift of a 4 × 4 region's mean
+//! luminance between the two, relative to the reference's region. The filter runs after the
+//! time limit, so its own time shows in the seconds column.
 //!
 //! The reference is BDPT on every core (checked against the path tracer on these scenes by
 //! `tests/bdpt.rs`; it converges much faster on caustics and on light through a crack),
@@ -28,6 +37,7 @@
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
 //!   `cornell-glass,door-ajar`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
+//! - `MLT_BENCH_REPEATS`: renders at the longest budget per thread count (default 1).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
 //!   paths); without one the plot is written without text.
 //!
@@ -39,7 +49,10 @@ use common::{
     FONT_FAMILY, draw_legend, env_names, env_value, output_dir, plot_font_or_color_key,
     series_color,
 };
-use mlt::{Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render};
+use mlt::{
+    Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render,
+    render_with_unfiltered,
+};
 use plotters::prelude::*;
 use std::error::Error;
 use std::io::Write;
@@ -47,7 +60,7 @@ use std::path::Path;
 
 /// An algorithm as compared: the name the table, the plot and `MLT_BENCH_ALGORITHMS` use,
 /// its `direct_samples_per_mutation` (Metropolis: the default direct pass, or 0 for chains
-/// over every depth) and path-space MLT's and ERPT's options.
+/// over every depth), path-space MLT's and ERPT's options and the post-process filter.
 #[derive(Clone, Copy)]
 struct Compared {
     name: &'static str,
@@ -55,6 +68,8 @@ struct Compared {
     direct_samples_per_mutation: u32,
     adapt_mutation_weights: bool,
     perturb_in_sample_space: bool,
+    erpt_chain_length: u32,
+    filter: bool,
 }
 
 const fn compared(name: &'static str, algorithm: Algorithm, direct: u32) -> Compared {
@@ -64,6 +79,8 @@ const fn compared(name: &'static str, algorithm: Algorithm, direct: u32) -> Comp
         direct_samples_per_mutation: direct,
         adapt_mutation_weights: false,
         perturb_in_sample_space: false,
+        erpt_chain_length: RenderSettings::DEFAULT_ERPT_CHAIN_LENGTH,
+        filter: false,
     }
 }
 
@@ -95,6 +112,22 @@ const ALGORITHMS: &[Compared] = &[
     Compared {
         perturb_in_sample_space: true,
         ..compared("erpt-sample-space", Algorithm::Erpt, 0)
+    },
+    Compared {
+        erpt_chain_length: 20,
+        ..compared("erpt-chains-20", Algorithm::Erpt, 0)
+    },
+    Compared {
+        filter: true,
+        ..compared("pssmlt-filtered", Algorithm::Pssmlt, DIRECT)
+    },
+    Compared {
+        filter: true,
+        ..compared("path-space-mlt-filtered", Algorithm::PathSpaceMlt, DIRECT)
+    },
+    Compared {
+        filter: true,
+        ..compared("erpt-filtered", Algorithm::Erpt, 0)
     },
 ];
 
@@ -129,6 +162,13 @@ struct Measurement {
     corrected_rmse: f64,
     /// Per channel: image mean / reference mean − 1, in percent.
     mean_difference_percent: [f64; 3],
+    /// With the filter: the corrected RMSE of the same render unfiltered …
+    unfiltered_corrected_rmse: Option<f64>,
+    /// … and the largest shift of a 4 × 4 region's mean luminance the filter made, relative
+    /// to the reference's region, in percent.
+    filter_shift_percent: Option<f64>,
+    /// Which render of several at the same budget and thread count (0 is plotted).
+    repeat: u32,
 }
 
 struct SceneResult {
@@ -239,6 +279,7 @@ fn reference(name: &str, scene: &Scene, camera: &Camera, spp: u32, dir: &Path) -
 }
 
 /// Renders with `algorithm` until `budget_seconds` pass and compares with the reference.
+#[allow(clippy::too_many_arguments)]
 fn measure(
     scene: &Scene,
     camera: &Camera,
@@ -247,6 +288,7 @@ fn measure(
     threads: u32,
     budget_seconds: f64,
     seed: u64,
+    repeat: u32,
 ) -> Measurement {
     let name = compared.name;
     // Everything else stays at the defaults: they are what is being judged.
@@ -264,11 +306,42 @@ fn measure(
         direct_samples_per_mutation: compared.direct_samples_per_mutation,
         adapt_mutation_weights: compared.adapt_mutation_weights,
         perturb_in_sample_space: compared.perturb_in_sample_space,
+        erpt_chain_length: compared.erpt_chain_length,
+        filter_buffers: if compared.filter {
+            RenderSettings::DEFAULT_FILTER_BUFFERS
+        } else {
+            0
+        },
         ..Default::default()
     };
     let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
-    let stats = render(scene, camera, &settings, &mut image, None)
+    let mut unfiltered = image.clone();
+    let stats = render_with_unfiltered(scene, camera, &settings, &mut image, &mut unfiltered, None)
         .unwrap_or_else(|e| panic!("{name} fails to render: {e}"));
+    let corrected = |rmse: f64| {
+        (rmse * rmse - reference.rmse * reference.rmse)
+            .max(0.0)
+            .sqrt()
+    };
+    let (unfiltered_corrected_rmse, filter_shift_percent) = if compared.filter {
+        let luminance = |v: &[f64; 3]| 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+        let regions =
+            |image: &[f32]| -> Vec<f64> { region_means(image).iter().map(luminance).collect() };
+        let (f, u, r) = (
+            regions(&image),
+            regions(&unfiltered),
+            regions(&reference.image),
+        );
+        let shift = (0..f.len())
+            .map(|i| ((f[i] - u[i]) / r[i]).abs())
+            .fold(0.0, f64::max);
+        (
+            Some(corrected(rmse(&unfiltered, &reference.image))),
+            Some(100.0 * shift),
+        )
+    } else {
+        (None, None)
+    };
     // With no sample count the render always ends at the time limit.
     assert_eq!(stats.stop, StopReason::TimeLimitReached, "{name}");
     let rmse = rmse(&image, &reference.image);
@@ -280,18 +353,35 @@ fn measure(
         budget_seconds,
         stats,
         rmse,
-        corrected_rmse: (rmse * rmse - reference.rmse * reference.rmse)
-            .max(0.0)
-            .sqrt(),
+        corrected_rmse: corrected(rmse),
         mean_difference_percent: std::array::from_fn(|c| {
             (means[c] / reference_means[c] - 1.0) * 100.0
         }),
+        unfiltered_corrected_rmse,
+        filter_shift_percent,
+        repeat,
     }
+}
+
+/// Mean RGB of each cell of a 4 × 4 partition of a `WIDTH` × `HEIGHT` image, row-major.
+fn region_means(rgb: &[f32]) -> Vec<[f64; 3]> {
+    const GRID: usize = 4;
+    let (width, height) = (WIDTH as usize, HEIGHT as usize);
+    let mut sums = vec![[0.0f64; 3]; GRID * GRID];
+    for (i, pixel) in rgb.chunks_exact(3).enumerate() {
+        let (x, y) = (i % width, i / width);
+        let cell = (y * GRID / height) * GRID + x * GRID / width;
+        for c in 0..3 {
+            sums[cell][c] += pixel[c] as f64;
+        }
+    }
+    let per_cell = (width * height / (GRID * GRID)) as f64;
+    sums.iter().map(|s| s.map(|v| v / per_cell)).collect()
 }
 
 fn print_header() {
     println!(
-        "{:<14} {:<28} {:>7} {:>7} {:>8} {:>12} {:>12} {:>9} {:>10} {:>10}  mean vs reference (R/G/B)",
+        "{:<14} {:<28} {:>7} {:>7} {:>8} {:>12} {:>12} {:>9} {:>10} {:>10}  mean vs reference (R/G/B)  [filter: unfiltered corrected, largest region shift]",
         "scene",
         "algo",
         "threads",
@@ -318,6 +408,9 @@ fn print_row(scene: &str, m: &Measurement) {
     if m.stats.seconds > m.budget_seconds * 1.1 + OVERRUN_TOLERANCE_SECONDS {
         notes.push_str("  over budget");
     }
+    if let (Some(unfiltered), Some(shift)) = (m.unfiltered_corrected_rmse, m.filter_shift_percent) {
+        notes = format!("  [{unfiltered:.5}, {shift:.1}%]{notes}");
+    }
     println!(
         "{scene:<14} {:<28} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>8.1}% {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
         m.algorithm,
@@ -332,6 +425,53 @@ fn print_row(scene: &str, m: &Measurement) {
     );
     // Rows appear as they are measured: a full run takes many minutes.
     let _ = std::io::stdout().flush();
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        (values[n / 2 - 1] + values[n / 2]) / 2.0
+    }
+}
+
+/// Medians over the repeated renders at the longest budget, per algorithm and thread count.
+fn print_medians(scene: &str, measurements: &[Measurement], max_seconds: f64, repeats: u32) {
+    println!(
+        "{scene}: medians over {repeats} renders of {max_seconds} s: {:<28} {:>7} {:>10} {:>9}  [filter: unfiltered corrected, largest region shift]",
+        "algo", "threads", "corrected", "accepted"
+    );
+    let mut names: Vec<&str> = measurements.iter().map(|m| m.algorithm).collect();
+    names.dedup();
+    for name in names {
+        for threads in [1, 2] {
+            let runs: Vec<&Measurement> = measurements
+                .iter()
+                .filter(|m| {
+                    m.algorithm == name && m.threads == threads && m.budget_seconds == max_seconds
+                })
+                .collect();
+            let of = |f: &dyn Fn(&Measurement) -> f64| median(runs.iter().map(|m| f(m)).collect());
+            let corrected = of(&|m| m.corrected_rmse);
+            let accepted = of(&|m| {
+                100.0 * m.stats.accepted_mutations as f64 / m.stats.mutations.max(1) as f64
+            });
+            let filter = if runs.iter().all(|m| m.unfiltered_corrected_rmse.is_some()) {
+                format!(
+                    "  [{:.5}, {:.1}%]",
+                    of(&|m| m.unfiltered_corrected_rmse.unwrap_or(0.0)),
+                    of(&|m| m.filter_shift_percent.unwrap_or(0.0))
+                )
+            } else {
+                String::new()
+            };
+            println!(
+                "{scene}: medians over {repeats} renders of {max_seconds} s: {name:<28} {threads:>7} {corrected:>10.5} {accepted:>8.1}%{filter}"
+            );
+        }
+    }
 }
 
 /// Tick values of a log axis over `min..max`: labelled ones on the 1-2-5 series and unlabelled
@@ -383,7 +523,10 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
             .measurements
             .iter()
             .filter(|m| {
-                m.threads == 1 && (m.stats.samples > 0 || m.stats.mutations > 0) && m.rmse > 0.0
+                m.threads == 1
+                    && m.repeat == 0
+                    && (m.stats.samples > 0 || m.stats.mutations > 0)
+                    && m.rmse > 0.0
             })
             .collect();
         if plotted.is_empty() {
@@ -496,6 +639,8 @@ fn main() {
                 })
         })
         .collect();
+    let repeats: u32 = env_value("MLT_BENCH_REPEATS", 1);
+    assert!(repeats >= 1, "MLT_BENCH_REPEATS must be at least 1");
     let budgets = time_budgets(max_seconds);
     let dir = output_dir();
     std::fs::create_dir_all(&dir).expect("output directory");
@@ -515,11 +660,14 @@ fn main() {
         print_header();
         let mut measurements = Vec::new();
         for &algorithm in &algorithms {
+            let extra = (1..repeats).map(|repeat| (1, max_seconds, repeat));
+            let two_threads = (0..repeats).map(|repeat| (2, max_seconds, repeat));
             let runs = budgets
                 .iter()
-                .map(|&budget| (1, budget))
-                .chain([(2, max_seconds)]);
-            for (seed, (threads, budget)) in runs.enumerate() {
+                .map(|&budget| (1, budget, 0))
+                .chain(extra)
+                .chain(two_threads);
+            for (seed, (threads, budget, repeat)) in runs.enumerate() {
                 let m = measure(
                     &scene,
                     &camera,
@@ -528,10 +676,14 @@ fn main() {
                     threads,
                     budget,
                     seed as u64,
+                    repeat,
                 );
                 print_row(name, &m);
                 measurements.push(m);
             }
+        }
+        if repeats > 1 {
+            print_medians(name, &measurements, max_seconds, repeats);
         }
         results.push(SceneResult {
             scene: name.clone(),

@@ -89,6 +89,10 @@ const SERIES_COLORS: &[RGBColor] = &[
     RGBColor(0, 0, 0),
     RGBColor(255, 187, 120),
     RGBColor(174, 199, 232),
+    RGBColor(152, 223, 138),
+    RGBColor(255, 152, 150),
+    RGBColor(197, 176, 213),
+    RGBColor(196, 156, 148),
 ];
 
 pub fn series_color(index: usize) -> RGBColor {
