@@ -114,8 +114,16 @@ const ALGORITHMS: &[Compared] = &[
         ..compared("erpt-sample-space", Algorithm::Erpt, 0)
     },
     Compared {
+        erpt_chain_length: 5,
+        ..compared("erpt-chains-5", Algorithm::Erpt, 0)
+    },
+    Compared {
         erpt_chain_length: 20,
         ..compared("erpt-chains-20", Algorithm::Erpt, 0)
+    },
+    Compared {
+        erpt_chain_length: 100,
+        ..compared("erpt-chains-100", Algorithm::Erpt, 0)
     },
     Compared {
         filter: true,

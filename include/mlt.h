@@ -200,9 +200,12 @@
 #define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
 
 /**
- * The default `erpt_chain_length` (Cline et al. used chains of about this length).
+ * The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
+ * cornell-glass and door-ajar (`benches/equal_time.rs`, medians of 3 renders of 10 s;
+ * 5 to 20 within noise of each other, 100, about Cline et al.'s length, 2 to 3 times
+ * worse: long chains leave few camera samples per pixel).
  */
-#define RenderSettings_DEFAULT_ERPT_CHAIN_LENGTH 100
+#define RenderSettings_DEFAULT_ERPT_CHAIN_LENGTH 10
 
 /**
  * The partial images a filtered render uses unless told otherwise (the CLI's
@@ -436,7 +439,7 @@ typedef struct MltRenderSettings {
    */
   float mutation_weights[4];
   /**
-   * `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 100.
+   * `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 10.
    */
   uint32_t erpt_chain_length;
   /**

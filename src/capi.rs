@@ -183,7 +183,7 @@ pub struct MltRenderSettings {
     /// those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
     /// positive.
     pub mutation_weights: [f32; 4],
-    /// `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 100.
+    /// `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 10.
     pub erpt_chain_length: u32,
     /// `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
     /// sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks

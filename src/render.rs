@@ -282,8 +282,11 @@ impl RenderSettings {
     /// The default `direct_samples_per_mutation`: one, the best measured at equal time on
     /// the Cornell scenes (benches/equal_time.rs).
     pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
-    /// The default `erpt_chain_length` (Cline et al. used chains of about this length).
-    pub const DEFAULT_ERPT_CHAIN_LENGTH: u32 = 100;
+    /// The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
+    /// cornell-glass and door-ajar (`benches/equal_time.rs`, medians of 3 renders of 10 s;
+    /// 5 to 20 within noise of each other, 100, about Cline et al.'s length, 2 to 3 times
+    /// worse: long chains leave few camera samples per pixel).
+    pub const DEFAULT_ERPT_CHAIN_LENGTH: u32 = 10;
     /// The partial images a filtered render uses unless told otherwise (the CLI's
     /// `--filter`): enough that one blotch is a clear minority, few enough to keep memory low.
     pub const DEFAULT_FILTER_BUFFERS: u32 = 8;

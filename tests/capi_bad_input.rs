@@ -381,7 +381,7 @@ fn defaults_are_valid_and_documented() {
         ),
         (0.3, 0.01, 1)
     );
-    assert_eq!((s.erpt_chain_length, s.erpt_deposit_energy), (100, 0.0));
+    assert_eq!((s.erpt_chain_length, s.erpt_deposit_energy), (10, 0.0));
     assert_eq!(
         (s.adapt_mutation_weights, s.perturb_in_sample_space),
         (0, 0)

@@ -51,7 +51,7 @@ fn furnace_matches_the_geometric_series() {
     let albedo = [0.5, 0.7, 0.9];
     let emission = [1.0, 0.5, 2.0];
     let scene = furnace_scene(albedo, emission);
-    let renders: Vec<Vec<f32>> = (0..8)
+    let renders: Vec<Vec<f32>> = (0..16)
         .map(|seed| {
             let settings = RenderSettings {
                 max_depth: 3,
@@ -70,7 +70,7 @@ fn furnace_matches_the_geometric_series() {
             truth[c],
             (mean[c] - truth[c]) / variance[c].sqrt()
         );
-        // 8 renders: a variance with 7 degrees of freedom; P(|t| > 6) = 9·10⁻⁴.
+        // 16 renders: a variance with 15 degrees of freedom; P(|t| > 6) = 2·10⁻⁵.
         assert_within_and_sharp(
             &format!("channel {c}"),
             mean[c],
