@@ -93,6 +93,8 @@ const SERIES_COLORS: &[RGBColor] = &[
     RGBColor(255, 152, 150),
     RGBColor(197, 176, 213),
     RGBColor(196, 156, 148),
+    RGBColor(219, 219, 141),
+    RGBColor(158, 218, 229),
 ];
 
 pub fn series_color(index: usize) -> RGBColor {
