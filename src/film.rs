@@ -1,7 +1,7 @@
 //! The film: per-pixel sums of radiance samples and the number of samples taken, turned into
 //! an image normalized pixel by pixel (so a partial render is still a valid estimate).
 
-use crate::filter::{FilterStats, filter_splats};
+use crate::filter::{FilterSettings, FilterStats, filter_splats};
 use rayon::prelude::*;
 
 pub struct Film {
@@ -17,13 +17,11 @@ pub struct Film {
     light_paths: u64,
     /// Overrides the splat normalization (Metropolis: b / mutations per pixel).
     splat_scale: Option<f64>,
-    /// The splats again, split into `filter_buffers` partial images for the post-process
-    /// filter (`crate::filter`): `partials[pixel * filter_buffers + buffer]`. Empty when
-    /// the filter is off.
+    /// The post-process filter (`crate::filter`), if on …
+    filter: Option<FilterSettings>,
+    /// … and the splats again, split into its partial images:
+    /// `partials[pixel * buffers + buffer]`.
     partials: Vec<[f32; 3]>,
-    filter_buffers: usize,
-    filter_strength: f32,
-    filter_radius: u32,
 }
 
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
@@ -49,29 +47,21 @@ impl Film {
             },
             light_paths: 0,
             splat_scale: None,
+            filter: None,
             partials: Vec::new(),
-            filter_buffers: 0,
-            filter_strength: 0.0,
-            filter_radius: 0,
         }
     }
 
-    /// Turns the post-process filter on: splats are also kept in `buffers` partial images,
-    /// and the written image is filtered with `strength` and `radius` (`crate::filter`).
-    pub fn enable_filter(&mut self, buffers: u32, strength: f32, radius: u32) {
-        self.filter_buffers = buffers as usize;
-        self.filter_strength = strength;
-        self.filter_radius = radius;
-        self.partials = vec![[0.0; 3]; self.splats.len() * buffers as usize];
+    /// Turns the post-process filter on: splats are also kept in its partial images, and
+    /// the written image is filtered (`crate::filter`).
+    pub fn enable_filter(&mut self, settings: FilterSettings) {
+        self.partials = vec![[0.0; 3]; self.splats.len() * settings.buffers as usize];
+        self.filter = Some(settings);
     }
 
     /// The number of partial images splats are split into; 0 when the filter is off.
     pub fn filter_buffers(&self) -> usize {
-        if self.partials.is_empty() {
-            0
-        } else {
-            self.filter_buffers
-        }
+        self.filter.map_or(0, |f| f.buffers as usize)
     }
 
     /// Sets the factor splats are multiplied by, instead of pixels / light paths.
@@ -82,7 +72,7 @@ impl Film {
     /// Adds the splats of a work unit (in the unit's order) and the light paths it traced.
     pub fn add_splats(&mut self, splats: &[crate::integrators::Splat], light_paths: u64) {
         self.light_paths += light_paths;
-        self.add_weighted_splats(splats, 1.0);
+        self.add_weighted_splats(splats, 1.0, 0);
     }
 
     /// Adds per-pixel splat sums (one RGB triple per pixel, in pixel order) that stand for
@@ -96,14 +86,9 @@ impl Film {
         }
     }
 
-    /// Adds `weight` × the splats of a work unit, in the unit's order.
-    pub fn add_weighted_splats(&mut self, splats: &[crate::integrators::Splat], weight: f64) {
-        self.add_weighted_splats_to(splats, weight, 0);
-    }
-
     /// Adds `weight` × the splats of a work unit, in the unit's order, and with the filter
     /// on also to partial image `buffer` (taken modulo their number).
-    pub fn add_weighted_splats_to(
+    pub fn add_weighted_splats(
         &mut self,
         splats: &[crate::integrators::Splat],
         weight: f64,
@@ -115,8 +100,9 @@ impl Film {
                 *s += v as f64 * weight;
             }
         }
-        if !self.partials.is_empty() {
-            let (buffers, buffer) = (self.filter_buffers, buffer % self.filter_buffers);
+        let buffers = self.filter_buffers();
+        if buffers > 0 {
+            let buffer = buffer % buffers;
             for splat in splats {
                 let partial = &mut self.partials[splat.pixel as usize * buffers + buffer];
                 for (s, v) in partial.iter_mut().zip(splat.value.to_array()) {
@@ -159,21 +145,15 @@ impl Film {
     /// the splats are filtered (the pixels' own samples are not: they are a Metropolis
     /// render's direct pass), and `unfiltered`, if given, receives the image without it.
     pub fn write_rgb(&self, out: &mut [f32], unfiltered: Option<&mut [f32]>) -> FilterStats {
-        if self.partials.is_empty() {
+        let Some(filter) = &self.filter else {
             self.write_rgb_with(out, &self.splats);
             if let Some(unfiltered) = unfiltered {
                 unfiltered.copy_from_slice(out);
             }
             return FilterStats::default();
-        }
-        let (filtered, stats) = filter_splats(
-            self.width as usize,
-            self.filter_buffers,
-            &self.partials,
-            &self.splats,
-            self.filter_strength,
-            self.filter_radius,
-        );
+        };
+        let (filtered, stats) =
+            filter_splats(self.width as usize, filter, &self.partials, &self.splats);
         self.write_rgb_with(out, &filtered);
         if let Some(unfiltered) = unfiltered {
             self.write_rgb_with(unfiltered, &self.splats);

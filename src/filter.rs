@@ -49,6 +49,18 @@ const PATCH_RADIUS: usize = 3;
 /// Radius of the window the variances are pooled over (5 × 5).
 const VARIANCE_POOL_RADIUS: usize = 2;
 
+/// How a render's image is filtered (`RenderSettings::filter_buffers`, `filter_strength`,
+/// `filter_radius`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilterSettings {
+    /// Partial images the deposits are split into.
+    pub buffers: u32,
+    /// k of the patch distance: higher smooths more.
+    pub strength: f32,
+    /// Search radius in pixels.
+    pub radius: u32,
+}
+
 /// What the filter did to an image.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FilterStats {
@@ -61,16 +73,20 @@ pub struct FilterStats {
 }
 
 /// Filters the splat image `totals` (per pixel, RGB, rows of `width`) given its partial
-/// images (`partials[pixel * buffers + b]`, which sum to `totals`), with strength k and
-/// search `radius`. Returns the filtered image and what was done.
+/// images (`partials[pixel * buffers + b]`, which sum to `totals`). Returns the filtered
+/// image and what was done.
 pub fn filter_splats(
     width: usize,
-    buffers: usize,
+    settings: &FilterSettings,
     partials: &[[f32; 3]],
     totals: &[[f64; 3]],
-    strength: f32,
-    radius: u32,
 ) -> (Vec<[f64; 3]>, FilterStats) {
+    let FilterSettings {
+        buffers,
+        strength,
+        radius,
+    } = *settings;
+    let buffers = buffers as usize;
     let pixels = totals.len();
     assert_eq!(partials.len(), pixels * buffers);
     assert!(width > 0 && pixels.is_multiple_of(width));
@@ -295,6 +311,14 @@ mod tests {
     use super::*;
     use crate::sampling::Rng;
 
+    fn settings(buffers: usize, strength: f32, radius: u32) -> FilterSettings {
+        FilterSettings {
+            buffers: buffers as u32,
+            strength,
+            radius,
+        }
+    }
+
     /// A step image: `low` left of column `width / 2`, `high` from it on.
     fn step(width: usize, height: usize, low: f64, high: f64) -> Vec<f64> {
         (0..width * height)
@@ -370,7 +394,8 @@ mod tests {
         let truth = step(width, height, 1.0, 3.0);
         let partials = noisy_partials(&truth, buffers, 0.5);
         let totals = totals(&partials, buffers);
-        let (filtered, stats) = filter_splats(width, buffers, &partials, &totals, 0.45, 7);
+        let (filtered, stats) =
+            filter_splats(width, &settings(buffers, 0.45, 7), &partials, &totals);
         let (before, after) = (rmse(&totals, &truth), rmse(&filtered, &truth));
         assert!(after < 0.5 * before, "RMSE {before} -> {after}");
         // The columns on either side of the edge keep their level: not averaged across it.
@@ -399,7 +424,8 @@ mod tests {
         let truth: Vec<f64> = (0..width * height).map(|i| 1.0 + (i % 7) as f64).collect();
         let partials = noisy_partials(&truth, buffers, 0.0);
         let totals = totals(&partials, buffers);
-        let (filtered, stats) = filter_splats(width, buffers, &partials, &totals, 0.45, 5);
+        let (filtered, stats) =
+            filter_splats(width, &settings(buffers, 0.45, 5), &partials, &totals);
         for (f, t) in filtered.iter().zip(&totals) {
             for c in 0..3 {
                 assert!((f[c] - t[c]).abs() <= 1e-12 * t[c], "{f:?} {t:?}");
@@ -418,7 +444,8 @@ mod tests {
             }
         }
         let totals = totals(&partials, buffers);
-        let (filtered, stats) = filter_splats(width, buffers, &partials, &totals, 1.0, 3);
+        let (filtered, stats) =
+            filter_splats(width, &settings(buffers, 1.0, 3), &partials, &totals);
         assert_eq!(filtered, totals);
         assert_eq!(stats, FilterStats::default());
     }
@@ -429,8 +456,8 @@ mod tests {
         let truth = step(width, height, 1.0, 2.0);
         let partials = noisy_partials(&truth, buffers, 0.5);
         let totals = totals(&partials, buffers);
-        let (_, weak) = filter_splats(width, buffers, &partials, &totals, 0.1, 5);
-        let (_, strong) = filter_splats(width, buffers, &partials, &totals, 1.0, 5);
+        let (_, weak) = filter_splats(width, &settings(buffers, 0.1, 5), &partials, &totals);
+        let (_, strong) = filter_splats(width, &settings(buffers, 1.0, 5), &partials, &totals);
         assert!(
             strong.mean_neighbours > weak.mean_neighbours * 1.3,
             "{weak:?} {strong:?}"

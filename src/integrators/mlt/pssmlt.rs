@@ -642,7 +642,7 @@ pub(crate) fn run_rounds<C: MarkovChain>(
         // Chains are independent, so chain i's deposits also make partial image i mod K
         // of the post-process filter.
         for (i, chain) in chains.iter().enumerate() {
-            film.add_weighted_splats_to(&chain.deposits, chain.weight, i);
+            film.add_weighted_splats(&chain.deposits, chain.weight, i);
         }
         after_round(
             film,
