@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::door_ajar;
+use common::{door_ajar, lamp_behind_glass};
 use mlt::io::{self, IoError, SceneData};
 use mlt::{Material, MaterialKind, Scene};
 use std::path::{Path, PathBuf};
@@ -122,12 +122,10 @@ fn cornell_box_obj_loads_triangles_materials_and_camera() {
     assert_eq!(scene.info().emitter_count, 2);
 }
 
-/// The committed door-ajar files are what `tests/common/door_ajar.rs` writes (with
-/// `MLT_WRITE_SCENES=1`, this test writes them instead), and the scene loads with one
-/// light, its camera sidecar and a door standing open.
-#[test]
-fn door_ajar_scene_files_are_what_the_generator_writes() {
-    for (name, text) in door_ajar::files() {
+/// Writes a generated scene's files (with `MLT_WRITE_SCENES=1`) or checks the committed
+/// ones are what its generator writes.
+fn check_generated_scene(files: [(&str, String); 3]) {
+    for (name, text) in files {
         let path = scenes().join(name);
         if std::env::var_os("MLT_WRITE_SCENES").is_some() {
             std::fs::write(&path, &text).unwrap();
@@ -138,6 +136,14 @@ fn door_ajar_scene_files_are_what_the_generator_writes() {
             "{name} differs from its generator: rewrite it with MLT_WRITE_SCENES=1 cargo test --test io"
         );
     }
+}
+
+/// The committed door-ajar files are what `tests/common/door_ajar.rs` writes (with
+/// `MLT_WRITE_SCENES=1`, this test writes them instead), and the scene loads with one
+/// light, its camera sidecar and a door standing open.
+#[test]
+fn door_ajar_scene_files_are_what_the_generator_writes() {
+    check_generated_scene(door_ajar::files());
     let data = io::load_scene(&scenes().join("door-ajar.obj")).unwrap();
     let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
     assert_eq!(scene.info().emitter_count, 2);
@@ -145,6 +151,21 @@ fn door_ajar_scene_files_are_what_the_generator_writes() {
     let (door, _) = material_named(&data, "door");
     let door_faces = data.material_ids.iter().filter(|&&m| m == door).count();
     assert_eq!(door_faces, 8);
+}
+
+/// The same for `tests/common/lamp_behind_glass.rs`: one two-triangle lamp, and a closed
+/// glass slab of ior 1.5 (12 triangles) under it.
+#[test]
+fn lamp_behind_glass_scene_files_are_what_the_generator_writes() {
+    check_generated_scene(lamp_behind_glass::files());
+    let data = io::load_scene(&scenes().join("lamp-behind-glass.obj")).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    assert_eq!(scene.info().emitter_count, 2);
+    assert!(data.camera.is_some());
+    let (glass, m) = material_named(&data, "glass");
+    assert_eq!((m.kind, m.ior), (MaterialKind::Dielectric, 1.5));
+    let glass_faces = data.material_ids.iter().filter(|&&id| id == glass).count();
+    assert_eq!(glass_faces, 12);
 }
 
 #[test]

@@ -16,7 +16,7 @@
 //! room by `DOOR_ANGLE_DEG`. The light hangs under the far room's ceiling on the side away
 //! from the hinge, facing down.
 
-use std::fmt::Write;
+use super::obj_text::Obj;
 
 /// How far the door stands open: its free edge leaves a gap of about 100 · sin(angle) mm.
 pub const DOOR_ANGLE_DEG: f64 = 9.0;
@@ -29,61 +29,6 @@ const DEPTH: f64 = 1000.0;
 const DOORWAY: [f64; 2] = [300.0, 400.0];
 const DOORWAY_HEIGHT: f64 = 210.0;
 const DOOR_THICKNESS: f64 = 15.0;
-
-type Point = [f64; 3];
-
-/// OBJ text under construction: `o` groups of quads (two triangles each) with a material.
-#[derive(Default)]
-struct Obj {
-    text: String,
-    vertices: usize,
-}
-
-impl Obj {
-    fn group(&mut self, name: &str, material: &str) {
-        writeln!(self.text, "o {name}\nusemtl {material}").unwrap();
-    }
-
-    /// The quad a, b, c, d (a planar, convex loop); its front side is the one the loop
-    /// turns counter-clockwise on.
-    fn quad(&mut self, [a, b, c, d]: [Point; 4]) {
-        for p in [a, b, c, d] {
-            // Whole hundredths of a millimetre: exact text, the same on every platform.
-            writeln!(self.text, "v {} {} {}", fmt(p[0]), fmt(p[1]), fmt(p[2])).unwrap();
-        }
-        let i = self.vertices + 1;
-        writeln!(self.text, "f {} {} {}", i, i + 1, i + 2).unwrap();
-        writeln!(self.text, "f {} {} {}", i, i + 2, i + 3).unwrap();
-        self.vertices += 4;
-    }
-
-    /// The axis-aligned box [lo, hi], faces outward. `skip` names faces left out because
-    /// they lie against other geometry: "-x", "+x", "-y", "+y", "-z", "+z".
-    fn cuboid(&mut self, lo: Point, hi: Point, skip: &[&str]) {
-        let corner = |x: usize, y: usize, z: usize| {
-            [[lo[0], hi[0]][x], [lo[1], hi[1]][y], [lo[2], hi[2]][z]]
-        };
-        let faces = [
-            ("-x", [(0, 0, 0), (0, 0, 1), (0, 1, 1), (0, 1, 0)]),
-            ("+x", [(1, 0, 0), (1, 1, 0), (1, 1, 1), (1, 0, 1)]),
-            ("-y", [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)]),
-            ("+y", [(0, 1, 0), (0, 1, 1), (1, 1, 1), (1, 1, 0)]),
-            ("-z", [(0, 0, 0), (0, 1, 0), (1, 1, 0), (1, 0, 0)]),
-            ("+z", [(0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]),
-        ];
-        for (name, loop_) in faces {
-            if !skip.contains(&name) {
-                self.quad(loop_.map(|(x, y, z)| corner(x, y, z)));
-            }
-        }
-    }
-}
-
-fn fmt(v: f64) -> String {
-    let rounded = (v * 100.0).round() / 100.0;
-    // Never "-0".
-    format!("{}", rounded + 0.0)
-}
 
 /// The scene's OBJ text.
 pub fn obj() -> String {

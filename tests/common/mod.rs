@@ -3,6 +3,8 @@
 
 pub mod door_ajar;
 pub mod generate;
+pub mod lamp_behind_glass;
+pub mod obj_text;
 
 use mlt::{Backend, Camera, Material, Scene, SceneDesc};
 
