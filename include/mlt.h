@@ -194,10 +194,47 @@
 #define MLT_MAX_BOOTSTRAP_SAMPLES (1 << 28)
 
 /**
+ * Largest accepted share of a Metropolis render's rays spent on its normalization pass.
+ */
+#define MLT_MAX_NORMALIZATION_WORK_FRACTION 0.9
+
+/**
+ * An automatic bootstrap (`bootstrap_samples` 0) takes one sample per this many
+ * planned mutations: at the default 256² × 32 mutations per pixel, 2^18 samples, the
+ * best of 2^16, 2^18 and 2^20 on cornell-glass at 10 s of one thread (8 seeds; MMLT's
+ * RMSE 41% and 10% higher with the others, path-space MLT's 9–17%: the bootstrap is
+ * also what the chains are seeded from). Sized to the work, the bootstrap's share of
+ * the render, and so the brightness error's fall with the work, stay the same at any
+ * budget.
+ */
+#define RenderSettings_AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE 8
+
+/**
+ * The fewest samples of an automatic bootstrap.
+ */
+#define RenderSettings_MIN_AUTO_BOOTSTRAP_SAMPLES (1 << 16)
+
+/**
+ * The automatic bootstrap of a render with a time limit and no mutation count (the
+ * normalization pass then makes b's error fall with the render's length).
+ */
+#define RenderSettings_TIME_LIMITED_BOOTSTRAP_SAMPLES (1 << 18)
+
+/**
  * The default `direct_samples_per_mutation`: one, the best measured at equal time on
  * the Cornell scenes (benches/equal_time.rs).
  */
 #define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
+
+/**
+ * The default `normalization_work_fraction`, chosen by `benches/brightness.rs` (8 seeds
+ * of 10 s on one thread, time-limited, so with a bootstrap of 2^18): 0.1 lowers the
+ * reported error of b from 0.71% to 0.54% on door-ajar and cornell-glass for MMLT and
+ * path-space MLT, and its share grows with the render, for 1–5% more RMSE (within the
+ * bench's noise); 0.2 lowers it to 0.45% for 2–8.5% more RMSE. PSSMLT's large steps
+ * (30% of its mutations) already make the share, so it costs PSSMLT nothing.
+ */
+#define RenderSettings_DEFAULT_NORMALIZATION_WORK_FRACTION 0.1
 
 /**
  * The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
@@ -407,13 +444,15 @@ typedef struct MltRenderSettings {
    */
   uint32_t mutations_per_pixel;
   /**
-   * Metropolis: independent samples that estimate the image normalization and seed the
-   * chains, in [1, 2^28].
+   * Metropolis: independent samples that seed the chains and start the estimate of the
+   * image normalization, at most 2^28. 0 (the default) sizes it to the render: one
+   * sample per 8 planned mutations, at least 2^16 (2^18 for a render planned by its time
+   * limit alone).
    */
   uint32_t bootstrap_samples;
   /**
-   * Metropolis: number of Markov chains, in [1, bootstrap_samples]. The image does not
-   * depend on the thread count.
+   * Metropolis: number of Markov chains, from 1 to the bootstrap samples. The image does
+   * not depend on the thread count.
    */
   uint32_t chains;
   /**
@@ -481,6 +520,15 @@ typedef struct MltRenderSettings {
    * The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
    */
   uint32_t filter_radius;
+  /**
+   * Metropolis: the share of the rays spent on independent samples of the chains' target,
+   * drawn alongside the chains to go on estimating the normalization b, which sets the
+   * image's brightness; in [0, 0.9], default 0.1. The image is scaled by the final
+   * estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
+   * large steps), so its brightness error shrinks as the render goes on. 0: no such
+   * samples.
+   */
+  float normalization_work_fraction;
 } MltRenderSettings;
 
 /**
@@ -542,7 +590,7 @@ typedef struct MltRenderStats {
   uint64_t accepted_mutations;
   /**
    * Metropolis: the normalization b (mean luminance of the path contribution) the image
-   * was scaled by.
+   * was scaled by, its final estimate. `MLT_ALGORITHM_ERPT`: the deposit energy used.
    */
   double normalization;
   /**
@@ -572,6 +620,20 @@ typedef struct MltRenderStats {
    * … and about how many pixels each pixel was averaged over (the mean sum of weights).
    */
   double filter_mean_neighbours;
+  /**
+   * Metropolis: independent samples the normalization was estimated from …
+   */
+  uint64_t normalization_samples;
+  /**
+   * … the estimated standard error of `normalization` over it (from the samples'
+   * variance: the brightness uncertainty of the image) …
+   */
+  double normalization_relative_error;
+  /**
+   * … and the largest share of it a single sample carried (near 1 / samples when no rare
+   * bright path dominates).
+   */
+  double normalization_largest_share;
 } MltRenderStats;
 
 /**
@@ -670,7 +732,8 @@ enum MltStatus mlt_camera_default(struct MltCamera *out);
 
 /**
  * Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
- * pass (32 mutations per pixel and one direct sample per mutation, 2^18 bootstrap samples,
+ * pass (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
+ * (2^18 samples at this size), 10% of the rays for the normalization pass,
  * 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
  * BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
  * 0.45 and radius 7 when `filter_buffers` turns it on).

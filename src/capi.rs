@@ -162,11 +162,13 @@ pub struct MltRenderSettings {
     pub time_limit_seconds: f64,
     /// Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
     pub mutations_per_pixel: u32,
-    /// Metropolis: independent samples that estimate the image normalization and seed the
-    /// chains, in [1, 2^28].
+    /// Metropolis: independent samples that seed the chains and start the estimate of the
+    /// image normalization, at most 2^28. 0 (the default) sizes it to the render: one
+    /// sample per 8 planned mutations, at least 2^16 (2^18 for a render planned by its time
+    /// limit alone).
     pub bootstrap_samples: u32,
-    /// Metropolis: number of Markov chains, in [1, bootstrap_samples]. The image does not
-    /// depend on the thread count.
+    /// Metropolis: number of Markov chains, from 1 to the bootstrap samples. The image does
+    /// not depend on the thread count.
     pub chains: u32,
     /// PSSMLT: probability of a large (independent) step, in [0, 1].
     pub large_step_probability: f32,
@@ -211,6 +213,13 @@ pub struct MltRenderSettings {
     pub filter_strength: f32,
     /// The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
     pub filter_radius: u32,
+    /// Metropolis: the share of the rays spent on independent samples of the chains' target,
+    /// drawn alongside the chains to go on estimating the normalization b, which sets the
+    /// image's brightness; in [0, 0.9], default 0.1. The image is scaled by the final
+    /// estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
+    /// large steps), so its brightness error shrinks as the render goes on. 0: no such
+    /// samples.
+    pub normalization_work_fraction: f32,
 }
 
 /// What a render did (filled by `mlt_render_ex`).
@@ -231,7 +240,7 @@ pub struct MltRenderStats {
     /// Metropolis: accepted mutations, of `mutations`.
     pub accepted_mutations: u64,
     /// Metropolis: the normalization b (mean luminance of the path contribution) the image
-    /// was scaled by.
+    /// was scaled by, its final estimate. `MLT_ALGORITHM_ERPT`: the deposit energy used.
     pub normalization: f64,
     /// Metropolis: mutations made by all chains.
     pub mutations: u64,
@@ -248,6 +257,14 @@ pub struct MltRenderStats {
     pub filter_changed_fraction: f64,
     /// … and about how many pixels each pixel was averaged over (the mean sum of weights).
     pub filter_mean_neighbours: f64,
+    /// Metropolis: independent samples the normalization was estimated from …
+    pub normalization_samples: u64,
+    /// … the estimated standard error of `normalization` over it (from the samples'
+    /// variance: the brightness uncertainty of the image) …
+    pub normalization_relative_error: f64,
+    /// … and the largest share of it a single sample carried (near 1 / samples when no rare
+    /// bright path dominates).
+    pub normalization_largest_share: f64,
 }
 
 /// Facts about a created scene.
@@ -497,6 +514,7 @@ fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         filter_buffers: s.filter_buffers,
         filter_strength: s.filter_strength,
         filter_radius: s.filter_radius,
+        normalization_work_fraction: s.normalization_work_fraction,
     })
 }
 
@@ -621,7 +639,8 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
 }
 
 /// Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
-/// pass (32 mutations per pixel and one direct sample per mutation, 2^18 bootstrap samples,
+/// pass (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
+/// (2^18 samples at this size), 10% of the rays for the normalization pass,
 /// 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
 /// BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
 /// 0.45 and radius 7 when `filter_buffers` turns it on).
@@ -655,6 +674,7 @@ pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings
             filter_buffers: d.filter_buffers,
             filter_strength: d.filter_strength,
             filter_radius: d.filter_radius,
+            normalization_work_fraction: d.normalization_work_fraction,
         };
         // SAFETY: forwarded contract.
         unsafe { write_out(out, "out", value) }?;
@@ -845,13 +865,16 @@ pub unsafe extern "C" fn mlt_render_ex(
                 seconds: stats.seconds,
                 threads: stats.threads,
                 accepted_mutations: stats.accepted_mutations,
-                normalization: stats.normalization,
+                normalization: stats.normalization.value,
                 mutations: stats.mutations,
                 mutations_proposed: stats.mutation_counts.proposed,
                 mutations_accepted: stats.mutation_counts.accepted,
                 mutation_weights: stats.mutation_weights.0,
                 filter_changed_fraction: stats.filter.changed_fraction,
                 filter_mean_neighbours: stats.filter.mean_neighbours,
+                normalization_samples: stats.normalization.samples,
+                normalization_relative_error: stats.normalization.relative_error,
+                normalization_largest_share: stats.normalization.largest_share,
             };
             // SAFETY: checked non-null and aligned above.
             unsafe { stats_out.write(value) };

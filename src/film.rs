@@ -15,7 +15,13 @@ pub struct Film {
     splats: Vec<[f64; 3]>,
     /// Light paths traced in all, the normalization of the splats.
     light_paths: u64,
-    /// Overrides the splat normalization (Metropolis: b / mutations per pixel).
+    /// Metropolis chains' deposits per group of chains, `chain_layers[group * pixels +
+    /// pixel]`, kept apart because each group is scaled by its own normalization, known only
+    /// when the render ends (24 bytes per pixel and group) …
+    chain_layers: Vec<[f64; 3]>,
+    /// … by these factors (one per group), on top of the splat scale.
+    chain_layer_scales: Vec<f64>,
+    /// Overrides the splat normalization (Metropolis: pixels / mutations per chain).
     splat_scale: Option<f64>,
     /// The post-process filter (`crate::filter`), if on …
     filter: Option<FilterSettings>,
@@ -46,6 +52,8 @@ impl Film {
                 Vec::new()
             },
             light_paths: 0,
+            chain_layers: Vec::new(),
+            chain_layer_scales: Vec::new(),
             splat_scale: None,
             filter: None,
             partials: Vec::new(),
@@ -57,6 +65,38 @@ impl Film {
     pub fn enable_filter(&mut self, settings: FilterSettings) {
         self.partials = vec![[0.0; 3]; self.splats.len() * settings.buffers as usize];
         self.filter = Some(settings);
+    }
+
+    /// Keeps the deposits of `groups` groups of Metropolis chains in layers of their own
+    /// (`add_chain_splats`), each scaled by `set_chain_layer_scales` when written.
+    pub fn enable_chain_layers(&mut self, groups: usize) {
+        self.chain_layers = vec![[0.0; 3]; self.counts.len() * groups];
+        self.chain_layer_scales = vec![0.0; groups];
+    }
+
+    /// Sets each chain layer's factor (Metropolis: the group's final normalization).
+    pub fn set_chain_layer_scales(&mut self, scales: &[f64]) {
+        for (scale, &s) in self.chain_layer_scales.iter_mut().zip(scales) {
+            *scale = s;
+        }
+    }
+
+    /// Adds `weight` × the deposits of a chain of `group` (in the chain's order) to its
+    /// layer, and with the filter on `weight × partial_scale` × them to partial image
+    /// `buffer` (taken modulo their number). `partial_scale` stands in for the layer's
+    /// factor, not yet known: the partial images only guide the filter.
+    pub fn add_chain_splats(
+        &mut self,
+        group: usize,
+        splats: &[crate::integrators::Splat],
+        weight: f64,
+        partial_scale: f64,
+        buffer: usize,
+    ) {
+        let pixels = self.counts.len();
+        let layer = &mut self.chain_layers[group * pixels..(group + 1) * pixels];
+        add_weighted(layer, splats, weight);
+        self.add_to_partial(splats, weight * partial_scale, buffer);
     }
 
     /// The number of partial images splats are split into; 0 when the filter is off.
@@ -94,12 +134,11 @@ impl Film {
         weight: f64,
         buffer: usize,
     ) {
-        for splat in splats {
-            let sum = &mut self.splats[splat.pixel as usize];
-            for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
-                *s += v as f64 * weight;
-            }
-        }
+        add_weighted(&mut self.splats, splats, weight);
+        self.add_to_partial(splats, weight, buffer);
+    }
+
+    fn add_to_partial(&mut self, splats: &[crate::integrators::Splat], weight: f64, buffer: usize) {
         let buffers = self.filter_buffers();
         if buffers > 0 {
             let buffer = buffer % buffers;
@@ -145,20 +184,48 @@ impl Film {
     /// the splats are filtered (the pixels' own samples are not: they are a Metropolis
     /// render's direct pass), and `unfiltered`, if given, receives the image without it.
     pub fn write_rgb(&self, out: &mut [f32], unfiltered: Option<&mut [f32]>) -> FilterStats {
+        let combined;
+        let splats = if self.chain_layers.is_empty() {
+            &self.splats
+        } else {
+            combined = self.splats_with_chain_layers();
+            &combined
+        };
         let Some(filter) = &self.filter else {
-            self.write_rgb_with(out, &self.splats);
+            self.write_rgb_with(out, splats);
             if let Some(unfiltered) = unfiltered {
                 unfiltered.copy_from_slice(out);
             }
             return FilterStats::default();
         };
-        let (filtered, stats) =
-            filter_splats(self.width as usize, filter, &self.partials, &self.splats);
+        let (filtered, stats) = filter_splats(self.width as usize, filter, &self.partials, splats);
         self.write_rgb_with(out, &filtered);
         if let Some(unfiltered) = unfiltered {
-            self.write_rgb_with(unfiltered, &self.splats);
+            self.write_rgb_with(unfiltered, splats);
         }
         stats
+    }
+
+    /// The splats plus every chain layer times its factor.
+    fn splats_with_chain_layers(&self) -> Vec<[f64; 3]> {
+        let pixels = self.counts.len();
+        let mut combined = if self.splats.is_empty() {
+            vec![[0.0; 3]; pixels]
+        } else {
+            self.splats.clone()
+        };
+        for (layer, &scale) in self
+            .chain_layers
+            .chunks_exact(pixels)
+            .zip(&self.chain_layer_scales)
+        {
+            for (total, value) in combined.iter_mut().zip(layer) {
+                for c in 0..3 {
+                    total[c] += value[c] * scale;
+                }
+            }
+        }
+        combined
     }
 
     fn write_rgb_with(&self, out: &mut [f32], splats: &[[f64; 3]]) {
@@ -181,6 +248,16 @@ impl Film {
             for c in 0..3 {
                 pixel[c] = (sum[c] * scale + splat[c] * splat_scale) as f32;
             }
+        }
+    }
+}
+
+/// Adds `weight` × each splat to its pixel of `sums`, in order.
+fn add_weighted(sums: &mut [[f64; 3]], splats: &[crate::integrators::Splat], weight: f64) {
+    for splat in splats {
+        let sum = &mut sums[splat.pixel as usize];
+        for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
+            *s += v as f64 * weight;
         }
     }
 }

@@ -41,6 +41,7 @@ pub mod io;
 
 pub use error::{Error, MltStatus, Result};
 pub use filter::FilterStats;
+pub use integrators::mlt::normalization::NormalizationStats;
 pub use integrators::mlt::path_space::{Mutation, MutationCounts, MutationWeights};
 pub use render::{
     Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,

@@ -8,10 +8,11 @@ use crate::filter::{
     MLT_MAX_FILTER_STRENGTH, MLT_MIN_FILTER_BUFFERS,
 };
 use crate::integrators::bdpt::Bdpt;
+use crate::integrators::mlt::normalization::NormalizationStats;
 use crate::integrators::mlt::path_space::{
     self, MutationCounts, MutationWeights, PathSpaceTarget, PerturbationSizes,
 };
-use crate::integrators::mlt::pssmlt::{self, PssmltOutcome, PssmltSettings};
+use crate::integrators::mlt::pssmlt::{self, PrimarySpaceTarget, PssmltOutcome, PssmltSettings};
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
 use crate::integrators::{PixelEstimator, SampleCounters, Splat};
@@ -70,6 +71,19 @@ enum Estimator<'a> {
     Erpt(&'a Bdpt<'a>),
 }
 
+impl Estimator<'_> {
+    /// Groups of Metropolis chains, whose deposits the film keeps in a layer each.
+    fn chain_groups(&self) -> usize {
+        match *self {
+            Estimator::Pssmlt(target) => target.groups(),
+            Estimator::Mmlt(target) => target.groups(),
+            Estimator::PssmltBdpt(target) => target.groups(),
+            Estimator::PathSpaceMlt(_) => 1,
+            Estimator::Path(_) | Estimator::Bdpt(_) | Estimator::Erpt(_) => 0,
+        }
+    }
+}
+
 /// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
 const DIRECT_PASS_DEPTHS: u32 = 2;
 
@@ -87,10 +101,11 @@ impl Estimator<'_> {
         let spp = settings.samples_per_pixel;
         let chains = PssmltSettings {
             mutations_per_pixel: settings.mutations_per_pixel,
-            bootstrap_samples: settings.bootstrap_samples,
+            bootstrap_samples: settings.resolved_bootstrap_samples(),
             chains: settings.chains,
             large_step_probability: settings.large_step_probability,
             small_step_sigma: settings.small_step_sigma,
+            normalization_work_fraction: settings.normalization_work_fraction,
             seed,
         };
         // The direct pass keeps pace with the chains: after each round of mutations it
@@ -180,6 +195,8 @@ pub const MLT_MAX_ERPT_CHAIN_LENGTH: u32 = 1 << 20;
 pub const MLT_MAX_ERPT_DEPOSIT_ENERGY: f32 = 1.0e30;
 /// Largest accepted number of Metropolis bootstrap samples.
 pub const MLT_MAX_BOOTSTRAP_SAMPLES: u32 = 1 << 28;
+/// Largest accepted share of a Metropolis render's rays spent on its normalization pass.
+pub const MLT_MAX_NORMALIZATION_WORK_FRACTION: f32 = 0.9;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -197,7 +214,12 @@ pub struct RenderSettings {
     pub time_limit_seconds: f64,
     /// Metropolis: mutations per pixel; 0 means "until the time limit".
     pub mutations_per_pixel: u32,
-    /// Metropolis: independent samples that estimate the normalization b and seed the chains.
+    /// Metropolis: independent samples that seed the chains and start the estimate of the
+    /// normalization b (see `normalization_work_fraction`). 0 (the default) sizes the
+    /// bootstrap to the render: one sample per `AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE`
+    /// planned mutations, at least `MIN_AUTO_BOOTSTRAP_SAMPLES`; a render planned by time
+    /// alone takes `TIME_LIMITED_BOOTSTRAP_SAMPLES`. `resolved_bootstrap_samples` says
+    /// what a render takes.
     pub bootstrap_samples: u32,
     /// Metropolis: number of Markov chains (independent of the thread count).
     pub chains: u32,
@@ -212,6 +234,15 @@ pub struct RenderSettings {
     /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
     /// pass; the chains render every depth.
     pub direct_samples_per_mutation: u32,
+    /// Metropolis: the share of the rays spent on independent samples of the chains' target
+    /// (path-tracer samples for PSSMLT, BDPT samples with all strategies for the others),
+    /// drawn alongside the chains to go on estimating the normalization b, which sets the
+    /// image's brightness. The image is scaled by the final estimate, over the bootstrap,
+    /// these samples and (PSSMLT, PSSMLT over BDPT) the chains' large steps, so its
+    /// brightness error shrinks with the render's length (`integrators::mlt::normalization`).
+    /// From 0 (no such samples: the bootstrap and the large steps alone) to 0.9.
+    /// `RenderStats::normalization` reports the estimate's own standard error.
+    pub normalization_work_fraction: f32,
     /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
     /// lens, caustic and multi-chain perturbations (`Mutation as usize` order). Each step
     /// picks among those the current path admits. The bidirectional weight must be
@@ -261,11 +292,12 @@ impl Default for RenderSettings {
             threads: 0,
             time_limit_seconds: 0.0,
             mutations_per_pixel: 32,
-            bootstrap_samples: 1 << 18,
+            bootstrap_samples: 0,
             chains: 1024,
             large_step_probability: 0.3,
             small_step_sigma: 0.01,
             direct_samples_per_mutation: Self::DEFAULT_DIRECT_SAMPLES_PER_MUTATION,
+            normalization_work_fraction: Self::DEFAULT_NORMALIZATION_WORK_FRACTION,
             mutation_weights: MutationWeights::default(),
             erpt_chain_length: Self::DEFAULT_ERPT_CHAIN_LENGTH,
             erpt_deposit_energy: 0.0,
@@ -279,9 +311,44 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// An automatic bootstrap (`bootstrap_samples` 0) takes one sample per this many
+    /// planned mutations: at the default 256² × 32 mutations per pixel, 2^18 samples, the
+    /// best of 2^16, 2^18 and 2^20 on cornell-glass at 10 s of one thread (8 seeds; MMLT's
+    /// RMSE 41% and 10% higher with the others, path-space MLT's 9–17%: the bootstrap is
+    /// also what the chains are seeded from). Sized to the work, the bootstrap's share of
+    /// the render, and so the brightness error's fall with the work, stay the same at any
+    /// budget.
+    pub const AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE: u64 = 8;
+    /// The fewest samples of an automatic bootstrap.
+    pub const MIN_AUTO_BOOTSTRAP_SAMPLES: u32 = 1 << 16;
+    /// The automatic bootstrap of a render with a time limit and no mutation count (the
+    /// normalization pass then makes b's error fall with the render's length).
+    pub const TIME_LIMITED_BOOTSTRAP_SAMPLES: u32 = 1 << 18;
+
+    /// The bootstrap samples a Metropolis render takes (see `bootstrap_samples`).
+    pub fn resolved_bootstrap_samples(&self) -> u32 {
+        if self.bootstrap_samples > 0 {
+            return self.bootstrap_samples;
+        }
+        if self.mutations_per_pixel == 0 {
+            return Self::TIME_LIMITED_BOOTSTRAP_SAMPLES;
+        }
+        let mutations = self.width as u64 * self.height as u64 * self.mutations_per_pixel as u64;
+        (mutations / Self::AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE).clamp(
+            Self::MIN_AUTO_BOOTSTRAP_SAMPLES as u64,
+            MLT_MAX_BOOTSTRAP_SAMPLES as u64,
+        ) as u32
+    }
     /// The default `direct_samples_per_mutation`: one, the best measured at equal time on
     /// the Cornell scenes (benches/equal_time.rs).
     pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
+    /// The default `normalization_work_fraction`, chosen by `benches/brightness.rs` (8 seeds
+    /// of 10 s on one thread, time-limited, so with a bootstrap of 2^18): 0.1 lowers the
+    /// reported error of b from 0.71% to 0.54% on door-ajar and cornell-glass for MMLT and
+    /// path-space MLT, and its share grows with the render, for 1–5% more RMSE (within the
+    /// bench's noise); 0.2 lowers it to 0.45% for 2–8.5% more RMSE. PSSMLT's large steps
+    /// (30% of its mutations) already make the share, so it costs PSSMLT nothing.
+    pub const DEFAULT_NORMALIZATION_WORK_FRACTION: f32 = 0.1;
     /// The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
     /// cornell-glass and door-ajar (`benches/equal_time.rs`, medians of 3 renders of 10 s;
     /// 5 to 20 within noise of each other, 100, about Cline et al.'s length, 2 to 3 times
@@ -354,16 +421,25 @@ impl RenderSettings {
                 "settings.samples_per_pixel is 0 and there is no time limit; the render would never end",
             ));
         }
-        if self.bootstrap_samples == 0 || self.bootstrap_samples > MLT_MAX_BOOTSTRAP_SAMPLES {
+        if self.bootstrap_samples > MLT_MAX_BOOTSTRAP_SAMPLES {
             return Err(Error::invalid(format!(
-                "settings.bootstrap_samples is {}; it must be between 1 and {MLT_MAX_BOOTSTRAP_SAMPLES}",
+                "settings.bootstrap_samples is {}; it must be 0 (automatic) or at most {MLT_MAX_BOOTSTRAP_SAMPLES}",
                 self.bootstrap_samples
             )));
         }
-        if self.chains == 0 || self.chains > self.bootstrap_samples {
+        let bootstrap = self.resolved_bootstrap_samples();
+        if self.chains == 0 || self.chains > bootstrap {
             return Err(Error::invalid(format!(
-                "settings.chains is {}; it must be between 1 and settings.bootstrap_samples ({})",
-                self.chains, self.bootstrap_samples
+                "settings.chains is {}; it must be between 1 and the bootstrap samples ({bootstrap})",
+                self.chains
+            )));
+        }
+        let fraction = self.normalization_work_fraction;
+        if !(fraction.is_finite()
+            && (0.0..=MLT_MAX_NORMALIZATION_WORK_FRACTION).contains(&fraction))
+        {
+            return Err(Error::invalid(format!(
+                "settings.normalization_work_fraction is {fraction}; it must be from 0 to {MLT_MAX_NORMALIZATION_WORK_FRACTION}"
             )));
         }
         let p = self.large_step_probability;
@@ -473,9 +549,11 @@ pub struct RenderStats {
     pub threads: u32,
     /// Metropolis: accepted mutations.
     pub accepted_mutations: u64,
-    /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by. ERPT: the
+    /// Metropolis: the normalization b = ∫ luminance(f) the image was scaled by (its final
+    /// estimate), how many independent samples it came from, its estimated relative
+    /// standard error and the largest share of it one sample carried. ERPT: `value` is the
     /// deposit energy e_d the chains used.
-    pub normalization: f64,
+    pub normalization: NormalizationStats,
     /// Path-space MLT: proposals and acceptances per mutation …
     pub mutation_counts: MutationCounts,
     /// … and the weights the chains ran with (after the warm-up, if adapted). ERPT: the
@@ -548,7 +626,6 @@ fn render_into(
             settings.width, settings.height
         )));
     }
-    let mut film = try_film(settings)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads as usize)
         .build()
@@ -614,6 +691,7 @@ fn render_into(
         Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
         Algorithm::Erpt => Estimator::Erpt(&bdpt),
     };
+    let mut film = try_film(settings, estimator.chain_groups())?;
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit
     // only) there is no plan.
@@ -727,8 +805,9 @@ impl Drop for SignalOnDrop<'_> {
     }
 }
 
-/// Allocates the film, reporting failure as a status instead of aborting.
-fn try_film(settings: &RenderSettings) -> Result<Film> {
+/// Allocates the film (with a layer for each of `chain_groups` groups of Metropolis chains),
+/// reporting failure as a status instead of aborting.
+fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
     let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;
     // Probe the largest allocations first: `vec!` would abort the process on failure.
@@ -749,7 +828,15 @@ fn try_film(settings: &RenderSettings) -> Result<Film> {
         .try_reserve_exact(pixels * buffers as usize)
         .map_err(|_| out_of_memory())?;
     drop(partials);
+    let mut layers: Vec<[f64; 3]> = Vec::new();
+    layers
+        .try_reserve_exact(pixels * chain_groups)
+        .map_err(|_| out_of_memory())?;
+    drop(layers);
     let mut film = Film::new(width, height, settings.algorithm != Algorithm::Path);
+    if chain_groups > 0 {
+        film.enable_chain_layers(chain_groups);
+    }
     if buffers > 0 {
         film.enable_filter(FilterSettings {
             buffers,

@@ -371,8 +371,9 @@ fn defaults_are_valid_and_documented() {
     );
     assert_eq!(
         (s.mutations_per_pixel, s.bootstrap_samples, s.chains),
-        (32, 1 << 18, 1024)
+        (32, 0, 1024)
     );
+    assert_eq!(s.normalization_work_fraction, 0.1);
     assert_eq!(
         (
             s.large_step_probability,
@@ -1382,7 +1383,7 @@ fn metropolis_settings_out_of_range() {
         chains: 4,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 15] = [
+    let cases: [(MltRenderSettings, &[&str]); 19] = [
         (
             MltRenderSettings {
                 mutations_per_pixel: 0,
@@ -1408,10 +1409,39 @@ fn metropolis_settings_out_of_range() {
         ),
         (
             MltRenderSettings {
-                bootstrap_samples: 0,
+                bootstrap_samples: (1 << 28) + 1,
                 ..metropolis
             },
-            &["bootstrap_samples is 0"],
+            &["bootstrap_samples is 268435457", "0 (automatic)"],
+        ),
+        (
+            MltRenderSettings {
+                bootstrap_samples: 0,
+                chains: 1 << 20,
+                ..metropolis
+            },
+            &["chains is 1048576", "bootstrap samples (65536)"],
+        ),
+        (
+            MltRenderSettings {
+                normalization_work_fraction: f32::NAN,
+                ..metropolis
+            },
+            &["normalization_work_fraction is NaN", "0 to 0.9"],
+        ),
+        (
+            MltRenderSettings {
+                normalization_work_fraction: -0.1,
+                ..metropolis
+            },
+            &["normalization_work_fraction is -0.1"],
+        ),
+        (
+            MltRenderSettings {
+                normalization_work_fraction: 0.95,
+                ..metropolis
+            },
+            &["normalization_work_fraction is 0.95"],
         ),
         (
             MltRenderSettings {
@@ -1425,7 +1455,7 @@ fn metropolis_settings_out_of_range() {
                 chains: 65,
                 ..metropolis
             },
-            &["chains is 65", "bootstrap_samples (64)"],
+            &["chains is 65", "bootstrap samples (64)"],
         ),
         (
             MltRenderSettings {

@@ -190,7 +190,10 @@ fn chains_run_and_a_huge_deposit_energy_starts_none() {
     let mut image = vec![0.0; 16 * 16 * 3];
     let stats = render(&scene, &camera, &settings, &mut image, None).unwrap();
     assert!(stats.mutations > 0 && stats.accepted_mutations > 0);
-    assert!(stats.normalization > 0.0, "the automatic e_d is reported");
+    assert!(
+        stats.normalization.value > 0.0,
+        "the automatic e_d is reported"
+    );
     let none = RenderSettings {
         erpt_deposit_energy: 1e30,
         ..settings

@@ -112,7 +112,9 @@ struct Args {
     /// Metropolis: mutations per pixel (0: until the time limit).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().mutations_per_pixel)]
     mutations_per_pixel: u32,
-    /// Metropolis: bootstrap samples estimating the normalization and seeding the chains.
+    /// Metropolis: bootstrap samples seeding the chains and starting the estimate of the
+    /// normalization (0: one per 8 planned mutations, at least 65536; 262144 with a time
+    /// limit alone).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().bootstrap_samples)]
     bootstrap: u32,
     /// Metropolis: number of Markov chains.
@@ -128,6 +130,11 @@ struct Args {
     /// seen, direct lighting) per chain mutation (0: the chains render every depth).
     #[arg(long, value_name = "N", default_value_t = RenderSettings::default().direct_samples_per_mutation)]
     direct_per_mutation: u32,
+    /// Metropolis: the share of the rays spent on independent samples that go on estimating
+    /// the normalization, which sets the image's brightness (0 to 0.9; 0: the bootstrap
+    /// and the large steps alone).
+    #[arg(long, value_name = "F", default_value_t = RenderSettings::default().normalization_work_fraction)]
+    normalization_fraction: f32,
     /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
     /// lens, caustic and multi-chain perturbations.
     #[arg(long, value_name = "B,L,C,M", default_value_t = WeightsArg(RenderSettings::default().mutation_weights.0))]
@@ -290,6 +297,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         large_step_probability: args.large_step,
         small_step_sigma: args.small_step,
         direct_samples_per_mutation: args.direct_per_mutation,
+        normalization_work_fraction: args.normalization_fraction,
         mutation_weights: MutationWeights(args.mutation_weights.0),
         erpt_chain_length: args.erpt_chain_length,
         erpt_deposit_energy: args.erpt_deposit,
@@ -402,13 +410,17 @@ fn print_summary(
     if settings.algorithm == mlt::Algorithm::Erpt {
         println!(
             "  erpt e_d = {:.6}, {:.1}% of mutations accepted",
-            stats.normalization,
+            stats.normalization.value,
             100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
         );
-    } else if stats.normalization > 0.0 {
+    } else if stats.normalization.value > 0.0 {
+        let b = stats.normalization;
         println!(
-            "  metropolis b = {:.6}, {:.1}% of mutations accepted",
-            stats.normalization,
+            "  metropolis b = {:.6} ± {:.2}% (from {} samples, the brightest {:.3}% of it), {:.1}% of mutations accepted",
+            b.value,
+            100.0 * b.relative_error,
+            b.samples,
+            100.0 * b.largest_share,
             100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
         );
     }

@@ -2,6 +2,7 @@
 //! numbers that generate them), accepted with the Metropolis–Hastings rule.
 
 pub mod image_chain;
+pub mod normalization;
 pub mod path_space;
 pub mod pss;
 pub mod pssmlt;

@@ -12,21 +12,26 @@
 //!    accuracy. Every chain makes the same number of mutations.
 //! 3. Each mutation deposits the proposal with weight a and the current state with 1 − a
 //!    (expected-value splatting). A large step's proposal is also an independent sample and
-//!    is deposited once more; every deposit is f⃗ / (f + p_large·b_g), the balance heuristic
-//!    between the chain (density f/b_g) and the large steps (density p_large) of Kelemen et
-//!    al. In bright regions this is the usual f⃗ / f; dim regions, which chains rarely visit,
-//!    are carried by the large steps as a path tracer would.
-//! 4. A chain of group g is scaled by b_g / (its group's chains × mutations per chain), so
-//!    each group's expected luminance is b_g, its bootstrap estimate, however many chains
-//!    it was allotted. The image's brightness error is the error of the b_g plus the
-//!    chains' own noise; a single group normalized by the chains' own visits (pbrt-v3's
-//!    design) adds the random allotment of chains to depths on top.
+//!    is deposited once more; every deposit is f⃗ / (f + p_large·c_g), the balance heuristic
+//!    between the chain (density f/b_g) and the large steps (density p_large), with c_g the
+//!    bootstrap's b_g. In bright regions this is the usual f⃗ / f; dim regions, which chains
+//!    rarely visit, are carried by the large steps as a path tracer would.
+//! 4. The normalization goes on being estimated while the chains run (`normalization`): a
+//!    pass of independent samples alongside them and, where they sample the same function,
+//!    the chains' large steps. After the last round, group g's chain deposits are scaled by
+//!    the final b_g / (its chains × mutations per chain), so each group's expected
+//!    luminance is b_g, and its large-step deposits by c_g / (the same), which makes the
+//!    combination exact for any c_g. The image's brightness error is the final b_g's
+//!    error, which shrinks with the work done, plus the chains' own noise; a single group
+//!    normalized by the chains' own visits (pbrt-v3's design) adds the random allotment of
+//!    chains to depths on top.
 //!
 //! Determinism: each chain's random numbers derive from (seed, chain index). Chains run in
 //! rounds; within a round they run in parallel, each recording its deposits, which are added
 //! to the film in chain order after the round.
 
 use super::acceptance;
+use super::normalization::{Moments, NormalizationEstimate, NormalizationPass, NormalizationStats};
 use super::path_space::{MutationCounts, MutationWeights};
 use super::pss::PssSampler;
 use crate::film::Film;
@@ -62,6 +67,8 @@ pub struct PssmltSettings {
     pub chains: u32,
     pub large_step_probability: f32,
     pub small_step_sigma: f32,
+    /// The share of the rays the normalization pass spends (`normalization` module).
+    pub normalization_work_fraction: f32,
     pub seed: u64,
 }
 
@@ -71,7 +78,7 @@ pub struct PssmltOutcome {
     pub mutations: u64,
     pub accepted: u64,
     /// The normalization b = ∫ f (summed over chain groups) the image is scaled by.
-    pub normalization: f64,
+    pub normalization: NormalizationStats,
     /// Path-space chains: proposals and acceptances per mutation …
     pub mutation_counts: MutationCounts,
     /// … and the weights they ran with (after the warm-up, if adapted).
@@ -160,6 +167,12 @@ pub(crate) trait PrimarySpaceTarget: Sync {
         out: &mut PathSample,
         rays: &mut u64,
     );
+    /// Whether a large step's proposal is what `bootstrap` evaluates (the sum over the
+    /// single group) and pooling it with the stratified samples helps, so that it also
+    /// estimates the normalization.
+    fn large_steps_are_bootstrap_samples(&self) -> bool {
+        false
+    }
     /// Evaluates the sampler's current state for a chain of `group`.
     fn evaluate(
         &self,
@@ -186,8 +199,8 @@ pub(crate) fn film_position(camera: &CameraModel, [u, v]: [f32; 2]) -> (f32, f32
 pub(crate) trait MarkovChain: Send {
     /// What the chain explores (shared by all chains).
     type Target: Sync;
-    /// Makes one mutation and appends its deposits (in units of the chain's weight).
-    fn mutate(&mut self, target: &Self::Target, camera: &CameraModel, deposits: &mut Vec<Splat>);
+    /// Makes one mutation and appends its deposits.
+    fn mutate(&mut self, target: &Self::Target, camera: &CameraModel, deposits: &mut Deposits);
     /// Proposals accepted so far.
     fn accepted(&self) -> u64;
     /// Rays traced so far.
@@ -198,22 +211,62 @@ pub(crate) trait MarkovChain: Send {
     fn mutation_counts(&self) -> MutationCounts {
         MutationCounts::default()
     }
+    /// The target values of the large steps' proposals so far (primary sample space) …
+    fn large_steps(&self) -> Moments {
+        Moments::default()
+    }
+    /// … and the rays they traced.
+    fn large_step_rays(&self) -> u64 {
+        0
+    }
 }
 
-/// A chain of a render with its weight (b_g / chains of its group: every deposit's factor)
-/// and the deposits of the current round.
+/// What a chain's mutations deposit: the chain's own expected-value deposits, whose
+/// expected luminance is its group's normalization b_g (so they are scaled by the final
+/// estimate of b_g), and large steps' proposals again as independent samples, scaled by the
+/// bootstrap's b_g, the constant of Kelemen's combination (see `mutate`).
+#[derive(Default)]
+pub(crate) struct Deposits {
+    pub chain: Vec<Splat>,
+    pub independent: Vec<Splat>,
+}
+
+impl Deposits {
+    fn with_capacity(splats: usize) -> Self {
+        Deposits {
+            chain: Vec::with_capacity(splats),
+            independent: Vec::with_capacity(splats),
+        }
+    }
+
+    fn clear(&mut self) {
+        self.chain.clear();
+        self.independent.clear();
+    }
+}
+
+/// A chain of a render with its group, the factors of its deposits and the deposits of the
+/// current round.
 pub(crate) struct WeightedChain<C> {
     pub chain: C,
-    pub weight: f64,
-    deposits: Vec<Splat>,
+    /// The group whose normalization scales the chain's deposits (a layer of the film).
+    group: usize,
+    /// 1 / the chains of its group: its share of the group's deposits.
+    share: f64,
+    /// The bootstrap's b_g: the factor of its independent deposits, and of its deposits in
+    /// the filter's partial images (which only guide the filter and are not rescaled).
+    bootstrap_b: f64,
+    deposits: Deposits,
 }
 
 impl<C> WeightedChain<C> {
-    pub fn new(chain: C, weight: f64) -> Self {
+    pub fn new(chain: C, group: usize, chains_in_group: u64, bootstrap_b: f64) -> Self {
         WeightedChain {
             chain,
-            weight,
-            deposits: Vec::new(),
+            group,
+            share: 1.0 / chains_in_group as f64,
+            bootstrap_b,
+            deposits: Deposits::default(),
         }
     }
 }
@@ -224,11 +277,14 @@ struct Chain<T: PrimarySpaceTarget> {
     scratch: T::Scratch,
     current: PathSample,
     proposal: PathSample,
-    /// p_large × b_g, added to f in the deposits' denominators (see `mutate`).
+    /// p_large × b_g (the bootstrap's), added to f in the deposits' denominators (see
+    /// `mutate`).
     mis_offset: f32,
     max_entries: usize,
     accepted: u64,
     rays: u64,
+    large_steps: Moments,
+    large_step_rays: u64,
 }
 
 impl<T: PrimarySpaceTarget> MarkovChain for Chain<T>
@@ -238,7 +294,7 @@ where
     type Target = T;
 
     #[inline]
-    fn mutate(&mut self, target: &T, camera: &CameraModel, deposits: &mut Vec<Splat>) {
+    fn mutate(&mut self, target: &T, camera: &CameraModel, deposits: &mut Deposits) {
         mutate(target, camera, self, deposits);
     }
 
@@ -251,7 +307,15 @@ where
     }
 
     fn max_deposits(&self) -> usize {
-        2 * self.max_entries
+        3 * self.max_entries
+    }
+
+    fn large_steps(&self) -> Moments {
+        self.large_steps
+    }
+
+    fn large_step_rays(&self) -> u64 {
+        self.large_step_rays
     }
 }
 
@@ -310,12 +374,11 @@ pub(crate) fn restart_as_bootstrap(
     sampler.restart_at(settings.seed, i + (1 << 40), position);
 }
 
-/// The bootstrap: per group, the sum of the target over the samples taken, and the values of
-/// the first samples (sample-major) for resampling.
+/// The bootstrap: its estimate of the normalization, and the values of the first samples
+/// (sample-major, per group) for resampling.
 pub(crate) struct Bootstrap {
-    pub sums: Vec<f64>,
-    /// Samples taken: all asked for, or the whole passes done before a stop.
-    pub samples: u64,
+    /// Over the samples taken: all asked for, or the whole passes done before a stop.
+    pub estimate: NormalizationEstimate,
     kept: Vec<f32>,
     kept_samples: u64,
 }
@@ -330,21 +393,21 @@ pub(crate) fn bootstrap<T: PrimarySpaceTarget>(
     let n = settings.bootstrap_samples as u64;
     let kept_limit = n.min(BOOTSTRAP_KEPT_VALUES / groups as u64).max(1);
     let pass_size = bootstrap_pass_size(n, camera);
-    let mut sums = vec![0.0f64; groups];
+    let mut estimate = NormalizationEstimate::new(groups);
     let mut kept = Vec::with_capacity(kept_limit as usize * groups);
     let mut rays = 0;
     let mut done = 0;
     // The first pass always runs: the chains need a normalization.
     while done < n && (done == 0 || !control.should_stop()) {
         let end = (done + pass_size).min(n);
-        let results: Vec<(Vec<f64>, Vec<f32>, u64)> = (done..end)
+        let results: Vec<(NormalizationEstimate, Vec<f32>, u64)> = (done..end)
             .step_by(BOOTSTRAP_CHUNK as usize)
             .collect::<Vec<u64>>()
             .into_par_iter()
             .map(|first| {
                 let mut sampler = new_sampler(target, settings);
                 let mut scratch = target.scratch();
-                let mut sums = vec![0.0f64; groups];
+                let mut estimate = NormalizationEstimate::new(groups);
                 let mut values = vec![0.0f32; groups];
                 let last = (first + BOOTSTRAP_CHUNK).min(end);
                 let mut kept = Vec::with_capacity(
@@ -355,21 +418,17 @@ pub(crate) fn bootstrap<T: PrimarySpaceTarget>(
                     restart_as_bootstrap(&mut sampler, settings, camera, i, n);
                     values.fill(0.0);
                     target.bootstrap(camera, &mut sampler, &mut scratch, &mut values, &mut rays);
-                    for (sum, &v) in sums.iter_mut().zip(&values) {
-                        *sum += v as f64;
-                    }
+                    estimate.add(&values);
                     if i < kept_limit {
                         kept.extend_from_slice(&values);
                     }
                 }
-                (sums, kept, rays)
+                (estimate, kept, rays)
             })
             .collect();
         // Merged in sample order, whatever the scheduling.
-        for (chunk_sums, chunk_kept, chunk_rays) in results {
-            for (sum, s) in sums.iter_mut().zip(chunk_sums) {
-                *sum += s;
-            }
+        for (chunk_estimate, chunk_kept, chunk_rays) in results {
+            estimate.merge(&chunk_estimate);
             kept.extend_from_slice(&chunk_kept);
             rays += chunk_rays;
         }
@@ -377,8 +436,7 @@ pub(crate) fn bootstrap<T: PrimarySpaceTarget>(
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
     Bootstrap {
-        sums,
-        samples: done,
+        estimate,
         kept_samples: done.min(kept_limit),
         kept,
     }
@@ -495,6 +553,7 @@ impl ChainPlan {
 pub(crate) fn finish_without_light(
     camera: &CameraModel,
     settings: &PssmltSettings,
+    bootstrap: &NormalizationEstimate,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
@@ -510,7 +569,31 @@ pub(crate) fn finish_without_light(
         f64::INFINITY
     };
     after_round(film, mutations_per_pixel);
-    PssmltOutcome::default()
+    PssmltOutcome {
+        normalization: bootstrap.stats(),
+        ..Default::default()
+    }
+}
+
+/// Scales each group's chain deposits on the film by its final normalization estimate
+/// (with the chains' large steps pooled in when `pass` says so) and reports it.
+pub(crate) fn normalize<N: PrimarySpaceTarget, C: MarkovChain>(
+    film: &mut Film,
+    pass: NormalizationPass<N>,
+    chains: &[WeightedChain<C>],
+) -> NormalizationStats
+where
+    N::Scratch: Send,
+{
+    let pools_large_steps = pass.pools_large_steps();
+    let mut estimate = pass.estimate;
+    if pools_large_steps {
+        for chain in chains {
+            estimate.merge_single_group(&chain.chain.large_steps());
+        }
+    }
+    film.set_chain_layer_scales(&estimate.b());
+    estimate.stats()
 }
 
 /// Runs the chains. `after_round(film, mutations per pixel so far)` is called after each round
@@ -529,16 +612,17 @@ where
     // 1. Bootstrap.
     let n = settings.bootstrap_samples as u64;
     let boot = bootstrap(target, camera, settings, control);
-    let b: Vec<f64> = boot.sums.iter().map(|&s| s / boot.samples as f64).collect();
+    let b = boot.estimate.b();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
-        return finish_without_light(camera, settings, film, control, after_round);
+        return finish_without_light(camera, settings, &boot.estimate, film, control, after_round);
     }
 
     // 2. Chains, allotted to groups and seeded from resampled bootstrap samples.
     let plan = ChainPlan::new(&b, camera, settings);
     let seeds = resample_seeds(&boot, &plan.chains_per_group, settings.seed);
-    drop(boot);
+    let mut pass = NormalizationPass::new(target, camera, settings, boot.estimate);
+    drop(boot.kept);
     let mut chains: Vec<WeightedChain<Chain<T>>> = seeds
         .into_par_iter()
         .enumerate()
@@ -570,44 +654,53 @@ where
                 max_entries: target.max_entries(),
                 accepted: 0,
                 rays,
+                large_steps: Moments::default(),
+                large_step_rays: 0,
             };
-            WeightedChain::new(chain, b[group] / plan.chains_per_group[group] as f64)
+            WeightedChain::new(chain, group, plan.chains_per_group[group], b[group])
         })
         .collect();
 
-    // 3. and 4. Rounds of mutations, then the normalization.
+    // 3. Rounds of mutations, the normalization estimated alongside; 4. the image scaled by
+    // its final estimate.
     let mut outcome = run_rounds(
         target,
         camera,
         &mut chains,
         &plan,
         0,
+        &mut pass,
         film,
         control,
         after_round,
     );
-    outcome.normalization = normalization;
+    outcome.normalization = normalize(film, pass, &chains);
     outcome
 }
 
 /// Runs `chains` in rounds, every chain making the same number of mutations, adds their
-/// deposits to the film in chain order after each round, and sets the film's splat scale
-/// so that each chain's deposits count with its weight per mutation.
+/// deposits to the film in chain order after each round (each chain's into its group's
+/// layer), lets the normalization pass catch up, and sets the film's splat scale so that
+/// each group's deposits count per mutation.
 ///
 /// The first round, about one mutation per pixel, always runs, so a stopped render still
 /// has an image. `done_before`: mutations per chain made in an earlier phase of the render
-/// by as many chains of the same weights, whose deposits are already on the film.
+/// by as many chains of the same groups, whose deposits are already on the film.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn run_rounds<C: MarkovChain>(
+pub(crate) fn run_rounds<C: MarkovChain, N: PrimarySpaceTarget>(
     target: &C::Target,
     camera: &CameraModel,
     chains: &mut [WeightedChain<C>],
     plan: &ChainPlan,
     done_before: u64,
+    normalization: &mut NormalizationPass<N>,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
-) -> PssmltOutcome {
+) -> PssmltOutcome
+where
+    N::Scratch: Send,
+{
     let chain_count = chains.len() as u64;
     let deposits_per_mutation = chains
         .iter()
@@ -616,10 +709,11 @@ pub(crate) fn run_rounds<C: MarkovChain>(
         .unwrap_or(1) as u64;
     let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / chain_count.max(1)).max(1);
     for chain in chains.iter_mut() {
-        chain.deposits = Vec::with_capacity((per_round * deposits_per_mutation) as usize);
+        chain.deposits = Deposits::with_capacity((per_round * deposits_per_mutation) as usize);
     }
     let mut mutations_done = 0u64;
     let first_round = plan.first_round().min(per_round);
+    normalization.start_phase();
     while mutations_done < plan.mutations_per_chain
         && (mutations_done + done_before == 0 || !control.should_stop())
     {
@@ -642,8 +736,19 @@ pub(crate) fn run_rounds<C: MarkovChain>(
         // Chains are independent, so chain i's deposits also make partial image i mod K
         // of the post-process filter.
         for (i, chain) in chains.iter().enumerate() {
-            film.add_weighted_splats(&chain.deposits, chain.weight, i);
+            let independent_weight = chain.share * chain.bootstrap_b;
+            film.add_chain_splats(
+                chain.group,
+                &chain.deposits.chain,
+                chain.share,
+                chain.bootstrap_b,
+                i,
+            );
+            film.add_weighted_splats(&chain.deposits.independent, independent_weight, i);
         }
+        let chain_rays = chains.iter().map(|c| c.chain.rays()).sum();
+        let large_step_rays = chains.iter().map(|c| c.chain.large_step_rays()).sum();
+        normalization.catch_up(chain_rays, large_step_rays, control);
         after_round(
             film,
             ((done_before + mutations_done) * chain_count) as f64 / plan.pixels as f64,
@@ -673,10 +778,11 @@ fn mutate<T: PrimarySpaceTarget>(
     target: &T,
     camera: &CameraModel,
     chain: &mut Chain<T>,
-    deposits: &mut Vec<Splat>,
+    deposits: &mut Deposits,
 ) {
     chain.sampler.start_iteration();
     chain.proposal.clear();
+    let rays_before = chain.rays;
     target.evaluate(
         camera,
         &mut chain.sampler,
@@ -690,18 +796,21 @@ fn mutate<T: PrimarySpaceTarget>(
     // large step is also an independent uniform sample (density p_large) deposited once
     // more. Weighting every deposit by 1/(f/b + p_large), the balance heuristic over the
     // two, lets the large steps carry the dim parts of the image, which the chain visits
-    // rarely.
+    // rarely. The weights stay a partition of unity with any constant c in place of b:
+    // 1/(f + p_large·c) on every deposit, the chain's scaled by b (its final estimate) and
+    // the large steps' by c. So c is the bootstrap's b, fixed before the chains start, and
+    // only the chain's deposits wait for the final b.
     let mis = chain.mis_offset;
-    let large = if chain.sampler.is_large_step() {
-        1.0
-    } else {
-        0.0
-    };
+    if chain.sampler.is_large_step() {
+        chain.large_steps.add(chain.proposal.target as f64);
+        chain.large_step_rays += chain.rays - rays_before;
+        deposit(&mut deposits.independent, &chain.proposal, 1.0, mis);
+    }
     if a > 0.0 {
-        deposit(deposits, &chain.proposal, a + large, mis);
+        deposit(&mut deposits.chain, &chain.proposal, a, mis);
     }
     if a < 1.0 && chain.current.target > 0.0 {
-        deposit(deposits, &chain.current, 1.0 - a, mis);
+        deposit(&mut deposits.chain, &chain.current, 1.0 - a, mis);
     }
     if chain.sampler.decision() < a {
         std::mem::swap(&mut chain.current, &mut chain.proposal);

@@ -40,6 +40,13 @@ impl PrimarySpaceTarget for PathTracer<'_> {
         1
     }
 
+    /// With emitters seen directly in f (no direct pass), the film position decides much of
+    /// a sample's value, and large steps, uniform over the film, would add more variance to
+    /// the bootstrap's stratified estimate than they take away.
+    fn large_steps_are_bootstrap_samples(&self) -> bool {
+        self.min_depth > 0
+    }
+
     fn bootstrap(
         &self,
         camera: &CameraModel,
@@ -235,6 +242,10 @@ impl PrimarySpaceTarget for BdptAllStrategies<'_> {
 
     fn groups(&self) -> usize {
         1
+    }
+
+    fn large_steps_are_bootstrap_samples(&self) -> bool {
+        self.0.min_depth > 0
     }
 
     fn bootstrap(

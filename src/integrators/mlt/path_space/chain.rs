@@ -6,11 +6,12 @@ use super::bidirectional::Bidirectional;
 use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
 use crate::film::Film;
-use crate::integrators::Splat;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::acceptance;
+use crate::integrators::mlt::normalization::NormalizationPass;
 use crate::integrators::mlt::pssmlt::{
-    self, ChainPlan, MarkovChain, PathSample, PssmltOutcome, PssmltSettings, WeightedChain,
+    self, ChainPlan, Deposits, MarkovChain, PathSample, PssmltOutcome, PssmltSettings,
+    WeightedChain,
 };
 use crate::integrators::mlt::targets::BdptAllStrategies;
 use crate::render::Control;
@@ -127,7 +128,7 @@ impl<'a> MarkovChain for PathChain<'a> {
     type Target = PathSpaceTarget<'a>;
 
     #[inline]
-    fn mutate(&mut self, target: &PathSpaceTarget<'a>, _: &CameraModel, deposits: &mut Vec<Splat>) {
+    fn mutate(&mut self, target: &PathSpaceTarget<'a>, _: &CameraModel, deposits: &mut Deposits) {
         let space = target.space();
         self.proposal_sample.clear();
         // Pick a mutation among those the current path admits.
@@ -192,10 +193,10 @@ impl<'a> MarkovChain for PathChain<'a> {
         };
         // Expected-value deposits: each carries f⃗/f, so a state counts once per visit.
         if a > 0.0 {
-            pssmlt::deposit(deposits, &self.proposal_sample, a, 0.0);
+            pssmlt::deposit(&mut deposits.chain, &self.proposal_sample, a, 0.0);
         }
         if a < 1.0 {
-            pssmlt::deposit(deposits, &self.current_sample, 1.0 - a, 0.0);
+            pssmlt::deposit(&mut deposits.chain, &self.current_sample, 1.0 - a, 0.0);
         }
         if self.rng.uniform() < a {
             std::mem::swap(&mut self.current, &mut self.proposal);
@@ -236,17 +237,24 @@ pub(crate) fn run(
     // 1. Bootstrap with BDPT, all strategies summed: b = ∫ f.
     let n = settings.bootstrap_samples as u64;
     let boot = pssmlt::bootstrap(&target.bdpt, camera, settings, control);
-    let b = boot.sums[0] / boot.samples as f64;
+    let b = boot.estimate.b()[0];
     if b <= 0.0 || !b.is_finite() {
-        let mut outcome =
-            pssmlt::finish_without_light(camera, settings, film, control, after_round);
+        let mut outcome = pssmlt::finish_without_light(
+            camera,
+            settings,
+            &boot.estimate,
+            film,
+            control,
+            after_round,
+        );
         outcome.mutation_weights = target.weights;
         return outcome;
     }
 
-    // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution.
+    // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution;
+    // the normalization goes on being estimated with more BDPT samples alongside them.
     let plan = ChainPlan::new(&[b], camera, settings);
-    let weight = b / plan.chain_count as f64;
+    let mut pass = NormalizationPass::new(&target.bdpt, camera, settings, boot.estimate.clone());
     let seed_chains = |boot: &pssmlt::Bootstrap, seed: u64, first_stream: u64| {
         let seeds = pssmlt::resample_seeds(boot, &plan.chains_per_group, seed);
         seeds
@@ -254,7 +262,8 @@ pub(crate) fn run(
             .enumerate()
             .map(|(c, (_, index))| {
                 let stream = first_stream + c as u64;
-                WeightedChain::new(seed_chain(target, settings, index, n, stream), weight)
+                let chain = seed_chain(target, settings, index, n, stream);
+                WeightedChain::new(chain, 0, plan.chain_count, b)
             })
             .collect::<Vec<WeightedChain<PathChain>>>()
     };
@@ -277,13 +286,14 @@ pub(crate) fn run(
         &mut chains,
         &plan.phase(first_phase),
         0,
+        &mut pass,
         film,
         control,
         after_round,
     );
-    outcome.normalization = b;
     outcome.mutation_weights = target.weights;
     let Some(boot) = boot.filter(|_| !control.should_stop()) else {
+        outcome.normalization = pssmlt::normalize(film, pass, &chains);
         return outcome;
     };
     let mut counts = MutationCounts::default();
@@ -311,6 +321,7 @@ pub(crate) fn run(
         &mut chains,
         &plan.phase(plan.mutations_per_chain - warmup),
         warmup,
+        &mut pass,
         film,
         control,
         after_round,
@@ -318,6 +329,7 @@ pub(crate) fn run(
     outcome.mutations += rest.mutations;
     outcome.accepted += rest.accepted;
     outcome.mutation_counts.add(&rest.mutation_counts);
+    outcome.normalization = pssmlt::normalize(film, pass, &chains);
     outcome
 }
 

@@ -52,6 +52,7 @@ use super::{PathSpace, PathVertex};
 use crate::film::Film;
 use crate::integrators::bdpt::{Bdpt, BdptScratch};
 use crate::integrators::mlt::acceptance;
+use crate::integrators::mlt::normalization::NormalizationStats;
 use crate::integrators::mlt::pssmlt::{PathSample, PssmltOutcome};
 use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::render::Control;
@@ -422,7 +423,10 @@ pub(crate) fn run(
         .collect();
     let seed = settings.seed ^ SEED_SALT;
     let mut outcome = PssmltOutcome {
-        normalization: deposit_energy as f64,
+        normalization: NormalizationStats {
+            value: deposit_energy as f64,
+            ..Default::default()
+        },
         ..Default::default()
     };
     // The first pass takes one sample per pixel, later ones up to `batch`. A pass always

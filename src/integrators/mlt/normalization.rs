@@ -1,0 +1,458 @@
+//! The normalization of a Metropolis image: b_g = ∫ f_g, the total luminance of the paths a
+//! group of chains renders (MMLT: one group per path depth; the other variants: one group).
+//! The chains only say where the light is (their deposits have density f_g / b_g); how bright
+//! the image is comes from b_g alone, so its error is the image's brightness error.
+//!
+//! # The estimator
+//!
+//! b_g is the mean of f_g over independent samples of the chains' own target, drawn from
+//! three sources during the whole render:
+//!
+//! 1. the bootstrap (stratified over the film), which also seeds the chains;
+//! 2. for the targets whose large steps evaluate the same function as the bootstrap
+//!    (PSSMLT over the path tracer, PSSMLT over BDPT; not MMLT, whose large steps pick one
+//!    strategy and have heavier tails), every large step's proposal: Kelemen's large steps
+//!    are uniform samples of primary sample space, drawn whatever the chain's state. Only
+//!    with the direct pass on: otherwise emitters seen directly are in f, and large steps,
+//!    not stratified over the film, add the variance of how many land on them;
+//! 3. a *normalization pass* that draws more such samples (uniform over primary sample
+//!    space) alongside the chains when 2. does not make `work_fraction` of the work: after
+//!    each round of mutations it draws samples until the independent samples (its own and
+//!    the pooled large steps) have traced `work_fraction` of all the rays the chains and it
+//!    traced. Rays are the cost measure because they are counted exactly, so the number of
+//!    samples, and the image, do not depend on timing. With the default fraction, PSSMLT's
+//!    large steps (30% of its mutations) already make the share, and the pass draws
+//!    nothing for it.
+//!
+//! The image is scaled by the final estimate, after the last round (a time-limited or
+//! cancelled render too). So its brightness error shrinks like 1/√(work): a render of four
+//! times the work has half the brightness error, and a rare bright path that carried a large
+//! share of a small bootstrap is diluted by every later sample.
+//!
+//! # Why it is right
+//!
+//! Every sample is an unbiased estimate of b_g, and whether a sample is drawn (how many
+//! large steps a chain takes, how far the pass got when a stop came) never depends on its
+//! value, so the mean over all of them is an unbiased estimate of b_g for any count. The
+//! image is b̂_g times the chains' normalized deposits; the two are not independent (chains
+//! start from bootstrap samples and accept large steps), so the image is consistent rather
+//! than unbiased, as a Metropolis image always was: both factors converge.
+//!
+//! # Its cost
+//!
+//! The independent samples take `work_fraction` of the rays (the pass's samples are path
+//! tracer samples for PSSMLT, BDPT samples with all strategies for the others); the large
+//! steps cost nothing more, since the chains make them anyway. `RenderSettings::normalization_work_fraction` documents the default and how
+//! it was chosen. The estimate also keeps the sample variance, so a
+//! render reports its own brightness uncertainty (`RenderStats::normalization_relative_error`)
+//! and the share of b its brightest single sample carried.
+
+use super::pss::PssSampler;
+use super::pssmlt::{PrimarySpaceTarget, PssmltSettings, new_sampler};
+use crate::render::Control;
+use crate::sampling::Rng;
+use crate::scene::CameraModel;
+use rayon::prelude::*;
+use std::sync::atomic::Ordering;
+
+/// Count, sum, sum of squares and largest value of a stream of samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Moments {
+    pub count: u64,
+    pub sum: f64,
+    pub squares: f64,
+    pub largest: f64,
+}
+
+impl Moments {
+    #[inline]
+    pub fn add(&mut self, value: f64) {
+        self.count += 1;
+        self.sum += value;
+        self.squares += value * value;
+        self.largest = self.largest.max(value);
+    }
+
+    pub fn merge(&mut self, other: &Moments) {
+        self.count += other.count;
+        self.sum += other.sum;
+        self.squares += other.squares;
+        self.largest = self.largest.max(other.largest);
+    }
+}
+
+/// Per group, Σ f_g over independent samples, and the moments of Σ_g f_g per sample (every
+/// sample evaluates every group).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct NormalizationEstimate {
+    pub group_sums: Vec<f64>,
+    pub total: Moments,
+}
+
+/// What a render's normalization came to.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NormalizationStats {
+    /// b = Σ_g b_g, the image's total luminance per pixel from the chains.
+    pub value: f64,
+    /// Independent samples b was estimated from.
+    pub samples: u64,
+    /// The estimated standard error of b over b (from the samples' variance; a tail the
+    /// samples never reached is not in it).
+    pub relative_error: f64,
+    /// The largest share of Σ f a single sample carried: near 1/samples for a well-behaved
+    /// scene, much more when rare bright paths dominate.
+    pub largest_share: f64,
+}
+
+impl NormalizationEstimate {
+    pub fn new(groups: usize) -> Self {
+        NormalizationEstimate {
+            group_sums: vec![0.0; groups],
+            total: Moments::default(),
+        }
+    }
+
+    /// Adds one sample's value per group.
+    #[inline]
+    pub fn add(&mut self, values: &[f32]) {
+        let mut total = 0.0;
+        for (sum, &v) in self.group_sums.iter_mut().zip(values) {
+            *sum += v as f64;
+            total += v as f64;
+        }
+        self.total.add(total);
+    }
+
+    /// Forgets every sample, keeping the memory.
+    pub fn clear(&mut self) {
+        self.group_sums.fill(0.0);
+        self.total = Moments::default();
+    }
+
+    pub fn merge(&mut self, other: &NormalizationEstimate) {
+        for (sum, o) in self.group_sums.iter_mut().zip(&other.group_sums) {
+            *sum += o;
+        }
+        self.total.merge(&other.total);
+    }
+
+    /// Adds samples of a single-group target (a chain's large steps).
+    pub fn merge_single_group(&mut self, moments: &Moments) {
+        debug_assert_eq!(self.group_sums.len(), 1);
+        self.group_sums[0] += moments.sum;
+        self.total.merge(moments);
+    }
+
+    /// b_g per group (zeros before any sample).
+    pub fn b(&self) -> Vec<f64> {
+        let n = self.total.count.max(1) as f64;
+        self.group_sums.iter().map(|s| s / n).collect()
+    }
+
+    pub fn stats(&self) -> NormalizationStats {
+        let Moments {
+            count,
+            sum,
+            squares,
+            largest,
+        } = self.total;
+        if count == 0 || sum <= 0.0 {
+            return NormalizationStats {
+                samples: count,
+                ..Default::default()
+            };
+        }
+        let n = count as f64;
+        let mean = sum / n;
+        let variance = if count > 1 {
+            ((squares - sum * mean) / (n - 1.0)).max(0.0)
+        } else {
+            0.0
+        };
+        NormalizationStats {
+            value: mean,
+            samples: count,
+            relative_error: (variance / n).sqrt() / mean,
+            largest_share: largest / sum,
+        }
+    }
+}
+
+/// Work units a batch of the pass is split into: fixed, not the thread count, so that the
+/// order the units' sums are added in (and the image's last bits) never depends on it.
+const PASS_UNITS: usize = 16;
+/// Stream offsets of the pass's samples (apart from the bootstrap's and the chains'), of
+/// their positions within the pixel and of each film pass's order.
+const PASS_STREAM: u64 = 0x5eed_b0b0_0000_0000;
+const PASS_JITTER_STREAM: u64 = 0x5eed_b0b1_0000_0000;
+const PASS_ORDER_STREAM: u64 = 0x5eed_b0b2_0000_0000;
+
+/// The film position of pass sample `i`, in [0, 1)². Like the bootstrap's, the samples are
+/// stratified over the film: film pass k = i / pixels visits every pixel once, in the order
+/// j ↦ (a_k·j + c_k) mod pixels, with a multiplier a_k near pixels / φ, coprime to the pixel
+/// count, and an offset c_k uniform over the pixels, both per film pass. The multiplier
+/// spreads consecutive samples over the film, so any stretch of a film pass covers it
+/// evenly (stratified, as the bootstrap; uniform positions add the variance of how often
+/// the samples land on bright pixels, such as a light seen directly). The uniform offset
+/// puts every pixel at a uniform place in the order, so wherever the pass stops (a round's
+/// catch-up, a time limit) each pixel was reached with the same probability and the mean
+/// stays unbiased.
+fn pass_film_position(i: u64, camera: &CameraModel, seed: u64) -> [f32; 2] {
+    let (width, height) = (camera.width as u64, camera.height as u64);
+    let pixels = width * height;
+    let (k, j) = (i / pixels, i % pixels);
+    let mut order = Rng::new(seed, PASS_ORDER_STREAM + k);
+    let offset = ((order.next_u32() as u64) << 32 | order.next_u32() as u64) % pixels;
+    let mut multiplier = ((pixels as f64 * 0.618_033_988_749_895) as u64).max(1);
+    multiplier += (order.next_u32() as u64) % 64;
+    while gcd(multiplier, pixels) != 1 {
+        multiplier += 1;
+    }
+    let pixel = ((multiplier as u128 * j as u128 + offset as u128) % pixels as u128) as u64;
+    let mut jitter = Rng::new(seed, PASS_JITTER_STREAM + i);
+    let [u, v] = jitter.uniform2();
+    let x = ((pixel % width) as f32 + u) / width as f32;
+    let y = ((pixel / width) as f32 + v) / height as f32;
+    [x.min(1.0f32.next_down()), y.min(1.0f32.next_down())]
+}
+
+fn gcd(mut a: u64, mut b: u64) -> u64 {
+    while b != 0 {
+        (a, b) = (b, a % b);
+    }
+    a
+}
+
+struct PassUnit<S> {
+    sampler: PssSampler,
+    scratch: S,
+    values: Vec<f32>,
+    estimate: NormalizationEstimate,
+}
+
+/// The normalization pass: independent samples of `target` drawn alongside the chains, a
+/// fixed share of the rays, added to the estimate the bootstrap started.
+pub(crate) struct NormalizationPass<'a, T: PrimarySpaceTarget> {
+    target: &'a T,
+    camera: &'a CameraModel,
+    seed: u64,
+    /// The share of all rays that independent samples are to trace.
+    work_fraction: f64,
+    /// Samples drawn and the rays they traced.
+    taken: u64,
+    rays: u64,
+    /// Rays of the chains of earlier phases, and of the current phase so far; of those, the
+    /// rays of large steps that count as independent samples.
+    chain_rays_before: u64,
+    chain_rays: u64,
+    large_step_rays_before: u64,
+    large_step_rays: u64,
+    units: Vec<PassUnit<T::Scratch>>,
+    pub estimate: NormalizationEstimate,
+}
+
+impl<'a, T: PrimarySpaceTarget> NormalizationPass<'a, T>
+where
+    T::Scratch: Send,
+{
+    /// A pass continuing `estimate` (the bootstrap's); with a work fraction of 0 it draws
+    /// nothing.
+    pub fn new(
+        target: &'a T,
+        camera: &'a CameraModel,
+        settings: &PssmltSettings,
+        estimate: NormalizationEstimate,
+    ) -> Self {
+        let groups = target.groups();
+        let fraction = settings.normalization_work_fraction as f64;
+        let units = if fraction > 0.0 {
+            (0..PASS_UNITS)
+                .map(|_| PassUnit {
+                    sampler: new_sampler(target, settings),
+                    scratch: target.scratch(),
+                    values: vec![0.0; groups],
+                    estimate: NormalizationEstimate::new(groups),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        NormalizationPass {
+            target,
+            camera,
+            seed: settings.seed,
+            work_fraction: fraction,
+            taken: 0,
+            rays: 0,
+            chain_rays_before: 0,
+            chain_rays: 0,
+            large_step_rays_before: 0,
+            large_step_rays: 0,
+            units,
+            estimate,
+        }
+    }
+
+    /// Whether the chains' large steps also count: the target's large steps evaluate what
+    /// the bootstrap does.
+    pub fn pools_large_steps(&self) -> bool {
+        self.target.large_steps_are_bootstrap_samples()
+    }
+
+    /// Starts a new phase of chains (path-space MLT's adapted chains), whose ray counts
+    /// start again from their seeds.
+    pub fn start_phase(&mut self) {
+        self.chain_rays_before += self.chain_rays;
+        self.large_step_rays_before += self.large_step_rays;
+        self.chain_rays = 0;
+        self.large_step_rays = 0;
+    }
+
+    /// Draws samples until the independent samples have traced their share of the rays,
+    /// the chains of the current phase having traced `chain_rays`, `large_step_rays` of
+    /// them for large steps; nothing once the render is stopping.
+    pub fn catch_up(&mut self, chain_rays: u64, large_step_rays: u64, control: &Control) {
+        self.chain_rays = chain_rays;
+        self.large_step_rays = if self.pools_large_steps() {
+            large_step_rays
+        } else {
+            0
+        };
+        if self.units.is_empty() {
+            return;
+        }
+        let rays_before = self.rays;
+        // The pass's rays P and the pooled large steps' L must make f of all rays C + P:
+        // P + L ≥ f (C + P), so P ≥ (f C − L) / (1 − f).
+        let f = self.work_fraction;
+        let chains = (self.chain_rays_before + self.chain_rays) as f64;
+        let large_steps = (self.large_step_rays_before + self.large_step_rays) as f64;
+        let goal = ((f * chains - large_steps) / (1.0 - f)).max(0.0) as u64;
+        // Each batch draws as many samples as the rays still owed would take at the rays per
+        // sample seen so far (a few rays per sample before the first batch), at least one per
+        // unit; ray counts are exact, so the batches are the same on every run.
+        while self.rays < goal && !control.should_stop() {
+            let rays_per_sample = if self.taken > 0 {
+                (self.rays as f64 / self.taken as f64).max(1.0)
+            } else {
+                4.0
+            };
+            let count = (((goal - self.rays) as f64 / rays_per_sample).ceil() as u64)
+                .max(PASS_UNITS as u64);
+            self.draw(count);
+        }
+        control
+            .rays
+            .fetch_add(self.rays - rays_before, Ordering::Relaxed);
+    }
+
+    /// Draws `count` more samples.
+    fn draw(&mut self, count: u64) {
+        let first = self.taken;
+        let (target, camera, seed) = (self.target, self.camera, self.seed);
+        let rays: u64 = self
+            .units
+            .par_iter_mut()
+            .enumerate()
+            .map(|(u, unit)| {
+                let begin = first + count * u as u64 / PASS_UNITS as u64;
+                let end = first + count * (u as u64 + 1) / PASS_UNITS as u64;
+                let mut rays = 0;
+                unit.estimate.clear();
+                for i in begin..end {
+                    let position = pass_film_position(i, camera, seed);
+                    unit.sampler.restart_at(seed, PASS_STREAM + i, position);
+                    unit.values.fill(0.0);
+                    target.bootstrap(
+                        camera,
+                        &mut unit.sampler,
+                        &mut unit.scratch,
+                        &mut unit.values,
+                        &mut rays,
+                    );
+                    unit.estimate.add(&unit.values);
+                }
+                rays
+            })
+            .sum();
+        for unit in &self.units {
+            self.estimate.merge(&unit.estimate);
+        }
+        self.taken += count;
+        self.rays += rays;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each film pass of the normalization pass visits every pixel once, and wherever it is
+    /// cut, each pixel was as likely to be reached.
+    #[test]
+    fn pass_positions_cover_the_film_and_every_prefix_is_fair() {
+        let camera = crate::scene::Camera::default().model(6, 4);
+        let pixels = 24u64;
+        let pixel_of = |i: u64| {
+            let [x, y] = pass_film_position(i, &camera, 7);
+            assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+            (y * 4.0) as u64 * 6 + (x * 6.0) as u64
+        };
+        let passes = 6000u64;
+        let mut in_prefix = vec![0u32; pixels as usize];
+        for k in 0..passes {
+            let mut seen = vec![false; pixels as usize];
+            for j in 0..pixels {
+                let p = pixel_of(k * pixels + j) as usize;
+                assert!(!seen[p], "pass {k} visits pixel {p} twice");
+                seen[p] = true;
+                if j < 5 {
+                    in_prefix[p] += 1;
+                }
+            }
+        }
+        // A prefix of 5 of 24: each pixel 6000 · 5/24 = 1250 times, ± 3.5 standard
+        // deviations (about 32).
+        for (p, &n) in in_prefix.iter().enumerate() {
+            assert!(
+                (1135..=1365).contains(&n),
+                "pixel {p}: {n} of 6000 prefixes"
+            );
+        }
+    }
+
+    #[test]
+    fn estimate_reports_mean_standard_error_and_largest_share() {
+        let mut estimate = NormalizationEstimate::new(2);
+        // Totals 1, 2, 3, 6 (mean 3, sample variance 14/3).
+        for values in [[0.5, 0.5], [2.0, 0.0], [1.0, 2.0], [4.0, 2.0]] {
+            estimate.add(&values);
+        }
+        assert_eq!(estimate.b(), vec![7.5 / 4.0, 4.5 / 4.0]);
+        let stats = estimate.stats();
+        assert_eq!(stats.samples, 4);
+        assert!((stats.value - 3.0).abs() < 1e-12);
+        let expected = (14.0f64 / 3.0 / 4.0).sqrt() / 3.0;
+        assert!((stats.relative_error - expected).abs() < 1e-12, "{stats:?}");
+        assert!((stats.largest_share - 0.5).abs() < 1e-12);
+
+        // Merging is adding the samples; a chain's large steps join a single group.
+        let mut other = NormalizationEstimate::new(2);
+        other.add(&[1.0, 1.0]);
+        estimate.merge(&other);
+        assert_eq!(estimate.total.count, 5);
+        assert_eq!(estimate.b(), vec![8.5 / 5.0, 5.5 / 5.0]);
+        let mut single = NormalizationEstimate::new(1);
+        single.add(&[2.0]);
+        let mut large_steps = Moments::default();
+        large_steps.add(4.0);
+        large_steps.add(0.0);
+        single.merge_single_group(&large_steps);
+        assert_eq!(single.b(), vec![2.0]);
+        assert_eq!(single.stats().largest_share, 4.0 / 6.0);
+
+        estimate.clear();
+        assert_eq!(estimate, NormalizationEstimate::new(2));
+        assert_eq!(estimate.stats(), NormalizationStats::default());
+    }
+}
