@@ -1,12 +1,14 @@
 //! Equal-time quality: how close each algorithm gets to a converged reference in the same
 //! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings:
-//! cornell-glass (caustics through a glass sphere) and door-ajar (a room lit through the
-//! crack of a door) by default, cornell-box on request.
+//! cornell-box, cornell-glass (caustics through a glass sphere), door-ajar (a room lit
+//! through the crack of a door) and lamp-behind-glass (a room lit only through the glass
+//! cover of a recessed lamp).
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
 //! actual seconds, camera samples and chain mutations per second, the share of mutations
 //! accepted, RMSE, RMSE corrected for the reference's own noise, and the per-channel mean
-//! brightness difference to the reference) and writes a
+//! brightness difference to the reference; for the Metropolis algorithms also the luminance
+//! difference and b's reported error) and writes a
 //! log-log plot of RMSE against seconds, one line per algorithm and one panel per scene, to
 //! `target/mlt-bench/convergence.png`. Numbers are reported, never asserted.
 //!
@@ -35,7 +37,7 @@
 //! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
 //! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 2048).
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
-//!   `cornell-glass,door-ajar`).
+//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
 //! - `MLT_BENCH_REPEATS`: renders at the longest budget per thread count (default 1).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
@@ -45,13 +47,16 @@
 
 mod common;
 
+use common::reference::{
+    DEFAULT_REFERENCE_SPP, HEIGHT, MAX_DEPTH, REFERENCE_ALGORITHM, Reference, WIDTH, channel_means,
+    load_scene, luminance, reference, rmse,
+};
 use common::{
     FONT_FAMILY, draw_legend, env_names, env_value, output_dir, plot_font_or_color_key,
     series_color,
 };
 use mlt::{
-    Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render,
-    render_with_unfiltered,
+    Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render_with_unfiltered,
 };
 use plotters::prelude::*;
 use std::error::Error;
@@ -139,27 +144,13 @@ const ALGORITHMS: &[Compared] = &[
     },
 ];
 
-const DEFAULT_SCENES: &[&str] = &["cornell-glass", "door-ajar"];
-const WIDTH: u32 = 256;
-const HEIGHT: u32 = 256;
-const MAX_DEPTH: u32 = 5;
+const DEFAULT_SCENES: &[&str] = &[
+    "cornell-box",
+    "cornell-glass",
+    "door-ajar",
+    "lamp-behind-glass",
+];
 const DEFAULT_MAX_SECONDS: f64 = 10.0;
-const DEFAULT_REFERENCE_SPP: u32 = 2048;
-const REFERENCE_ALGORITHM: (&str, Algorithm) = ("bdpt", Algorithm::Bdpt);
-
-/// Seeds of the two reference halves. The measured renders use seeds 0, 1, 2, …: keeping
-/// these far away means no measured render shares random numbers with the reference, which
-/// would make its error look smaller than it is.
-const REFERENCE_SEEDS: [u64; 2] = [0x5EED_0000_000A, 0x5EED_0000_000B];
-
-/// A converged image and the estimate of its own remaining error.
-struct Reference {
-    image: Vec<f32>,
-    /// RMSE of the reference against the true image, estimated from its two halves.
-    rmse: f64,
-    spp: u32,
-}
-
 /// One time-limited render compared with the reference.
 struct Measurement {
     algorithm: &'static str,
@@ -170,6 +161,8 @@ struct Measurement {
     corrected_rmse: f64,
     /// Per channel: image mean / reference mean − 1, in percent.
     mean_difference_percent: [f64; 3],
+    /// The same for the luminance: the render's brightness error.
+    brightness_difference_percent: f64,
     /// With the filter: the corrected RMSE of the same render unfiltered …
     unfiltered_corrected_rmse: Option<f64>,
     /// … and the largest shift of a 4 × 4 region's mean luminance the filter made, relative
@@ -202,88 +195,6 @@ fn time_budgets(max_seconds: f64) -> Vec<f64> {
         .collect();
     budgets.push(max_seconds);
     budgets
-}
-
-/// Root-mean-square difference over all floats (the same definition as the tests' `rmse`).
-fn rmse(a: &[f32], b: &[f32]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let sum: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
-        .sum();
-    (sum / a.len() as f64).sqrt()
-}
-
-fn channel_means(image: &[f32]) -> [f64; 3] {
-    let mut sum = [0.0f64; 3];
-    for pixel in image.chunks_exact(3) {
-        for (s, &value) in sum.iter_mut().zip(pixel) {
-            *s += value as f64;
-        }
-    }
-    sum.map(|s| s / (image.len() / 3) as f64)
-}
-
-fn load_scene(name: &str) -> (Scene, Camera) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/scenes")
-        .join(format!("{name}.obj"));
-    let data = mlt::io::load_scene(&path)
-        .unwrap_or_else(|e| panic!("scene {name} (MLT_BENCH_SCENES) does not load: {e}"));
-    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).expect("scene builds");
-    let camera = data.camera.expect("camera sidecar").camera;
-    (scene, camera)
-}
-
-/// The two reference halves, read from the cache or rendered (and cached) when missing.
-fn reference(name: &str, scene: &Scene, camera: &Camera, spp: u32, dir: &Path) -> Reference {
-    let half_spp = (spp / 2).max(1);
-    let halves: Vec<Vec<f32>> = REFERENCE_SEEDS
-        .iter()
-        .zip(["a", "b"])
-        .map(|(&seed, half)| {
-            let path = dir.join(format!(
-                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{}-{half}.pfm",
-                REFERENCE_ALGORITHM.0
-            ));
-            if let Ok((WIDTH, HEIGHT, image)) = mlt::io::read_pfm(&path) {
-                return image;
-            }
-            println!(
-                "rendering reference half {half} of {name}: {}, {half_spp} spp, all threads",
-                REFERENCE_ALGORITHM.0
-            );
-            let settings = RenderSettings {
-                width: WIDTH,
-                height: HEIGHT,
-                max_depth: MAX_DEPTH,
-                algorithm: REFERENCE_ALGORITHM.1,
-                samples_per_pixel: half_spp,
-                threads: 0,
-                seed,
-                ..Default::default()
-            };
-            let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
-            let stats = render(scene, camera, &settings, &mut image, None).expect("renders");
-            assert_eq!(stats.stop, StopReason::Completed);
-            mlt::io::write_pfm(&path, WIDTH, HEIGHT, &image).expect("reference cache writes");
-            println!("  {:.1} s, cached in {}", stats.seconds, path.display());
-            image
-        })
-        .collect();
-    let image = halves[0]
-        .iter()
-        .zip(&halves[1])
-        .map(|(&a, &b)| 0.5 * (a + b))
-        .collect();
-    // Each half has variance σ² per float, their difference 2σ² and their mean σ²/2: the
-    // mean's RMSE is half the RMSE between the halves.
-    Reference {
-        image,
-        rmse: rmse(&halves[0], &halves[1]) / 2.0,
-        spp: half_spp * 2,
-    }
 }
 
 /// Renders with `algorithm` until `budget_seconds` pass and compares with the reference.
@@ -365,6 +276,8 @@ fn measure(
         mean_difference_percent: std::array::from_fn(|c| {
             (means[c] / reference_means[c] - 1.0) * 100.0
         }),
+        brightness_difference_percent: (luminance(means) / luminance(reference_means) - 1.0)
+            * 100.0,
         unfiltered_corrected_rmse,
         filter_shift_percent,
         repeat,
@@ -389,7 +302,7 @@ fn region_means(rgb: &[f32]) -> Vec<[f64; 3]> {
 
 fn print_header() {
     println!(
-        "{:<14} {:<28} {:>7} {:>7} {:>8} {:>12} {:>12} {:>9} {:>10} {:>10}  mean vs reference (R/G/B)  [filter: unfiltered corrected, largest region shift]",
+        "{:<14} {:<28} {:>7} {:>7} {:>8} {:>12} {:>12} {:>9} {:>10} {:>10}  mean vs reference (R/G/B)  [filter: unfiltered corrected, largest region shift]  brightness (luminance), b's reported error",
         "scene",
         "algo",
         "threads",
@@ -418,6 +331,14 @@ fn print_row(scene: &str, m: &Measurement) {
     }
     if let (Some(unfiltered), Some(shift)) = (m.unfiltered_corrected_rmse, m.filter_shift_percent) {
         notes = format!("  [{unfiltered:.5}, {shift:.1}%]{notes}");
+    }
+    if m.stats.mutations > 0 {
+        let b = m.stats.normalization;
+        notes = format!(
+            "  brightness {:+.2}%, b ± {:.2}%{notes}",
+            m.brightness_difference_percent,
+            100.0 * b.relative_error
+        );
     }
     println!(
         "{scene:<14} {:<28} {:>7} {:>7.2} {:>8.2} {:>12.0} {:>12.0} {:>8.1}% {:>10.5} {:>10.5}  {r:+6.2}% {g:+6.2}% {b:+6.2}%{notes}",
@@ -448,8 +369,8 @@ fn median(mut values: Vec<f64>) -> f64 {
 /// Medians over the repeated renders at the longest budget, per algorithm and thread count.
 fn print_medians(scene: &str, measurements: &[Measurement], max_seconds: f64, repeats: u32) {
     println!(
-        "{scene}: medians over {repeats} renders of {max_seconds} s: {:<28} {:>7} {:>10} {:>9}  [filter: unfiltered corrected, largest region shift]",
-        "algo", "threads", "corrected", "accepted"
+        "{scene}: medians over {repeats} renders of {max_seconds} s: {:<28} {:>7} {:>10} {:>9}  {:>27}  [filter: unfiltered corrected, largest region shift]",
+        "algo", "threads", "corrected", "accepted", "brightness: mean, sd, max|.|"
     );
     let mut names: Vec<&str> = measurements.iter().map(|m| m.algorithm).collect();
     names.dedup();
@@ -475,8 +396,21 @@ fn print_medians(scene: &str, measurements: &[Measurement], max_seconds: f64, re
             } else {
                 String::new()
             };
+            // The brightness error over the repeats: its mean (a bias), spread and largest.
+            let errors: Vec<f64> = runs
+                .iter()
+                .map(|m| m.brightness_difference_percent)
+                .collect();
+            let n = errors.len().max(1) as f64;
+            let mean = errors.iter().sum::<f64>() / n;
+            let spread = if errors.len() > 1 {
+                (errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+            } else {
+                0.0
+            };
+            let largest = errors.iter().fold(0.0f64, |a, e| a.max(e.abs()));
             println!(
-                "{scene}: medians over {repeats} renders of {max_seconds} s: {name:<28} {threads:>7} {corrected:>10.5} {accepted:>8.1}%{filter}"
+                "{scene}: medians over {repeats} renders of {max_seconds} s: {name:<28} {threads:>7} {corrected:>10.5} {accepted:>8.1}%  {mean:>+8.2}% {spread:>7.2}% {largest:>7.2}%{filter}"
             );
         }
     }

@@ -2,6 +2,8 @@
 //! plots' font and colors. Each bench uses part of them.
 #![allow(dead_code)]
 
+pub mod reference;
+
 use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
