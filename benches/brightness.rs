@@ -144,7 +144,7 @@ fn main() {
                                     break;
                                 }
                                 let seed = i + 1;
-                                let settings = RenderSettings {
+                                let mut settings = RenderSettings {
                                     width: WIDTH,
                                     height: HEIGHT,
                                     max_depth: MAX_DEPTH,
@@ -156,9 +156,11 @@ fn main() {
                                     mutations_per_pixel: mutations,
                                     normalization_work_fraction: ratio,
                                     bootstrap_samples: bootstrap,
-                                    chains: RenderSettings::default().chains.min(bootstrap),
                                     ..Default::default()
                                 };
+                                // A small fixed bootstrap caps the chains it seeds.
+                                settings.chains =
+                                    settings.chains.min(settings.resolved_bootstrap_samples());
                                 let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
                                 let stats = render(&scene, &camera, &settings, &mut image, None)
                                     .unwrap_or_else(|e| panic!("{algorithm_name}: {e}"));

@@ -414,7 +414,7 @@ typedef struct MltRenderSettings {
   uint32_t width;
   uint32_t height;
   /**
-   * One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_PSSMLT`.
+   * One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_MMLT`.
    */
   int32_t algorithm;
   /**

@@ -146,7 +146,7 @@ pub struct MltRenderSettings {
     /// Image size in pixels, each in [1, 65536].
     pub width: u32,
     pub height: u32,
-    /// One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_PSSMLT`.
+    /// One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_MMLT`.
     pub algorithm: i32,
     /// Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
     /// `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.

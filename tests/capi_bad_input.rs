@@ -367,7 +367,7 @@ fn defaults_are_valid_and_documented() {
     assert_eq!((s.max_depth, s.seed, s.threads), (5, 0, 0));
     assert_eq!(
         (s.algorithm, s.time_limit_seconds),
-        (MLT_ALGORITHM_PSSMLT, 0.0)
+        (MLT_ALGORITHM_MMLT, 0.0)
     );
     assert_eq!(
         (s.mutations_per_pixel, s.bootstrap_samples, s.chains),

@@ -113,7 +113,7 @@ fn the_default_algorithm_is_metropolis_and_its_summary_counts_mutations() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{output:?}");
     for needle in [
-        "Pssmlt",
+        "Mmlt",
         // The direct pass: one camera sample per mutation.
         "samples    2048 (2.00 per pixel)",
         "mutations  2048 (2.00 per pixel)",
