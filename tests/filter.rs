@@ -41,10 +41,6 @@ fn settings(algorithm: Algorithm, size: u32, budget: u32, seed: u64) -> RenderSe
     }
 }
 
-fn luminance(v: &[f64; 3]) -> f64 {
-    0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]
-}
-
 #[test]
 fn the_unfiltered_image_is_the_render_without_the_filter() {
     let (scene, camera) = load_canonical("cornell-glass");
@@ -122,8 +118,8 @@ fn lowers_the_error_of_path_space_mlt_and_erpt_with_a_bounded_bias() {
                 region_means(&unfiltered, 64, 64, 4),
             );
             for r in 0..16 {
-                shifts[r] += (luminance(&f[r]) - luminance(&u[r]))
-                    / luminance(&reference_regions[r])
+                shifts[r] += (luminance(f[r]) - luminance(u[r]))
+                    / luminance(reference_regions[r])
                     / seeds as f64;
             }
         }

@@ -16,7 +16,7 @@
 //! room by `DOOR_ANGLE_DEG`. The light hangs under the far room's ceiling on the side away
 //! from the hinge, facing down.
 
-use super::obj_text::Obj;
+use super::obj_text::{self, Obj};
 
 /// How far the door stands open: its free edge leaves a gap of about 100 · sin(angle) mm.
 pub const DOOR_ANGLE_DEG: f64 = 9.0;
@@ -135,9 +135,7 @@ pub fn mtl() -> String {
 
 /// The camera sidecar: from the near room's front corner, looking at the door.
 pub fn camera_json() -> String {
-    "{\n  \"eye\": [60.0, 160.0, 20.0],\n  \"target\": [340.0, 90.0, 500.0],\n  \
-     \"up\": [0.0, 1.0, 0.0],\n  \"fov_y_deg\": 60.0,\n  \"width\": 256,\n  \"height\": 256\n}\n"
-        .to_string()
+    obj_text::camera_json([60.0, 160.0, 20.0], [340.0, 90.0, 500.0])
 }
 
 /// The three files under their names in tests/scenes.

@@ -14,7 +14,7 @@
 //! has an opening x ∈ [240, 360], z ∈ [440, 560] into a recess 60 deep whose top holds a
 //! 40 × 40 emitter facing down; a glass slab 8 thick (ior 1.5) closes the opening from below.
 
-use super::obj_text::Obj;
+use super::obj_text::{self, Obj};
 
 const WIDTH: f64 = 600.0;
 const HEIGHT: f64 = 300.0;
@@ -98,9 +98,7 @@ pub fn mtl() -> String {
 
 /// The camera sidecar: from the front of the room, looking in and slightly up.
 pub fn camera_json() -> String {
-    "{\n  \"eye\": [300.0, 120.0, 20.0],\n  \"target\": [300.0, 150.0, 800.0],\n  \
-     \"up\": [0.0, 1.0, 0.0],\n  \"fov_y_deg\": 60.0,\n  \"width\": 256,\n  \"height\": 256\n}\n"
-        .to_string()
+    obj_text::camera_json([300.0, 120.0, 20.0], [300.0, 150.0, 800.0])
 }
 
 /// The three files under their names in tests/scenes.

@@ -158,6 +158,11 @@ pub fn mean_and_standard_error(rgb: &[f32]) -> ([f64; 3], [f64; 3]) {
     (mean, error)
 }
 
+/// Luminance of a linear RGB mean (Rec. 709 weights, as `mlt::scene::luminance`).
+pub fn luminance(rgb: [f64; 3]) -> f64 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+}
+
 /// Root-mean-square difference between two images of equal size.
 pub fn rmse(a: &[f32], b: &[f32]) -> f64 {
     assert_eq!(a.len(), b.len());

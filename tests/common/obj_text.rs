@@ -71,3 +71,15 @@ fn fmt(v: f64) -> String {
     // Never "-0".
     format!("{}", rounded + 0.0)
 }
+
+/// A camera sidecar (tests/scenes' NAME.camera.json) for a 256 × 256 view with a 60° vertical
+/// field of view and +y up.
+pub fn camera_json(eye: Point, target: Point) -> String {
+    let vector = |[x, y, z]: Point| format!("[{x:?}, {y:?}, {z:?}]");
+    format!(
+        "{{\n  \"eye\": {},\n  \"target\": {},\n  \"up\": [0.0, 1.0, 0.0],\n  \
+         \"fov_y_deg\": 60.0,\n  \"width\": 256,\n  \"height\": 256\n}}\n",
+        vector(eye),
+        vector(target)
+    )
+}
