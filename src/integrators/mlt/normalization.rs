@@ -16,13 +16,21 @@
 //!    with the direct pass on: otherwise emitters seen directly are in f, and large steps,
 //!    not stratified over the film, add the variance of how many land on them;
 //! 3. a *normalization pass* that draws more such samples (uniform over primary sample
-//!    space) alongside the chains when 2. does not make `work_fraction` of the work: after
-//!    each round of mutations it draws samples until the independent samples (its own and
-//!    the pooled large steps) have traced `work_fraction` of all the rays the chains and it
-//!    traced. Rays are the cost measure because they are counted exactly, so the number of
-//!    samples, and the image, do not depend on timing. With the default fraction, PSSMLT's
-//!    large steps (30% of its mutations) already make the share, and the pass draws
-//!    nothing for it.
+//!    space) alongside the chains when 2. does not make `work_fraction` of the work, so
+//!    that the independent samples (its own and the pooled large steps) trace about
+//!    `work_fraction` of all the rays. After each round of mutations it catches up: for
+//!    path-space MLT until its rays make the share; for the primary-sample-space chains by
+//!    a number of samples per mutation fixed before the chains start, from the rays a
+//!    bootstrap sample traced and those of a few hundred independent chain states. Rays and
+//!    mutations are counted exactly, so the number of samples, and the image, do not depend
+//!    on timing. With the default fraction, PSSMLT's large steps (30% of its mutations)
+//!    already make the share, and the pass draws nothing for it.
+//!
+//! In primary sample space the pass's samples are not spent on b alone: they are a third
+//! sampling technique of the image beside the chains and their large steps, combined with
+//! them by Kelemen's balance heuristic (`PassImage`). MMLT's pass samples are BDPT samples,
+//! every strategy of every depth at once; where the chains rarely go they carry the image,
+//! so the rays the pass takes from the chains come back as image.
 //!
 //! The image is scaled by the final estimate, after the last round (a time-limited or
 //! cancelled render too). So its brightness error shrinks like 1/√(work): a render of four
@@ -42,13 +50,16 @@
 //!
 //! The independent samples take `work_fraction` of the rays (the pass's samples are path
 //! tracer samples for PSSMLT, BDPT samples with all strategies for the others); the large
-//! steps cost nothing more, since the chains make them anyway. `RenderSettings::normalization_work_fraction` documents the default and how
+//! steps cost nothing more, since the chains make them anyway, and in primary sample space
+//! neither do the pass's samples, which join the image. `RenderSettings::normalization_work_fraction` documents the default and how
 //! it was chosen. The estimate also keeps the sample variance, so a
 //! render reports its own brightness uncertainty (`RenderStats::normalization_relative_error`)
 //! and the share of b its brightest single sample carried.
 
 use super::pss::PssSampler;
 use super::pssmlt::{PrimarySpaceTarget, PssmltSettings, new_sampler};
+use crate::film::Film;
+use crate::integrators::Splat;
 use crate::render::Control;
 use crate::sampling::Rng;
 use crate::scene::CameraModel;
@@ -181,6 +192,9 @@ impl NormalizationEstimate {
 /// Work units a batch of the pass is split into: fixed, not the thread count, so that the
 /// order the units' sums are added in (and the image's last bits) never depends on it.
 const PASS_UNITS: usize = 16;
+/// Samples a unit draws at most per batch when the pass is in the image, so that its
+/// points fit memory reserved once.
+const PASS_UNIT_BATCH: u64 = 64;
 /// Stream offsets of the pass's samples (apart from the bootstrap's and the chains'), of
 /// their positions within the pixel and of each film pass's order.
 const PASS_STREAM: u64 = 0x5eed_b0b0_0000_0000;
@@ -228,6 +242,56 @@ struct PassUnit<S> {
     scratch: S,
     values: Vec<f32>,
     estimate: NormalizationEstimate,
+    /// With the pass in the image: its samples' weighted points, and each sample's index
+    /// with the end of its points.
+    deposits: Vec<Splat>,
+    sample_ends: Vec<(u64, usize)>,
+}
+
+/// How a point of a pass sample (`PrimarySpaceTarget::pass_sample`) of a group is weighted
+/// into the image.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum PointWeight {
+    /// Combined with the group's chains and their large steps by the balance heuristic:
+    /// `numerator / (f + offset)` (see `PassImage`).
+    Combined { numerator: f32, offset: f32 },
+    /// A group without chains (its light was not in the bootstrap): the pass alone renders
+    /// it, each point standing for `weight` = 1 / its points per sample.
+    Alone { weight: f32 },
+}
+
+impl PointWeight {
+    /// The weight of a point whose state has value `target`.
+    #[inline]
+    pub fn of(self, target: f32) -> f32 {
+        match self {
+            PointWeight::Combined { numerator, offset } => numerator / (target + offset),
+            PointWeight::Alone { weight } => weight,
+        }
+    }
+}
+
+/// The pass's samples as a third sampling technique of the image, beside the chains and
+/// their large steps (primary sample space only: there the pass's density is known).
+///
+/// Kelemen et al. weight the chain's deposits and the large steps' by the balance heuristic
+/// over the chain's density f/b and the large steps' density p_large, both per mutation.
+/// The pass is one more uniform technique: per mutation of group g it puts r_g points in
+/// the chains' space (`samples_per_mutation` × the group's points per sample × all chains
+/// / the chains of g), so every deposit's weight becomes 1/(f + (p_large + r_g)·c_g), the large
+/// steps' and the pass's times c_g, and the chains' times the final b_g. As with the large
+/// steps, any constants keep the weights a partition of unity, so c_g is the bootstrap's
+/// b_g and r_g the planned rate; the pass's points are averaged over the samples actually
+/// drawn (a layer of the film scaled at the end). Where the chains rarely go, the pass's
+/// BDPT samples, which evaluate every strategy of every depth at once, carry the image.
+pub(crate) struct PassImage {
+    pub weights: Vec<PointWeight>,
+    /// Samples the pass draws per chain mutation (it draws exactly that many, so the weights
+    /// are what was planned).
+    pub samples_per_mutation: f64,
+    /// The chains, and the film layer the pass's points go to.
+    pub chains: u64,
+    pub layer: usize,
 }
 
 /// The normalization pass: independent samples of `target` drawn alongside the chains, a
@@ -249,6 +313,10 @@ pub(crate) struct NormalizationPass<'a, T: PrimarySpaceTarget> {
     large_step_rays: u64,
     units: Vec<PassUnit<T::Scratch>>,
     pub estimate: NormalizationEstimate,
+    /// With its samples in the image, the pass keeps pace by samples per mutation instead
+    /// of by rays; the chains' mutations so far.
+    image: Option<PassImage>,
+    mutations: u64,
 }
 
 impl<'a, T: PrimarySpaceTarget> NormalizationPass<'a, T>
@@ -272,6 +340,8 @@ where
                     scratch: target.scratch(),
                     values: vec![0.0; groups],
                     estimate: NormalizationEstimate::new(groups),
+                    deposits: Vec::new(),
+                    sample_ends: Vec::new(),
                 })
                 .collect()
         } else {
@@ -290,7 +360,38 @@ where
             large_step_rays: 0,
             units,
             estimate,
+            image: None,
+            mutations: 0,
         }
+    }
+
+    /// Puts the pass's samples in the image (`PassImage`); a pass drawing nothing is left
+    /// as it is.
+    pub fn with_image(mut self, image: Option<PassImage>) -> Self {
+        debug_assert!(image.is_none() || !self.units.is_empty());
+        self.image = image.filter(|_| !self.units.is_empty());
+        if self.image.is_some() {
+            let groups = self.estimate.group_sums.len();
+            let points: u32 = (0..groups).map(|g| self.target.points_per_sample(g)).sum();
+            let per_sample = self.target.max_entries() * points as usize;
+            for unit in &mut self.units {
+                unit.deposits = Vec::with_capacity(PASS_UNIT_BATCH as usize * per_sample);
+                unit.sample_ends = Vec::with_capacity(PASS_UNIT_BATCH as usize);
+            }
+        }
+        self
+    }
+
+    /// The film layer of the pass's points and its factor relative to the splat scale
+    /// (pixels / mutations per chain): mutations per chain / samples drawn.
+    pub fn image_layer_scale(&self) -> Option<(usize, f64)> {
+        let image = self.image.as_ref()?;
+        let scale = if self.taken > 0 {
+            self.mutations as f64 / image.chains as f64 / self.taken as f64
+        } else {
+            0.0
+        };
+        Some((image.layer, scale))
     }
 
     /// Whether the chains' large steps also count: the target's large steps evaluate what
@@ -310,18 +411,39 @@ where
 
     /// Draws samples until the independent samples have traced their share of the rays,
     /// the chains of the current phase having traced `chain_rays`, `large_step_rays` of
-    /// them for large steps; nothing once the render is stopping.
-    pub fn catch_up(&mut self, chain_rays: u64, large_step_rays: u64, control: &Control) {
+    /// them for large steps; nothing once the render is stopping. With the pass in the
+    /// image, draws instead until it has its samples per mutation for the chains'
+    /// `mutations` so far (all phases), even when stopping: the weights count on them.
+    pub fn catch_up(
+        &mut self,
+        chain_rays: u64,
+        large_step_rays: u64,
+        mutations: u64,
+        control: &Control,
+        film: &mut Film,
+    ) {
         self.chain_rays = chain_rays;
         self.large_step_rays = if self.pools_large_steps() {
             large_step_rays
         } else {
             0
         };
+        self.mutations = mutations;
         if self.units.is_empty() {
             return;
         }
         let rays_before = self.rays;
+        if let Some(image) = &self.image {
+            let goal = (image.samples_per_mutation * mutations as f64).ceil() as u64;
+            while self.taken < goal {
+                let batch = (goal - self.taken).min(PASS_UNIT_BATCH * PASS_UNITS as u64);
+                self.draw(batch, film);
+            }
+            control
+                .rays
+                .fetch_add(self.rays - rays_before, Ordering::Relaxed);
+            return;
+        }
         // The pass's rays P and the pooled large steps' L must make f of all rays C + P:
         // P + L ≥ f (C + P), so P ≥ (f C − L) / (1 − f).
         let f = self.work_fraction;
@@ -339,17 +461,19 @@ where
             };
             let count = (((goal - self.rays) as f64 / rays_per_sample).ceil() as u64)
                 .max(PASS_UNITS as u64);
-            self.draw(count);
+            self.draw(count, film);
         }
         control
             .rays
             .fetch_add(self.rays - rays_before, Ordering::Relaxed);
     }
 
-    /// Draws `count` more samples.
-    fn draw(&mut self, count: u64) {
+    /// Draws `count` more samples (and with the pass in the image, adds their points to its
+    /// layer of `film`, sample i's to the filter's partial image i).
+    fn draw(&mut self, count: u64, film: &mut Film) {
         let first = self.taken;
         let (target, camera, seed) = (self.target, self.camera, self.seed);
+        let weights = self.image.as_ref().map(|image| &image.weights[..]);
         let rays: u64 = self
             .units
             .par_iter_mut()
@@ -359,17 +483,38 @@ where
                 let end = first + count * (u as u64 + 1) / PASS_UNITS as u64;
                 let mut rays = 0;
                 unit.estimate.clear();
+                unit.deposits.clear();
+                unit.sample_ends.clear();
                 for i in begin..end {
                     let position = pass_film_position(i, camera, seed);
                     unit.sampler.restart_at(seed, PASS_STREAM + i, position);
                     unit.values.fill(0.0);
-                    target.bootstrap(
-                        camera,
-                        &mut unit.sampler,
-                        &mut unit.scratch,
-                        &mut unit.values,
-                        &mut rays,
-                    );
+                    if let Some(weights) = weights {
+                        let deposits = &mut unit.deposits;
+                        target.pass_sample(
+                            camera,
+                            &mut unit.sampler,
+                            &mut unit.scratch,
+                            &mut unit.values,
+                            &mut rays,
+                            &mut |group, point| {
+                                let weight = weights[group].of(point.target);
+                                deposits.extend(point.entries.iter().map(|e| Splat {
+                                    pixel: e.pixel,
+                                    value: e.value * weight,
+                                }));
+                            },
+                        );
+                        unit.sample_ends.push((i, unit.deposits.len()));
+                    } else {
+                        target.bootstrap(
+                            camera,
+                            &mut unit.sampler,
+                            &mut unit.scratch,
+                            &mut unit.values,
+                            &mut rays,
+                        );
+                    }
                     unit.estimate.add(&unit.values);
                 }
                 rays
@@ -377,6 +522,18 @@ where
             .sum();
         for unit in &self.units {
             self.estimate.merge(&unit.estimate);
+        }
+        if let Some(image) = &self.image {
+            // The partial images get the planned factor: mutations per chain / samples.
+            let partial_scale = 1.0 / (image.samples_per_mutation * image.chains as f64);
+            for unit in &self.units {
+                let mut start = 0;
+                for &(i, end) in &unit.sample_ends {
+                    let points = &unit.deposits[start..end];
+                    film.add_chain_splats(image.layer, points, 1.0, partial_scale, i as usize);
+                    start = end;
+                }
+            }
         }
         self.taken += count;
         self.rays += rays;

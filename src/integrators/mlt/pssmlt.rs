@@ -31,7 +31,9 @@
 //! to the film in chain order after the round.
 
 use super::acceptance;
-use super::normalization::{Moments, NormalizationEstimate, NormalizationPass, NormalizationStats};
+use super::normalization::{
+    Moments, NormalizationEstimate, NormalizationPass, NormalizationStats, PassImage, PointWeight,
+};
 use super::path_space::{MutationCounts, MutationWeights};
 use super::pss::PssSampler;
 use crate::film::Film;
@@ -152,6 +154,33 @@ pub(crate) trait PrimarySpaceTarget: Sync {
         targets: &mut [f32],
         rays: &mut u64,
     );
+    /// `bootstrap`, also handing each *point* of the sample to `point(group, state)`: a state
+    /// a chain of that group could be in, with its value and its contributions as the chain
+    /// would deposit them, so that the normalization pass's samples can join the image
+    /// (`NormalizationPass::with_image`).
+    #[allow(clippy::too_many_arguments)]
+    fn pass_sample(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut Self::Scratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+        point: &mut dyn FnMut(usize, &PathSample),
+    );
+    /// Whether the normalization pass's samples join the image (`PassImage`): measured to
+    /// pay for MMLT, whose pass samples (every strategy of every depth) render the dim
+    /// parts its single-strategy large steps find poorly; for PSSMLT over the path tracer
+    /// without the direct pass they added noise to the image mean.
+    fn pass_joins_the_image(&self) -> bool {
+        false
+    }
+    /// Points of `group` a pass sample has: where the bootstrap sums alternatives that a
+    /// chain's state picks one of (MMLT: the strategies of a depth), a point per alternative,
+    /// one in each stratum of the coordinate that picks it.
+    fn points_per_sample(&self, _group: usize) -> u32 {
+        1
+    }
     /// Evaluates the state a chain of `group` starts from: the sampler was restarted where
     /// a bootstrap sample was drawn. Where the bootstrap summed alternatives the chain state
     /// picks one of (MMLT: strategies), `choice` ∈ [0, 1) picks one in proportion to its value
@@ -277,8 +306,9 @@ struct Chain<T: PrimarySpaceTarget> {
     scratch: T::Scratch,
     current: PathSample,
     proposal: PathSample,
-    /// p_large × b_g (the bootstrap's), added to f in the deposits' denominators (see
-    /// `mutate`).
+    /// (p_large + r_g) × b_g (the bootstrap's), added to f in the deposits' denominators
+    /// (see `mutate`); r_g is the normalization pass's rate when its samples join the image
+    /// (`PassImage`), else 0.
     mis_offset: f32,
     max_entries: usize,
     accepted: u64,
@@ -379,6 +409,8 @@ pub(crate) fn restart_as_bootstrap(
 pub(crate) struct Bootstrap {
     /// Over the samples taken: all asked for, or the whole passes done before a stop.
     pub estimate: NormalizationEstimate,
+    /// The rays its samples traced.
+    pub rays: u64,
     kept: Vec<f32>,
     kept_samples: u64,
 }
@@ -437,6 +469,7 @@ pub(crate) fn bootstrap<T: PrimarySpaceTarget>(
     control.rays.fetch_add(rays, Ordering::Relaxed);
     Bootstrap {
         estimate,
+        rays,
         kept_samples: done.min(kept_limit),
         kept,
     }
@@ -586,14 +619,139 @@ where
     N::Scratch: Send,
 {
     let pools_large_steps = pass.pools_large_steps();
+    let pass_layer = pass.image_layer_scale();
     let mut estimate = pass.estimate;
     if pools_large_steps {
         for chain in chains {
             estimate.merge_single_group(&chain.chain.large_steps());
         }
     }
-    film.set_chain_layer_scales(&estimate.b());
+    let mut scales = estimate.b();
+    if let Some((layer, scale)) = pass_layer {
+        scales.resize(layer + 1, 0.0);
+        scales[layer] = scale;
+    }
+    film.set_chain_layer_scales(&scales);
     estimate.stats()
+}
+
+/// Independent states per group whose rays estimate what a mutation costs.
+const CALIBRATION_STATES: u64 = 256;
+const CALIBRATION_STREAM: u64 = 0x5eed_ca1b_0000_0000;
+
+/// The offsets of the deposits' denominators per group (`mutate`), and how the
+/// normalization pass's samples join the image (`PassImage`), if it draws any: its samples
+/// per mutation are set so that, with the pooled large steps, its rays make the work
+/// fraction of all rays, from the rays a bootstrap sample traced and the rays of a few
+/// hundred independent states of each group's chains (a mutation's cost; large and small
+/// steps trace paths alike).
+#[allow(clippy::too_many_arguments)]
+fn plan_pass_image<T: PrimarySpaceTarget>(
+    target: &T,
+    camera: &CameraModel,
+    settings: &PssmltSettings,
+    boot: &Bootstrap,
+    plan: &ChainPlan,
+    pass: &NormalizationPass<T>,
+    control: &Control,
+) -> (Vec<f32>, Option<PassImage>)
+where
+    T::Scratch: Send,
+{
+    let b = boot.estimate.b();
+    let p_large = settings.large_step_probability as f64;
+    let large_steps_only = || b.iter().map(|&b| (p_large * b) as f32).collect();
+    let f = settings.normalization_work_fraction as f64;
+    let pooled = if pass.pools_large_steps() {
+        p_large
+    } else {
+        0.0
+    };
+    let bootstrap_samples = boot.estimate.total.count;
+    if !target.pass_joins_the_image() || f <= pooled || bootstrap_samples == 0 || boot.rays == 0 {
+        return (large_steps_only(), None);
+    }
+    let mut sampler = new_sampler(target, settings);
+    let mut scratch = target.scratch();
+    let mut state = PathSample::with_capacity(target.max_entries());
+    let mut chain_rays = 0.0;
+    for (group, &chains) in plan.chains_per_group.iter().enumerate() {
+        if chains == 0 {
+            continue;
+        }
+        let mut rays = 0;
+        for i in 0..CALIBRATION_STATES {
+            sampler.restart(settings.seed, CALIBRATION_STREAM + i);
+            state.clear();
+            target.evaluate(
+                camera,
+                &mut sampler,
+                &mut scratch,
+                group,
+                &mut state,
+                &mut rays,
+            );
+        }
+        control.rays.fetch_add(rays, Ordering::Relaxed);
+        chain_rays += chains as f64 * rays as f64 / CALIBRATION_STATES as f64;
+    }
+    let rays_per_mutation = chain_rays / plan.chain_count as f64;
+    let rays_per_sample = boot.rays as f64 / bootstrap_samples as f64;
+    // P + L = f (C + P) with L = pooled · C: P / C = (f − pooled) / (1 − f).
+    let samples_per_mutation = (f - pooled) / (1.0 - f) * rays_per_mutation / rays_per_sample;
+    if samples_per_mutation <= 0.0 || !samples_per_mutation.is_finite() {
+        return (large_steps_only(), None);
+    }
+    let points: Vec<u32> = (0..b.len()).map(|g| target.points_per_sample(g)).collect();
+    let (offsets, weights) = balance_weights(
+        &b,
+        &plan.chains_per_group,
+        &points,
+        p_large,
+        samples_per_mutation,
+    );
+    let image = PassImage {
+        weights,
+        samples_per_mutation,
+        chains: plan.chain_count,
+        layer: b.len(),
+    };
+    (offsets, Some(image))
+}
+
+/// The balance heuristic over a group's three techniques (`PassImage`): per group, the
+/// offset of every deposit's denominator, (p_large + r_g)·b_g, and the weight of a pass
+/// point, r_g·b_g / points_g over the same denominator, where the pass puts r_g points per
+/// mutation of the group in its space. A group without chains is the pass's alone.
+fn balance_weights(
+    b: &[f64],
+    chains_per_group: &[u64],
+    points_per_sample: &[u32],
+    p_large: f64,
+    samples_per_mutation: f64,
+) -> (Vec<f32>, Vec<PointWeight>) {
+    let chain_count: u64 = chains_per_group.iter().sum();
+    let mut offsets = Vec::with_capacity(b.len());
+    let weights = (0..b.len())
+        .map(|g| {
+            let points = points_per_sample[g] as f64;
+            let chains = chains_per_group[g];
+            if chains == 0 {
+                offsets.push(0.0);
+                return PointWeight::Alone {
+                    weight: (1.0 / points) as f32,
+                };
+            }
+            let rate = samples_per_mutation * points * chain_count as f64 / chains as f64;
+            let offset = ((p_large + rate) * b[g]) as f32;
+            offsets.push(offset);
+            PointWeight::Combined {
+                numerator: (rate * b[g] / points) as f32,
+                offset,
+            }
+        })
+        .collect();
+    (offsets, weights)
 }
 
 /// Runs the chains. `after_round(film, mutations per pixel so far)` is called after each round
@@ -621,7 +779,10 @@ where
     // 2. Chains, allotted to groups and seeded from resampled bootstrap samples.
     let plan = ChainPlan::new(&b, camera, settings);
     let seeds = resample_seeds(&boot, &plan.chains_per_group, settings.seed);
-    let mut pass = NormalizationPass::new(target, camera, settings, boot.estimate);
+    let pass = NormalizationPass::new(target, camera, settings, boot.estimate.clone());
+    let (offsets, pass_image) =
+        plan_pass_image(target, camera, settings, &boot, &plan, &pass, control);
+    let mut pass = pass.with_image(pass_image);
     drop(boot.kept);
     let mut chains: Vec<WeightedChain<Chain<T>>> = seeds
         .into_par_iter()
@@ -650,7 +811,7 @@ where
                 scratch,
                 current,
                 proposal: PathSample::with_capacity(target.max_entries()),
-                mis_offset: (settings.large_step_probability as f64 * b[group]) as f32,
+                mis_offset: offsets[group],
                 max_entries: target.max_entries(),
                 accepted: 0,
                 rays,
@@ -748,7 +909,8 @@ where
         }
         let chain_rays = chains.iter().map(|c| c.chain.rays()).sum();
         let large_step_rays = chains.iter().map(|c| c.chain.large_step_rays()).sum();
-        normalization.catch_up(chain_rays, large_step_rays, control);
+        let mutations = (done_before + mutations_done) * chain_count;
+        normalization.catch_up(chain_rays, large_step_rays, mutations, control, film);
         after_round(
             film,
             ((done_before + mutations_done) * chain_count) as f64 / plan.pixels as f64,
@@ -799,7 +961,8 @@ fn mutate<T: PrimarySpaceTarget>(
     // rarely. The weights stay a partition of unity with any constant c in place of b:
     // 1/(f + p_large·c) on every deposit, the chain's scaled by b (its final estimate) and
     // the large steps' by c. So c is the bootstrap's b, fixed before the chains start, and
-    // only the chain's deposits wait for the final b.
+    // only the chain's deposits wait for the final b. The normalization pass's samples,
+    // when they join the image, are a third technique of the same kind (`PassImage`).
     let mis = chain.mis_offset;
     if chain.sampler.is_large_step() {
         chain.large_steps.add(chain.proposal.target as f64);
@@ -847,6 +1010,33 @@ mod tests {
         let chains = allot_chains(&[0.5, 0.3, 0.2], 1000);
         assert_eq!(chains.iter().sum::<u64>(), 1000);
         assert_eq!(chains, vec![500, 300, 200]);
+    }
+
+    /// At every target value, a state's weights as a chain deposit (f), a large step
+    /// (p_large·b) and the pass's points of its sample (points × the point weight) sum to
+    /// the denominator: the three techniques' weights are a partition of unity.
+    #[test]
+    fn pass_chain_and_large_step_weights_sum_to_one() {
+        let b = [0.5, 0.02, 0.0, 0.3];
+        let chains = [600, 24, 0, 400];
+        let points = [4, 5, 6, 7];
+        let (p_large, samples_per_mutation) = (0.3, 0.04);
+        let (offsets, weights) =
+            balance_weights(&b, &chains, &points, p_large, samples_per_mutation);
+        for g in [0, 1, 3] {
+            for f in [0.0f32, 1e-4, 0.01, 0.3, 2.0, 50.0] {
+                let chain = f / (f + offsets[g]);
+                let large_step = (p_large * b[g]) as f32 / (f + offsets[g]);
+                let pass = points[g] as f32 * weights[g].of(f);
+                let sum = chain + large_step + pass;
+                assert!((sum - 1.0).abs() < 1e-5, "group {g}, f {f}: {sum}");
+            }
+        }
+        // The pass's points per mutation of a group: samples per mutation × points per
+        // sample × chains per chain of the group; a group without chains is the pass's.
+        let rate = 0.04 * 4.0 * 1024.0 / 600.0;
+        assert!((offsets[0] - ((0.3 + rate) * 0.5) as f32).abs() < 1e-6);
+        assert_eq!(points[2] as f32 * weights[2].of(1.0), 1.0);
     }
 
     #[test]

@@ -60,6 +60,19 @@ impl PrimarySpaceTarget for PathTracer<'_> {
         targets[0] += scratch.target;
     }
 
+    fn pass_sample(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut PathSample,
+        targets: &mut [f32],
+        rays: &mut u64,
+        point: &mut dyn FnMut(usize, &PathSample),
+    ) {
+        self.bootstrap(camera, sampler, scratch, targets, rays);
+        point(0, scratch);
+    }
+
     fn seed(
         &self,
         camera: &CameraModel,
@@ -262,6 +275,19 @@ impl PrimarySpaceTarget for BdptAllStrategies<'_> {
         targets[0] += sample.target;
     }
 
+    fn pass_sample(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+        point: &mut dyn FnMut(usize, &PathSample),
+    ) {
+        self.bootstrap(camera, sampler, scratch, targets, rays);
+        point(0, &scratch.sample);
+    }
+
     fn seed(
         &self,
         camera: &CameraModel,
@@ -351,6 +377,49 @@ impl PrimarySpaceTarget for BdptMultiplexed<'_> {
             rays,
             |s, t, c| targets[s + t - 2 - min_depth] += PathSample::usable_luminance(c.value),
         );
+    }
+
+    /// Each strategy is a point: the state whose strategy coordinate lies in its interval.
+    fn pass_sample(
+        &self,
+        camera: &CameraModel,
+        sampler: &mut PssSampler,
+        scratch: &mut BdptTargetScratch,
+        targets: &mut [f32],
+        rays: &mut u64,
+        point: &mut dyn FnMut(usize, &PathSample),
+    ) {
+        let min_depth = self.0.min_depth as usize;
+        let mut counters = SampleCounters::default();
+        let (x, y, pixel, _) = start_camera_stream(camera, sampler);
+        let sample = &mut scratch.sample;
+        self.0.sample_all_strategies(
+            camera,
+            x,
+            y,
+            sampler,
+            &mut scratch.paths,
+            &mut counters,
+            |s, t, c| {
+                let depth = s + t - 2;
+                let (_, _, count) = strategy(depth, 0.0);
+                targets[depth - min_depth] += PathSample::usable_luminance(c.value);
+                sample.clear();
+                sample.push(c.splat_pixel.unwrap_or(pixel), c.value * count as f32);
+                if sample.target > 0.0 {
+                    point(depth - min_depth, sample);
+                }
+            },
+        );
+        *rays += counters.rays;
+    }
+
+    fn pass_joins_the_image(&self) -> bool {
+        true
+    }
+
+    fn points_per_sample(&self, group: usize) -> u32 {
+        strategy(group + self.0.min_depth as usize, 0.0).2 as u32
     }
 
     /// Reproduces the bootstrap sample, picks one strategy of `group` in proportion to its
@@ -446,7 +515,7 @@ impl PrimarySpaceTarget for BdptMultiplexed<'_> {
 #[cfg(all(test, feature = "cli"))]
 mod tests {
     use super::*;
-    use crate::scene::Scene;
+    use crate::scene::{Scene, luminance};
 
     #[test]
     fn strategies_cover_each_depth_once() {
@@ -462,6 +531,85 @@ mod tests {
             assert!(seen.iter().all(|&x| x), "depth {depth}");
         }
         assert_eq!(strategy(3, 0.999_999_9).0, 4);
+    }
+
+    /// A pass sample's points are its bootstrap value split into chain states: per group,
+    /// the points' values over the group's points per sample sum to what `bootstrap` adds
+    /// (MMLT: a point per strategy, each valued as a chain at that strategy would be).
+    #[test]
+    fn pass_points_split_the_bootstrap_values() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/cornell-glass.obj");
+        let data = crate::io::load_scene(&path).unwrap();
+        let scene = Scene::new(&data.desc(crate::scene::Backend::Bvh)).unwrap();
+        let camera = data.camera.unwrap().camera.model(32, 32);
+        let bdpt = |min_depth| Bdpt {
+            scene: &scene,
+            max_depth: 5,
+            min_depth,
+        };
+        let tracer = PathTracer {
+            scene: &scene,
+            max_depth: 5,
+            min_depth: 2,
+        };
+        check_pass_points(&BdptMultiplexed(bdpt(2)), &camera);
+        check_pass_points(&BdptMultiplexed(bdpt(0)), &camera);
+        check_pass_points(&BdptAllStrategies(bdpt(2)), &camera);
+        check_pass_points(&tracer, &camera);
+    }
+
+    fn check_pass_points<T: PrimarySpaceTarget>(target: &T, camera: &CameraModel) {
+        let groups = target.groups();
+        let mut scratch = target.scratch();
+        let mut sampler = PssSampler::new(1, 0, 0.3, 0.01, target.streams(), target.dimensions());
+        let (mut bootstrapped, mut passed, mut split) =
+            (vec![0.0; groups], vec![0.0; groups], vec![0.0; groups]);
+        let mut lit = 0;
+        for i in 0..2000u64 {
+            let position = [(i % 97) as f32 / 97.0, (i % 89) as f32 / 89.0];
+            let mut rays = 0;
+            bootstrapped.fill(0.0);
+            sampler.restart_at(1, i, position);
+            target.bootstrap(
+                camera,
+                &mut sampler,
+                &mut scratch,
+                &mut bootstrapped,
+                &mut rays,
+            );
+            passed.fill(0.0);
+            split.fill(0.0);
+            sampler.restart_at(1, i, position);
+            target.pass_sample(
+                camera,
+                &mut sampler,
+                &mut scratch,
+                &mut passed,
+                &mut rays,
+                &mut |group, point| {
+                    let entries: f32 = point
+                        .entries
+                        .iter()
+                        .map(|e| luminance(e.value.into()))
+                        .sum();
+                    assert!((entries - point.target).abs() <= 1e-5 * point.target);
+                    split[group] += point.target / target.points_per_sample(group) as f32;
+                },
+            );
+            assert_eq!(bootstrapped, passed, "sample {i}");
+            for g in 0..groups {
+                let tolerance = 1e-5 * bootstrapped[g].max(1e-20);
+                assert!(
+                    (split[g] - bootstrapped[g]).abs() <= tolerance,
+                    "sample {i} group {g}: points {} vs bootstrap {}",
+                    split[g],
+                    bootstrapped[g]
+                );
+                lit += (split[g] > 0.0) as u32;
+            }
+        }
+        assert!(lit > 100, "only {lit} lit groups");
     }
 
     /// A multiplexed chain's first state, picked from a bootstrap sample that evaluated all
