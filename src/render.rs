@@ -74,13 +74,16 @@ enum Estimator<'a> {
 
 impl Estimator<'_> {
     /// Film layers of a Metropolis render: one per group of chains, whose deposits are
-    /// scaled by the group's normalization, and in primary sample space one for the
-    /// normalization pass's samples (`PassImage`).
+    /// scaled by the group's normalization, and one for the normalization pass's samples
+    /// where they join the image (`PassImage`).
     fn chain_groups(&self) -> usize {
+        fn layers<T: PrimarySpaceTarget>(target: &T) -> usize {
+            target.groups() + target.pass_joins_the_image() as usize
+        }
         match *self {
-            Estimator::Pssmlt(target) => target.groups() + 1,
-            Estimator::Mmlt(target) => target.groups() + 1,
-            Estimator::PssmltBdpt(target) => target.groups() + 1,
+            Estimator::Pssmlt(target) => layers(target),
+            Estimator::Mmlt(target) => layers(target),
+            Estimator::PssmltBdpt(target) => layers(target),
             Estimator::PathSpaceMlt(_) => 1,
             Estimator::Path(_) | Estimator::Bdpt(_) | Estimator::Erpt(_) => 0,
         }

@@ -368,7 +368,6 @@ where
     /// Puts the pass's samples in the image (`PassImage`); a pass drawing nothing is left
     /// as it is.
     pub fn with_image(mut self, image: Option<PassImage>) -> Self {
-        debug_assert!(image.is_none() || !self.units.is_empty());
         self.image = image.filter(|_| !self.units.is_empty());
         if self.image.is_some() {
             let groups = self.estimate.group_sums.len();
