@@ -17,7 +17,7 @@
 //! - `MLT_BENCH_ALGORITHMS`: of `path, bdpt, pssmlt, pssmlt-bdpt, mmlt, path-space-mlt, erpt`
 //!   (default the four Metropolis variants).
 //! - `MLT_BENCH_NORMALIZATION`: values of `normalization_work_fraction` to compare
-//!   (default `0,0.1`: none, and the default).
+//!   (default 0 and the default fraction).
 //! - `MLT_BENCH_BOOTSTRAP`: values of `bootstrap_samples` to compare (default the default).
 //! - `MLT_BENCH_SEEDS`: renders per case (default 8; seeds 1, 2, …).
 //! - `MLT_BENCH_SECONDS`: the time limit of each render (default 30), or
@@ -28,7 +28,7 @@
 //!   machine, so each does a little less work in its time than alone.
 //! - `MLT_BENCH_REFERENCE_SPP`: the reference's samples per pixel (default 2048).
 //!
-//! The issue-15 table: `MLT_BENCH_NORMALIZATION=0.1 cargo bench --bench brightness`
+//! The issue-15 table: `MLT_BENCH_NORMALIZATION=0.05 cargo bench --bench brightness`
 //! (door-ajar and lamp-behind-glass, 8 seeds of 30 s on one thread).
 
 mod common;
@@ -75,7 +75,8 @@ fn main() {
             .unwrap_or_else(|| panic!("MLT_BENCH_ALGORITHMS: unknown {wanted:?}"))
     })
     .collect();
-    let ratios: Vec<f32> = env_names("MLT_BENCH_NORMALIZATION", &["0", "0.1"])
+    let default_fraction = RenderSettings::DEFAULT_NORMALIZATION_WORK_FRACTION.to_string();
+    let ratios: Vec<f32> = env_names("MLT_BENCH_NORMALIZATION", &["0", &default_fraction])
         .iter()
         .map(|r| r.parse().expect("MLT_BENCH_NORMALIZATION: numbers"))
         .collect();

@@ -227,17 +227,16 @@
 #define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
 
 /**
- * The default `normalization_work_fraction`, chosen by `benches/brightness.rs` (8 seeds
- * of 10 s on one thread, time-limited, so with a bootstrap of 2^18): 0.1 lowers the
- * reported error of b from 0.71% to 0.54% on door-ajar and cornell-glass for MMLT and
- * path-space MLT, and its share grows with the render, for 1–5% more RMSE (within the
- * bench's noise); 0.2 lowers it to 0.45% for 2–8.5% more RMSE. PSSMLT's large steps
- * (30% of its mutations) already make the share, so it costs PSSMLT nothing; MMLT's
- * pass samples join the image, which gives back about half of what they cost it
- * (door-ajar, 20 seeds of 10 s: RMSE 6.4% above a bootstrap alone without that, 4.1%
- * with it; 0.05 measured within noise of 0.1, 3.7%).
+ * The default `normalization_work_fraction`, chosen by `benches/brightness.rs`. Against
+ * a bootstrap alone (fraction 0), 20 seeds of 10 s on one thread on the four bench
+ * scenes, MMLT and path-space MLT: at 0.05 every median RMSE is within its standard
+ * error (0.5–5%) of fraction 0's (−1.8% to +1.7%), while the brightness spread over the
+ * seeds falls (lamp-behind-glass 0.77% → 0.57%) and goes on falling with the render's
+ * length; 0.1 cost up to 6% more RMSE (door-ajar), 0.2 up to 8.5%. PSSMLT's large
+ * steps (30% of its mutations) already make the share, so it costs PSSMLT nothing;
+ * MMLT's pass samples join the image, which gives back about half of what they cost.
  */
-#define RenderSettings_DEFAULT_NORMALIZATION_WORK_FRACTION 0.1
+#define RenderSettings_DEFAULT_NORMALIZATION_WORK_FRACTION 0.05
 
 /**
  * The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
@@ -526,7 +525,7 @@ typedef struct MltRenderSettings {
   /**
    * Metropolis: the share of the rays spent on independent samples of the chains' target,
    * drawn alongside the chains to go on estimating the normalization b, which sets the
-   * image's brightness; in [0, 0.9], default 0.1. The image is scaled by the final
+   * image's brightness; in [0, 0.9], default 0.05. The image is scaled by the final
    * estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
    * large steps), so its brightness error shrinks as the render goes on. 0: no such
    * samples.
@@ -734,9 +733,9 @@ enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
 enum MltStatus mlt_camera_default(struct MltCamera *out);
 
 /**
- * Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
- * pass (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
- * (2^18 samples at this size), 10% of the rays for the normalization pass,
+ * Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
+ * (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
+ * (2^18 samples at this size), 5% of the rays for the normalization pass,
  * 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
  * BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
  * 0.45 and radius 7 when `filter_buffers` turns it on).

@@ -215,7 +215,7 @@ pub struct MltRenderSettings {
     pub filter_radius: u32,
     /// Metropolis: the share of the rays spent on independent samples of the chains' target,
     /// drawn alongside the chains to go on estimating the normalization b, which sets the
-    /// image's brightness; in [0, 0.9], default 0.1. The image is scaled by the final
+    /// image's brightness; in [0, 0.9], default 0.05. The image is scaled by the final
     /// estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
     /// large steps), so its brightness error shrinks as the render goes on. 0: no such
     /// samples.
@@ -638,9 +638,9 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
     })
 }
 
-/// Fills `out` with the default settings: 256 x 256, primary-sample-space MLT with the direct
-/// pass (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
-/// (2^18 samples at this size), 10% of the rays for the normalization pass,
+/// Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
+/// (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
+/// (2^18 samples at this size), 5% of the rays for the normalization pass,
 /// 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
 /// BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
 /// 0.45 and radius 7 when `filter_buffers` turns it on).

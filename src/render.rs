@@ -348,16 +348,15 @@ impl RenderSettings {
     /// The default `direct_samples_per_mutation`: one, the best measured at equal time on
     /// the Cornell scenes (benches/equal_time.rs).
     pub const DEFAULT_DIRECT_SAMPLES_PER_MUTATION: u32 = 1;
-    /// The default `normalization_work_fraction`, chosen by `benches/brightness.rs` (8 seeds
-    /// of 10 s on one thread, time-limited, so with a bootstrap of 2^18): 0.1 lowers the
-    /// reported error of b from 0.71% to 0.54% on door-ajar and cornell-glass for MMLT and
-    /// path-space MLT, and its share grows with the render, for 1–5% more RMSE (within the
-    /// bench's noise); 0.2 lowers it to 0.45% for 2–8.5% more RMSE. PSSMLT's large steps
-    /// (30% of its mutations) already make the share, so it costs PSSMLT nothing; MMLT's
-    /// pass samples join the image, which gives back about half of what they cost it
-    /// (door-ajar, 20 seeds of 10 s: RMSE 6.4% above a bootstrap alone without that, 4.1%
-    /// with it; 0.05 measured within noise of 0.1, 3.7%).
-    pub const DEFAULT_NORMALIZATION_WORK_FRACTION: f32 = 0.1;
+    /// The default `normalization_work_fraction`, chosen by `benches/brightness.rs`. Against
+    /// a bootstrap alone (fraction 0), 20 seeds of 10 s on one thread on the four bench
+    /// scenes, MMLT and path-space MLT: at 0.05 every median RMSE is within its standard
+    /// error (0.5–5%) of fraction 0's (−1.8% to +1.7%), while the brightness spread over the
+    /// seeds falls (lamp-behind-glass 0.77% → 0.57%) and goes on falling with the render's
+    /// length; 0.1 cost up to 6% more RMSE (door-ajar), 0.2 up to 8.5%. PSSMLT's large
+    /// steps (30% of its mutations) already make the share, so it costs PSSMLT nothing;
+    /// MMLT's pass samples join the image, which gives back about half of what they cost.
+    pub const DEFAULT_NORMALIZATION_WORK_FRACTION: f32 = 0.05;
     /// The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
     /// cornell-glass and door-ajar (`benches/equal_time.rs`, medians of 3 renders of 10 s;
     /// 5 to 20 within noise of each other, 100, about Cline et al.'s length, 2 to 3 times

@@ -373,7 +373,7 @@ fn defaults_are_valid_and_documented() {
         (s.mutations_per_pixel, s.bootstrap_samples, s.chains),
         (32, 0, 1024)
     );
-    assert_eq!(s.normalization_work_fraction, 0.1);
+    assert_eq!(s.normalization_work_fraction, 0.05);
     assert_eq!(
         (
             s.large_step_probability,
