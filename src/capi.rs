@@ -7,10 +7,11 @@
 //! - a null pointer is accepted only where a count of 0 makes it unused, or where the header
 //!   says it is optional.
 
+use crate::accel::Backend;
 use crate::error::*;
-use crate::integrators::mlt::path_space::MutationWeights;
+use crate::integrators::mlt::driver::MutationWeights;
 use crate::render::{self, Algorithm, RenderSettings, StopReason};
-use crate::scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc};
+use crate::scene::{Camera, Material, MaterialKind, Scene, SceneDesc};
 use glam::Vec3A;
 use std::cell::RefCell;
 use std::ffi::{CString, c_char, c_void};

@@ -2,7 +2,17 @@
 //! an image normalized pixel by pixel (so a partial render is still a valid estimate).
 
 use crate::filter::{FilterSettings, FilterStats, filter_splats};
+use glam::Vec3;
 use rayon::prelude::*;
+
+/// A contribution to an arbitrary pixel (light tracing onto the film, Metropolis deposits),
+/// recorded by a work unit and added to the film in a fixed order so the image never depends
+/// on scheduling. 16 bytes: work units keep many.
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    pub pixel: u32,
+    pub value: Vec3,
+}
 
 pub struct Film {
     pub width: u32,
@@ -88,7 +98,7 @@ impl Film {
     pub fn add_chain_splats(
         &mut self,
         group: usize,
-        splats: &[crate::integrators::Splat],
+        splats: &[Splat],
         weight: f64,
         partial_scale: f64,
         buffer: usize,
@@ -110,7 +120,7 @@ impl Film {
     }
 
     /// Adds the splats of a work unit (in the unit's order) and the light paths it traced.
-    pub fn add_splats(&mut self, splats: &[crate::integrators::Splat], light_paths: u64) {
+    pub fn add_splats(&mut self, splats: &[Splat], light_paths: u64) {
         self.light_paths += light_paths;
         self.add_weighted_splats(splats, 1.0, 0);
     }
@@ -128,17 +138,12 @@ impl Film {
 
     /// Adds `weight` × the splats of a work unit, in the unit's order, and with the filter
     /// on also to partial image `buffer` (taken modulo their number).
-    pub fn add_weighted_splats(
-        &mut self,
-        splats: &[crate::integrators::Splat],
-        weight: f64,
-        buffer: usize,
-    ) {
+    pub fn add_weighted_splats(&mut self, splats: &[Splat], weight: f64, buffer: usize) {
         add_weighted(&mut self.splats, splats, weight);
         self.add_to_partial(splats, weight, buffer);
     }
 
-    fn add_to_partial(&mut self, splats: &[crate::integrators::Splat], weight: f64, buffer: usize) {
+    fn add_to_partial(&mut self, splats: &[Splat], weight: f64, buffer: usize) {
         let buffers = self.filter_buffers();
         if buffers > 0 {
             let buffer = buffer % buffers;
@@ -253,7 +258,7 @@ impl Film {
 }
 
 /// Adds `weight` × each splat to its pixel of `sums`, in order.
-fn add_weighted(sums: &mut [[f64; 3]], splats: &[crate::integrators::Splat], weight: f64) {
+fn add_weighted(sums: &mut [[f64; 3]], splats: &[Splat], weight: f64) {
     for splat in splats {
         let sum = &mut sums[splat.pixel as usize];
         for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {

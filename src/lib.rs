@@ -28,6 +28,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod capi;
+mod control;
 pub mod error;
 pub mod film;
 pub mod filter;
@@ -39,14 +40,15 @@ pub mod scene;
 #[cfg(feature = "cli")]
 pub mod io;
 
+pub use accel::Backend;
 pub use error::{Error, MltStatus, Result};
 pub use filter::FilterStats;
+pub use integrators::mlt::driver::{Mutation, MutationCounts, MutationWeights};
 pub use integrators::mlt::normalization::NormalizationStats;
-pub use integrators::mlt::path_space::{Mutation, MutationCounts, MutationWeights};
 pub use render::{
     Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
 };
-pub use scene::{Backend, Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
+pub use scene::{Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
 
 // One scene serves renders and queries from many threads at once.
 const _: () = {

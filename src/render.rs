@@ -1,26 +1,27 @@
 //! Render settings, their validation, and the driver that runs an integrator over the film in
 //! parallel with progress reporting, cancellation and a time limit.
 
+use crate::control::Control;
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
-use crate::film::Film;
+use crate::film::{Film, Splat};
 use crate::filter::{
     FilterSettings, FilterStats, MLT_MAX_FILTER_BUFFERS, MLT_MAX_FILTER_RADIUS,
     MLT_MAX_FILTER_STRENGTH, MLT_MIN_FILTER_BUFFERS,
 };
 use crate::integrators::bdpt::Bdpt;
+use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
-use crate::integrators::mlt::path_space::{
-    self, MutationCounts, MutationWeights, PathSpaceTarget, PerturbationSizes,
-};
-use crate::integrators::mlt::pssmlt::{self, PrimarySpaceTarget, PssmltOutcome, PssmltSettings};
+use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
+use crate::integrators::mlt::primary_space::{MetropolisSettings, PrimarySpaceTarget};
+use crate::integrators::mlt::pssmlt;
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
-use crate::integrators::{PixelEstimator, SampleCounters, Splat};
+use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::{Camera, CameraModel, Scene};
 use glam::Vec3A;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -102,10 +103,10 @@ impl Estimator<'_> {
         direct: Option<&PathTracer>,
         film: &mut Film,
         control: &Control,
-    ) -> PssmltOutcome {
+    ) -> MetropolisOutcome {
         let seed = settings.seed;
         let spp = settings.samples_per_pixel;
-        let chains = PssmltSettings {
+        let chains = MetropolisSettings {
             mutations_per_pixel: settings.mutations_per_pixel,
             bootstrap_samples: settings.resolved_bootstrap_samples(),
             chains: settings.chains,
@@ -134,11 +135,11 @@ impl Estimator<'_> {
         match *self {
             Estimator::Path(estimator) => {
                 CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
-                PssmltOutcome::default()
+                MetropolisOutcome::default()
             }
             Estimator::Bdpt(estimator) => {
                 CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
-                PssmltOutcome::default()
+                MetropolisOutcome::default()
             }
             Estimator::Pssmlt(target) => {
                 pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
@@ -648,16 +649,7 @@ fn render_into(
     let start = Instant::now();
     let deadline = (settings.time_limit_seconds > 0.0)
         .then(|| start + Duration::from_secs_f64(settings.time_limit_seconds));
-    let control = Control {
-        stop: AtomicBool::new(false),
-        cancelled: AtomicBool::new(false),
-        deadline,
-        samples_done: AtomicU64::new(0),
-        mutations_done: AtomicU64::new(0),
-        rays: AtomicU64::new(0),
-        invalid: AtomicU64::new(0),
-        mutations_are_work: settings.algorithm.is_metropolis(),
-    };
+    let control = Control::new(deadline, settings.algorithm.is_metropolis());
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
     // A Metropolis render with a direct pass leaves the shortest paths to a path tracer.
@@ -737,12 +729,11 @@ fn render_into(
             if let Some(callback) = progress.as_mut() {
                 let fraction = control.fraction(planned, start);
                 if !callback(fraction) {
-                    control.cancelled.store(true, Ordering::Relaxed);
-                    control.stop.store(true, Ordering::Relaxed);
+                    control.cancel();
                 }
             }
             if deadline.is_some_and(|d| Instant::now() >= d) {
-                control.stop.store(true, Ordering::Relaxed);
+                control.stop();
             }
         }
         worker.join()
@@ -757,7 +748,7 @@ fn render_into(
         &mut rgb_out[..needed],
         unfiltered_out.map(|u| &mut u[..needed]),
     );
-    let stop = if control.cancelled.load(Ordering::Relaxed) {
+    let stop = if control.was_cancelled() {
         StopReason::Cancelled
     } else if planned == 0 || control.work_done() < planned {
         StopReason::TimeLimitReached
@@ -853,58 +844,6 @@ fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
         });
     }
     Ok(film)
-}
-
-/// Shared state between the workers and the calling thread.
-pub(crate) struct Control {
-    /// Set when workers should finish their current band and start no more.
-    stop: AtomicBool,
-    cancelled: AtomicBool,
-    deadline: Option<Instant>,
-    pub(crate) samples_done: AtomicU64,
-    pub(crate) mutations_done: AtomicU64,
-    pub(crate) rays: AtomicU64,
-    pub(crate) invalid: AtomicU64,
-    /// Whether progress counts mutations (Metropolis) or camera samples only (ERPT, whose
-    /// mutations per sample are not known in advance).
-    mutations_are_work: bool,
-}
-
-impl Control {
-    pub(crate) fn should_stop(&self) -> bool {
-        if self.stop.load(Ordering::Relaxed) {
-            return true;
-        }
-        if self.deadline.is_some_and(|d| Instant::now() >= d) {
-            self.stop.store(true, Ordering::Relaxed);
-            return true;
-        }
-        false
-    }
-
-    /// Camera samples and mutations: the units of a render's plan.
-    fn work_done(&self) -> u64 {
-        let mutations = if self.mutations_are_work {
-            self.mutations_done.load(Ordering::Relaxed)
-        } else {
-            0
-        };
-        self.samples_done.load(Ordering::Relaxed) + mutations
-    }
-
-    /// Fraction done: by samples when a count was asked for, else by time.
-    fn fraction(&self, planned: u64, start: Instant) -> f32 {
-        let by_samples = if planned > 0 {
-            self.work_done() as f64 / planned as f64
-        } else {
-            0.0
-        };
-        let by_time = self.deadline.map_or(0.0, |d| {
-            let total = (d - start).as_secs_f64();
-            start.elapsed().as_secs_f64() / total
-        });
-        by_samples.max(by_time).clamp(0.0, 1.0) as f32
-    }
 }
 
 /// Per-work-unit state of a render: the estimator's scratch memory and the splats of the

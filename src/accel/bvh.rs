@@ -15,7 +15,7 @@
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
 
-use super::{Hit, Ray};
+use super::ray::{Hit, Ray};
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, Result};
 use glam::{BVec4A, Vec3A, Vec4};
 use obvhs::{

@@ -16,46 +16,37 @@ mod bvh;
 /// cbindgen:ignore
 #[cfg(feature = "embree")]
 pub mod embree;
+mod ray;
 
 pub use bvh::BvhAccel;
 #[doc(hidden)]
 pub use bvh::{BvhWidth, with_bvh_width};
 #[cfg(feature = "embree")]
 pub use embree::EmbreeAccel;
+pub use ray::{Hit, Ray};
 
 use crate::error::Result;
-use crate::scene::Backend;
 use glam::Vec3A;
 
-/// A ray with a parametric interval: points `origin + t * direction` for t in [tmin, tmax].
-#[derive(Clone, Copy, Debug)]
-pub struct Ray {
-    pub origin: Vec3A,
-    pub direction: Vec3A,
-    pub tmin: f32,
-    pub tmax: f32,
+/// Which ray-intersection backend a scene is built with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Backend {
+    /// mlt's own SIMD BVH, 8-wide on x86-64 CPUs with AVX2 and FMA, else 4-wide; built with
+    /// obvhs (always available).
+    #[default]
+    Bvh,
+    /// Intel Embree 3 (only with the `embree` cargo feature).
+    Embree,
 }
 
-impl Ray {
-    #[inline]
-    pub fn new(origin: Vec3A, direction: Vec3A, tmin: f32, tmax: f32) -> Self {
-        Ray {
-            origin,
-            direction,
-            tmin,
-            tmax,
+impl Backend {
+    /// Whether scenes can be built with this backend in this build of mlt.
+    pub const fn is_available(self) -> bool {
+        match self {
+            Backend::Bvh => true,
+            Backend::Embree => cfg!(feature = "embree"),
         }
     }
-}
-
-/// The closest intersection: internal triangle index, distance and barycentrics
-/// (the hit point is `(1-u-v)·v0 + u·v1 + v·v2`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    pub triangle: u32,
-    pub t: f32,
-    pub u: f32,
-    pub v: f32,
 }
 
 /// The backends. An enum, not a trait object, so the hot path dispatches without a vtable.

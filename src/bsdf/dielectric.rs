@@ -1,6 +1,6 @@
 //! Smooth dielectric interface: Fresnel-weighted choice between reflection and refraction.
 
-use super::{ScatterSample, TransportMode, reflect};
+use super::scattering::{ScatterSample, TransportMode, reflect};
 use glam::Vec3A;
 
 /// Unpolarized Fresnel reflectance for light arriving with |cos θ| = `cos_i` on the side

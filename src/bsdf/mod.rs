@@ -4,32 +4,15 @@
 //! new direction. `normal` is the triangle's front (counter-clockwise) geometric normal.
 
 mod dielectric;
+mod scattering;
 
 pub use dielectric::fresnel_dielectric;
+pub use scattering::{ScatterSample, TransportMode, reflect};
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::scene::{Material, MaterialKind};
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
-
-/// Which quantity a path carries; refraction scales radiance but not importance.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TransportMode {
-    Radiance,
-    Importance,
-}
-
-/// A sampled scattering direction.
-#[derive(Clone, Copy, Debug)]
-pub struct ScatterSample {
-    pub wi: Vec3A,
-    /// BSDF × |cos θi| / pdf: the factor the path throughput is multiplied by.
-    pub weight: Vec3A,
-    /// Solid-angle density of `wi` (for specular lobes, the discrete lobe probability).
-    pub pdf: f32,
-    /// A Dirac lobe: no other strategy can generate this direction.
-    pub specular: bool,
-}
 
 /// Samples a direction `wi` given `wo`. `u` picks the direction, `u_lobe` the lobe.
 #[inline]
@@ -172,12 +155,6 @@ pub fn specular_direction(
         }
         _ => None,
     }
-}
-
-/// Mirror reflection of `wo` about `normal` (either orientation).
-#[inline]
-pub fn reflect(wo: Vec3A, normal: Vec3A) -> Vec3A {
-    normal * (2.0 * wo.dot(normal)) - wo
 }
 
 #[cfg(test)]

@@ -13,9 +13,9 @@
 //! Russian roulette is not used: subpaths end at the depth limit, which keeps the densities
 //! of both directions exact for MIS.
 
-use super::mlt::path_space::PathVertex;
-use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
+use super::{PathVertex, PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
+use crate::film::Splat;
 use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere, uniform_triangle};
 use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;

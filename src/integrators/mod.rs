@@ -5,17 +5,20 @@ pub mod mlt;
 pub mod path;
 
 use crate::accel::Ray;
+use crate::film::Splat;
 use crate::sampling::Rng;
 use crate::scene::{CameraModel, Scene};
-use glam::{Vec3, Vec3A};
+use glam::Vec3A;
 
-/// A contribution to an arbitrary pixel (light tracing onto the film, Metropolis deposits),
-/// recorded by a work unit and added to the film in a fixed order so the image never depends
-/// on scheduling. 16 bytes: work units keep many.
-#[derive(Clone, Copy, Debug)]
-pub struct Splat {
-    pub pixel: u32,
-    pub value: Vec3,
+/// A vertex of a light path: a point on a light (the first), on a surface, or on the lens
+/// (the last).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PathVertex {
+    pub p: Vec3A,
+    /// The triangle's front geometric normal; the camera's view direction for the lens.
+    pub normal: Vec3A,
+    /// Internal triangle index (unused for the lens).
+    pub triangle: u32,
 }
 
 /// Counters a sample updates; summed per work unit.

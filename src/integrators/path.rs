@@ -1,8 +1,9 @@
 //! Unidirectional path tracing: BSDF importance sampling, next-event estimation to area
 //! lights, multiple importance sampling (power heuristic) and Russian roulette.
 
-use super::{PixelEstimator, SampleCounters, Splat, shadow_ray, spawn_ray};
+use super::{PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{self, TransportMode};
+use crate::film::Splat;
 use crate::sampling::{Rng, Sampler, power_heuristic, uniform_triangle};
 use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;

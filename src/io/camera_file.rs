@@ -3,7 +3,7 @@
 //! (0 by default: a pinhole focused on the target). Unknown keys are rejected, so a typo
 //! does not silently fall back to a default.
 
-use super::{CameraFile, IoError};
+use super::scene_data::{CameraFile, IoError};
 use crate::Camera;
 use crate::render::MLT_MAX_IMAGE_SIDE;
 use serde::Deserialize;

@@ -1,7 +1,7 @@
 //! glTF 2.0 (`.gltf` with external or data-URI buffers, `.glb`); the mapping is documented on
 //! [`super::load_scene`].
 
-use super::{CameraFile, GLTF_DEFAULT_HEIGHT, IoError, SceneData};
+use super::scene_data::{CameraFile, GLTF_DEFAULT_HEIGHT, IoError, SceneData};
 use crate::{Camera, Material};
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;

@@ -1,7 +1,7 @@
 //! Image output: the renderer's linear RGB f32 buffer (rows top to bottom) as PFM, OpenEXR or
 //! 8-bit sRGB PNG.
 
-use super::IoError;
+use super::scene_data::IoError;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 

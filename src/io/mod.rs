@@ -34,92 +34,13 @@ mod camera_file;
 mod gltf_file;
 mod image_file;
 mod obj;
+mod scene_data;
 
-use crate::{Backend, Camera, Material, SceneDesc};
-use std::fmt;
 use std::path::Path;
 
 pub use camera_file::load_camera_json;
 pub use image_file::{ImageFormat, read_pfm, write_exr, write_image, write_pfm, write_png};
-
-/// Albedo of the diffuse material given to OBJ faces without a material, and of
-/// materials without `Kd`.
-pub(crate) const DEFAULT_ALBEDO: [f32; 3] = [0.8, 0.8, 0.8];
-
-/// Size of the image when a glTF camera gives no aspect ratio (square), and its height
-/// otherwise.
-pub(crate) const GLTF_DEFAULT_HEIGHT: u32 = 512;
-
-/// An error reading or writing a file: a sentence naming the file and what is wrong.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct IoError {
-    pub message: String,
-}
-
-impl IoError {
-    pub fn new(message: impl Into<String>) -> Self {
-        IoError {
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for IoError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
-    }
-}
-
-impl std::error::Error for IoError {}
-
-/// A camera and the image size it was set up for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraFile {
-    pub camera: Camera,
-    pub width: u32,
-    pub height: u32,
-}
-
-/// A loaded scene: the flat arrays [`crate::SceneDesc`] borrows, plus the camera the file
-/// came with, if any.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SceneData {
-    /// x, y, z per vertex.
-    pub positions: Vec<f32>,
-    /// Three vertex indices per triangle, counter-clockwise front.
-    pub indices: Vec<u32>,
-    /// One index into `materials` per triangle.
-    pub material_ids: Vec<u32>,
-    pub materials: Vec<Material>,
-    /// The name of each material in `materials` (same length), for error messages.
-    pub material_names: Vec<String>,
-    /// The OBJ's `NAME.camera.json` sidecar or the glTF's first camera.
-    pub camera: Option<CameraFile>,
-}
-
-impl SceneData {
-    /// Borrows the arrays as a scene description for [`crate::Scene::new`].
-    pub fn desc(&self, backend: Backend) -> SceneDesc<'_> {
-        SceneDesc {
-            positions: &self.positions,
-            indices: &self.indices,
-            material_ids: &self.material_ids,
-            materials: &self.materials,
-            backend,
-        }
-    }
-
-    pub fn triangle_count(&self) -> usize {
-        self.indices.len() / 3
-    }
-
-    /// Adds `material` (named `name`) and returns its index.
-    fn push_material(&mut self, name: String, material: Material) -> u32 {
-        self.materials.push(material);
-        self.material_names.push(name);
-        (self.materials.len() - 1) as u32
-    }
-}
+pub use scene_data::{CameraFile, IoError, SceneData};
 
 /// Loads a scene by its file extension (case-insensitive):
 ///

@@ -1,6 +1,7 @@
 //! Wavefront OBJ + MTL through tobj; the material mapping is documented in the module docs.
 
-use super::{DEFAULT_ALBEDO, IoError, SceneData, load_camera_json};
+use super::camera_file::load_camera_json;
+use super::scene_data::{DEFAULT_ALBEDO, IoError, SceneData};
 use crate::Material;
 use std::cell::RefCell;
 use std::collections::HashSet;

@@ -6,31 +6,10 @@ mod material;
 pub use camera::{Camera, CameraModel};
 pub use material::{Material, MaterialKind};
 
-use crate::accel::{Accel, Hit, Ray};
+use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::sampling::Distribution1D;
 use glam::Vec3A;
-
-/// Which ray-intersection backend a scene is built with.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Backend {
-    /// mlt's own SIMD BVH, 8-wide on x86-64 CPUs with AVX2 and FMA, else 4-wide; built with
-    /// obvhs (always available).
-    #[default]
-    Bvh,
-    /// Intel Embree 3 (only with the `embree` cargo feature).
-    Embree,
-}
-
-impl Backend {
-    /// Whether scenes can be built with this backend in this build of mlt.
-    pub const fn is_available(self) -> bool {
-        match self {
-            Backend::Bvh => true,
-            Backend::Embree => cfg!(feature = "embree"),
-        }
-    }
-}
 
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
 #[derive(Clone, Copy, Debug)]

@@ -16,7 +16,7 @@
 #[doc(hidden)]
 pub mod ffi;
 
-use super::{Hit, Ray};
+use super::ray::{Hit, Ray};
 use crate::error::{
     Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, MLT_STATUS_UNSUPPORTED, MltStatus,
     Result,

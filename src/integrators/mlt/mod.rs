@@ -1,9 +1,11 @@
 //! Metropolis light transport: Markov chains whose states are light paths (or the random
 //! numbers that generate them), accepted with the Metropolis–Hastings rule.
 
+pub mod driver;
 pub mod image_chain;
 pub mod normalization;
 pub mod path_space;
+pub mod primary_space;
 pub mod pss;
 pub mod pssmlt;
 pub mod targets;

@@ -56,11 +56,11 @@
 //! render reports its own brightness uncertainty (`RenderStats::normalization_relative_error`)
 //! and the share of b its brightest single sample carried.
 
+use super::primary_space::{MetropolisSettings, PrimarySpaceTarget, new_sampler};
 use super::pss::PssSampler;
-use super::pssmlt::{PrimarySpaceTarget, PssmltSettings, new_sampler};
+use crate::control::Control;
 use crate::film::Film;
-use crate::integrators::Splat;
-use crate::render::Control;
+use crate::film::Splat;
 use crate::sampling::Rng;
 use crate::scene::CameraModel;
 use rayon::prelude::*;
@@ -328,7 +328,7 @@ where
     pub fn new(
         target: &'a T,
         camera: &'a CameraModel,
-        settings: &PssmltSettings,
+        settings: &MetropolisSettings,
         estimate: NormalizationEstimate,
     ) -> Self {
         let groups = target.groups();

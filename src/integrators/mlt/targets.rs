@@ -3,9 +3,9 @@
 //! BDPT), and BDPT with the path depth and one strategy picked by the chain (multiplexed MLT,
 //! Hachisuka et al. 2014).
 
-use super::path_space::PathVertex;
+use super::primary_space::{PathSample, PrimarySpaceTarget, film_position};
 use super::pss::PssSampler;
-use super::pssmlt::{PathSample, PrimarySpaceTarget, film_position};
+use crate::integrators::PathVertex;
 use crate::integrators::bdpt::{
     Bdpt, BdptScratch, CAMERA_STREAM, CONNECTION_STREAM, Contribution, STREAMS,
 };
@@ -541,7 +541,7 @@ mod tests {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/cornell-glass.obj");
         let data = crate::io::load_scene(&path).unwrap();
-        let scene = Scene::new(&data.desc(crate::scene::Backend::Bvh)).unwrap();
+        let scene = Scene::new(&data.desc(crate::accel::Backend::Bvh)).unwrap();
         let camera = data.camera.unwrap().camera.model(32, 32);
         let bdpt = |min_depth| Bdpt {
             scene: &scene,
@@ -621,7 +621,7 @@ mod tests {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/cornell-glass.obj");
         let data = crate::io::load_scene(&path).unwrap();
-        let scene = Scene::new(&data.desc(crate::scene::Backend::Bvh)).unwrap();
+        let scene = Scene::new(&data.desc(crate::accel::Backend::Bvh)).unwrap();
         let camera = data.camera.unwrap().camera.model(32, 32);
         for min_depth in [0, 2] {
             let target = BdptMultiplexed(Bdpt {

@@ -300,8 +300,9 @@ fn sample_direction(
 mod tests {
     use super::super::test_geometry::Rect;
     use super::*;
+    use crate::accel::Backend;
     use crate::integrators::mlt::acceptance;
-    use crate::scene::{Backend, Camera, CameraModel, Material, Scene, SceneDesc};
+    use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
     use glam::DVec3;
     use std::f64::consts::PI;
 

@@ -1,20 +1,21 @@
 //! The path-space render: BDPT bootstrap for b, chains seeded from resampled bootstrap
 //! paths, and rounds of mutations with expected-value deposits, run by the same driver as
-//! the primary-sample-space chains (`pssmlt::run_rounds`).
+//! the primary-sample-space chains (`driver::run_rounds`).
 
 use super::bidirectional::Bidirectional;
 use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
+use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::acceptance;
-use crate::integrators::mlt::normalization::NormalizationPass;
-use crate::integrators::mlt::pssmlt::{
-    self, ChainPlan, Deposits, MarkovChain, PathSample, PssmltOutcome, PssmltSettings,
-    WeightedChain,
+use crate::integrators::mlt::driver::{
+    self, ChainPlan, Deposits, MarkovChain, MetropolisOutcome, Mutation, MutationCounts,
+    MutationWeights, WeightedChain,
 };
+use crate::integrators::mlt::normalization::NormalizationPass;
+use crate::integrators::mlt::primary_space::{self, MetropolisSettings, PathSample};
 use crate::integrators::mlt::targets::BdptAllStrategies;
-use crate::render::Control;
 use crate::sampling::Rng;
 use crate::scene::CameraModel;
 use rayon::prelude::*;
@@ -23,52 +24,6 @@ use std::marker::PhantomData;
 /// Stream offsets of the chains' random numbers and of their seed choices.
 const CHAIN_STREAM: u64 = 0x5eed_9a7b_0000_0000;
 const SEED_CHOICE_STREAM: u64 = 0x5eed_9a7c_0000_0000;
-
-/// The mutations of a path-space chain.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mutation {
-    Bidirectional = 0,
-    Lens = 1,
-    Caustic = 2,
-    MultiChain = 3,
-}
-
-impl Mutation {
-    pub const ALL: [Mutation; 4] = [
-        Mutation::Bidirectional,
-        Mutation::Lens,
-        Mutation::Caustic,
-        Mutation::MultiChain,
-    ];
-}
-
-/// Relative probabilities of the mutations; each step picks among those the current path
-/// admits (the bidirectional mutation always applies; exactly one of the lens and
-/// multi-chain perturbations does; the caustic perturbation needs `… D S+ D E`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MutationWeights(pub [f32; 4]);
-
-impl Default for MutationWeights {
-    fn default() -> Self {
-        MutationWeights([0.5, 0.25, 0.25, 0.25])
-    }
-}
-
-/// Proposals and acceptances per mutation (indexed by `Mutation as usize`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct MutationCounts {
-    pub proposed: [u64; 4],
-    pub accepted: [u64; 4],
-}
-
-impl MutationCounts {
-    pub fn add(&mut self, other: &MutationCounts) {
-        for m in 0..4 {
-            self.proposed[m] += other.proposed[m];
-            self.accepted[m] += other.accepted[m];
-        }
-    }
-}
 
 /// What the chains explore: paths of the scene through the camera, within a depth range.
 pub(crate) struct PathSpaceTarget<'a> {
@@ -193,10 +148,10 @@ impl<'a> MarkovChain for PathChain<'a> {
         };
         // Expected-value deposits: each carries f⃗/f, so a state counts once per visit.
         if a > 0.0 {
-            pssmlt::deposit(&mut deposits.chain, &self.proposal_sample, a, 0.0);
+            driver::deposit(&mut deposits.chain, &self.proposal_sample, a, 0.0);
         }
         if a < 1.0 {
-            pssmlt::deposit(&mut deposits.chain, &self.current_sample, 1.0 - a, 0.0);
+            driver::deposit(&mut deposits.chain, &self.current_sample, 1.0 - a, 0.0);
         }
         if self.rng.uniform() < a {
             std::mem::swap(&mut self.current, &mut self.proposal);
@@ -223,23 +178,23 @@ impl<'a> MarkovChain for PathChain<'a> {
     }
 }
 
-/// Runs path-space MLT; see `pssmlt::run` for `after_round`. With `adapt_weights`, the
+/// Runs path-space MLT; see `driver::run` for `after_round`. With `adapt_weights`, the
 /// mutation weights are adapted after a warm-up (see `adapted_weights`).
 pub(crate) fn run(
     target: &PathSpaceTarget,
-    settings: &PssmltSettings,
+    settings: &MetropolisSettings,
     adapt_weights: bool,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
-) -> PssmltOutcome {
+) -> MetropolisOutcome {
     let camera = &target.camera;
     // 1. Bootstrap with BDPT, all strategies summed: b = ∫ f.
     let n = settings.bootstrap_samples as u64;
-    let boot = pssmlt::bootstrap(&target.bdpt, camera, settings, control);
+    let boot = driver::bootstrap(&target.bdpt, camera, settings, control);
     let b = boot.estimate.b()[0];
     if b <= 0.0 || !b.is_finite() {
-        let mut outcome = pssmlt::finish_without_light(
+        let mut outcome = driver::finish_without_light(
             camera,
             settings,
             &boot.estimate,
@@ -255,8 +210,8 @@ pub(crate) fn run(
     // the normalization goes on being estimated with more BDPT samples alongside them.
     let plan = ChainPlan::new(&[b], camera, settings);
     let mut pass = NormalizationPass::new(&target.bdpt, camera, settings, boot.estimate.clone());
-    let seed_chains = |boot: &pssmlt::Bootstrap, seed: u64, first_stream: u64| {
-        let seeds = pssmlt::resample_seeds(boot, &plan.chains_per_group, seed);
+    let seed_chains = |boot: &driver::Bootstrap, seed: u64, first_stream: u64| {
+        let seeds = driver::resample_seeds(boot, &plan.chains_per_group, seed);
         seeds
             .into_par_iter()
             .enumerate()
@@ -280,7 +235,7 @@ pub(crate) fn run(
     let mut chains = seed_chains(&boot, settings.seed, 0);
     // The second phase seeds its chains from the bootstrap too; otherwise free it now.
     let boot = adapting.then_some(boot);
-    let mut outcome = pssmlt::run_rounds(
+    let mut outcome = driver::run_rounds(
         target,
         camera,
         &mut chains,
@@ -293,7 +248,7 @@ pub(crate) fn run(
     );
     outcome.mutation_weights = target.weights;
     let Some(boot) = boot.filter(|_| !control.should_stop()) else {
-        outcome.normalization = pssmlt::normalize(film, pass, &chains);
+        outcome.normalization = driver::normalize(film, pass, &chains);
         return outcome;
     };
     let mut counts = MutationCounts::default();
@@ -315,7 +270,7 @@ pub(crate) fn run(
     // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
     let mut chains = seed_chains(&boot, settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
     drop(boot);
-    let rest = pssmlt::run_rounds(
+    let rest = driver::run_rounds(
         &adapted,
         camera,
         &mut chains,
@@ -329,7 +284,7 @@ pub(crate) fn run(
     outcome.mutations += rest.mutations;
     outcome.accepted += rest.accepted;
     outcome.mutation_counts.add(&rest.mutation_counts);
-    outcome.normalization = pssmlt::normalize(film, pass, &chains);
+    outcome.normalization = driver::normalize(film, pass, &chains);
     outcome
 }
 
@@ -380,7 +335,7 @@ const MAX_ADAPTATION: f32 = 8.0;
 /// stream `stream`.
 fn seed_chain<'a>(
     target: &PathSpaceTarget<'a>,
-    settings: &PssmltSettings,
+    settings: &MetropolisSettings,
     index: u64,
     bootstrap_samples: u64,
     stream: u64,
@@ -388,9 +343,9 @@ fn seed_chain<'a>(
     let camera = &target.camera;
     let space = target.space();
     let max_vertices = target.bdpt.0.max_depth as usize + 2;
-    let mut sampler = pssmlt::new_sampler(&target.bdpt, settings);
-    pssmlt::restart_as_bootstrap(&mut sampler, settings, camera, index, bootstrap_samples);
-    let mut scratch = crate::integrators::mlt::pssmlt::PrimarySpaceTarget::scratch(&target.bdpt);
+    let mut sampler = primary_space::new_sampler(&target.bdpt, settings);
+    driver::restart_as_bootstrap(&mut sampler, settings, camera, index, bootstrap_samples);
+    let mut scratch = primary_space::PrimarySpaceTarget::scratch(&target.bdpt);
     let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + stream);
     let mut current = Vec::with_capacity(max_vertices);
     let mut current_sample = PathSample::with_capacity(1);

@@ -46,16 +46,16 @@
 //! the render's samples and the estimate stays unbiased given it) estimates the mean energy
 //! ē of a camera sample (its strategies summed), and e_d = ē / L.
 
-use super::chain::{MutationCounts, MutationWeights};
 use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
+use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::{Bdpt, BdptScratch};
 use crate::integrators::mlt::acceptance;
+use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
-use crate::integrators::mlt::pssmlt::{PathSample, PssmltOutcome};
+use crate::integrators::mlt::primary_space::PathSample;
 use crate::integrators::{PixelEstimator, SampleCounters};
-use crate::render::Control;
 use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::CameraModel;
 use glam::Vec3A;
@@ -372,7 +372,7 @@ pub(crate) fn run(
     settings: &ErptSettings,
     film: &mut Film,
     control: &Control,
-) -> PssmltOutcome {
+) -> MetropolisOutcome {
     let (width, height) = (camera.width, camera.height);
     let pixels = width as usize * height as usize;
     let chain_length = settings.chain_length.max(1);
@@ -422,7 +422,7 @@ pub(crate) fn run(
         })
         .collect();
     let seed = settings.seed ^ SEED_SALT;
-    let mut outcome = PssmltOutcome {
+    let mut outcome = MetropolisOutcome {
         normalization: NormalizationStats {
             value: deposit_energy as f64,
             ..Default::default()

@@ -34,26 +34,15 @@ mod perturbation;
 #[cfg(test)]
 mod test_geometry;
 
-pub use chain::{Mutation, MutationCounts, MutationWeights};
 pub(crate) use chain::{PathSpaceTarget, run};
 pub(crate) use erpt::{ErptSettings, run as run_erpt};
 pub(crate) use perturbation::PerturbationSizes;
 
 use crate::bsdf::{self, TransportMode};
+use crate::integrators::PathVertex;
 use crate::scene::{CameraModel, MaterialKind, Scene};
 use glam::Vec3A;
 use std::f32::consts::PI;
-
-/// A vertex of a light path: a point on a light (the first), on a surface, or on the lens
-/// (the last).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct PathVertex {
-    pub p: Vec3A,
-    /// The triangle's front geometric normal; the camera's view direction for the lens.
-    pub normal: Vec3A,
-    /// Internal triangle index (unused for the lens).
-    pub triangle: u32,
-}
 
 /// The scene and camera a path lives in, with the functions that evaluate paths.
 pub(crate) struct PathSpace<'a> {
@@ -250,10 +239,11 @@ impl PathSpace<'_> {
 #[cfg(all(test, feature = "cli"))]
 mod tests {
     use super::*;
+    use crate::accel::Backend;
     use crate::integrators::SampleCounters;
     use crate::integrators::bdpt::Bdpt;
     use crate::sampling::Rng;
-    use crate::scene::{Backend, Camera, SceneDesc};
+    use crate::scene::{Camera, SceneDesc};
 
     /// A scene of tests/scenes with its camera.
     fn canonical(name: &str) -> (Scene, Camera) {

@@ -436,7 +436,8 @@ fn proposal(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{Backend, Camera, CameraModel, Material, Scene, SceneDesc};
+    use crate::accel::Backend;
+    use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
 
     /// Fixed moves, to set up a given proposal: a film offset, and directions turned by a
     /// fixed rotation.
