@@ -418,13 +418,22 @@ fn status_string_of_every_value() {
     }
 }
 
+/// Releasing NULL touches nothing: the thread's last error stays as it was, and scenes are
+/// created and released as before.
 #[test]
-fn release_null_is_a_no_op() {
+fn release_null_leaves_the_last_error_and_the_library_as_they_were() {
+    let mut out = sentinel_scene();
+    // SAFETY: NULL desc must be rejected.
+    let status = unsafe { mlt_scene_create(null(), &mut out) };
+    assert_invalid(status, &["desc", "NULL"]);
+    let error = last_error();
     // SAFETY: NULL is documented as a no-op.
     unsafe {
         mlt_scene_release(null_mut());
         mlt_scene_release(null_mut());
     }
+    assert_eq!(last_error(), error);
+    drop(HostScene::floor_and_light().create());
 }
 
 #[test]

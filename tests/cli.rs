@@ -24,6 +24,21 @@ fn mlt_render(args: &[&dyn AsRef<std::ffi::OsStr>]) -> Output {
         .expect("mlt-render runs")
 }
 
+/// Every line of a render summary after the first is a label in one column and its value
+/// starting in the next.
+fn assert_summary_lines_up(stdout: &str) {
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert!(lines[0].starts_with("mlt-render: "), "{stdout}");
+    for line in &lines[1..] {
+        let (label, value) = (&line[..15], &line[15..]);
+        assert!(
+            label.starts_with("  ") && !label[2..].starts_with(' ') && value.starts_with(' '),
+            "{line:?} in:\n{stdout}"
+        );
+        assert!(!value[1..].starts_with(' '), "{line:?} in:\n{stdout}");
+    }
+}
+
 /// Exit status 1 and exactly one stderr line `mlt-render: ...` without a panic; returns it.
 fn assert_one_line_error(output: &Output) -> String {
     let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
@@ -61,15 +76,17 @@ fn renders_the_cornell_box_to_pfm_and_prints_a_summary() {
         "stdout: {stdout}\nstderr: {stderr}"
     );
     for needle in [
+        "(32 x 32, path, max depth",
         "wall time",
-        "samples    2048 (2.00 per pixel)",
+        "samples       2048 (2.00 per pixel)",
         "samples/s",
         "Mrays/s",
-        "threads    2",
-        "completed",
+        "threads       2",
+        "status        completed",
     ] {
         assert!(stdout.contains(needle), "missing {needle:?} in:\n{stdout}");
     }
+    assert_summary_lines_up(&stdout);
 
     let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
     assert_eq!((w, h), (32, 32));
@@ -113,16 +130,18 @@ fn the_default_algorithm_is_metropolis_and_its_summary_counts_mutations() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{output:?}");
     for needle in [
-        "Mmlt",
+        // The algorithm as the user names it.
+        "(32 x 32, mmlt, max depth",
         // The direct pass: one camera sample per mutation.
-        "samples    2048 (2.00 per pixel)",
-        "mutations  2048 (2.00 per pixel)",
+        "samples       2048 (2.00 per pixel)",
+        "mutations     2048 (2.00 per pixel)",
         "mutations/s",
-        "metropolis b = ",
-        "completed",
+        "metropolis    b = ",
+        "status        completed",
     ] {
         assert!(stdout.contains(needle), "missing {needle:?} in:\n{stdout}");
     }
+    assert_summary_lines_up(&stdout);
     let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
     assert_eq!((w, h), (32, 32));
     assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
@@ -255,7 +274,8 @@ fn erpt_takes_its_settings_and_reports_mutations() {
     ]);
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{output:?}");
-    assert!(stdout.contains("erpt e_d = 0.000500"), "{stdout}");
+    assert!(stdout.contains("erpt          e_d = 0.000500"), "{stdout}");
+    assert_summary_lines_up(&stdout);
     let mutations: u64 = stdout
         .lines()
         .find(|l| l.trim_start().starts_with("mutations "))
@@ -284,7 +304,7 @@ fn erpt_takes_its_settings_and_reports_mutations() {
 }
 
 #[test]
-fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
+fn time_limit_with_unbounded_samples_completes_at_the_limit_and_says_so() {
     let out = temp_path("timed.png");
     let output = mlt_render(&[
         &scene("cornell-box.obj"),
@@ -305,9 +325,38 @@ fn time_limit_with_unbounded_samples_stops_early_and_says_so() {
     ]);
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{output:?}");
-    assert!(stdout.contains("time limit"), "{stdout}");
+    // The user asked for exactly that: not "stopped early".
+    assert!(
+        stdout.contains("status        completed at the time limit of 0.3 s"),
+        "{stdout}"
+    );
     let image = image::open(&out).unwrap();
     assert_eq!((image.width(), image.height()), (16, 16));
+
+    // A sample count the time limit cuts short is stopping early.
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--algorithm",
+        &"path",
+        &"--spp",
+        &"1000000",
+        &"--time-limit",
+        &"0.3",
+        &"--width",
+        &"16",
+        &"--height",
+        &"16",
+        &"--threads",
+        &"1",
+        &"--out",
+        &out,
+    ]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{output:?}");
+    assert!(
+        stdout.contains("status        stopped early: time limit of 0.3 s reached"),
+        "{stdout}"
+    );
     std::fs::remove_file(&out).unwrap();
 }
 

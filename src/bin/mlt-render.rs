@@ -349,6 +349,11 @@ fn progress_bar() -> ProgressBar {
     bar
 }
 
+/// A line of the summary: the label in a column wide enough for every label.
+fn row(label: &str, value: impl std::fmt::Display) {
+    println!("  {label:<13} {value}");
+}
+
 fn print_summary(
     args: &Args,
     scene: &Scene,
@@ -359,69 +364,103 @@ fn print_summary(
     let info = scene.info();
     let pixels = settings.width as f64 * settings.height as f64;
     let seconds = stats.seconds.max(1e-9);
+    // A render asked for no sample or mutation count runs until its time limit: reaching it
+    // is finishing, not stopping early.
+    let planned_by_time = if settings.algorithm.is_metropolis() {
+        settings.mutations_per_pixel == 0
+    } else {
+        settings.samples_per_pixel == 0
+    };
     let stop = match stats.stop {
         StopReason::Completed => "completed".to_owned(),
         StopReason::Cancelled => "stopped early: cancelled".to_owned(),
+        StopReason::TimeLimitReached if planned_by_time => format!(
+            "completed at the time limit of {} s",
+            settings.time_limit_seconds
+        ),
         StopReason::TimeLimitReached => format!(
-            "stopped early: time limit of {} s reached",
+            "stopped early: time limit of {} s reached before the planned work",
             settings.time_limit_seconds
         ),
     };
+    let algorithm = args
+        .algorithm
+        .to_possible_value()
+        .map_or_else(String::new, |v| v.get_name().to_owned());
     println!(
-        "mlt-render: {} -> {} ({} x {}, {:?}, max depth {})",
+        "mlt-render: {} -> {} ({} x {}, {algorithm}, max depth {})",
         args.scene.display(),
         args.out.display(),
         settings.width,
         settings.height,
-        settings.algorithm,
         settings.max_depth
     );
-    println!(
-        "  scene      {} triangles, {} emitters, {} backend, loaded in {:.3} s",
-        info.triangle_count,
-        info.emitter_count,
-        format!("{:?}", args.backend).to_lowercase(),
-        load_seconds
+    row(
+        "scene",
+        format!(
+            "{} triangles, {} emitters, {} backend, loaded in {:.3} s",
+            info.triangle_count,
+            info.emitter_count,
+            format!("{:?}", args.backend).to_lowercase(),
+            load_seconds
+        ),
     );
-    println!("  wall time  {:.3} s", stats.seconds);
-    println!(
-        "  samples    {} ({:.2} per pixel)",
-        stats.samples,
-        stats.samples as f64 / pixels
+    row("wall time", format!("{:.3} s", stats.seconds));
+    row(
+        "samples",
+        format!(
+            "{} ({:.2} per pixel)",
+            stats.samples,
+            stats.samples as f64 / pixels
+        ),
     );
-    println!("  samples/s  {:.3} M", stats.samples as f64 / seconds / 1e6);
+    row(
+        "samples/s",
+        format!("{:.3} M", stats.samples as f64 / seconds / 1e6),
+    );
     if settings.algorithm.is_metropolis() || settings.algorithm == mlt::Algorithm::Erpt {
-        println!(
-            "  mutations  {} ({:.2} per pixel)",
-            stats.mutations,
-            stats.mutations as f64 / pixels
+        row(
+            "mutations",
+            format!(
+                "{} ({:.2} per pixel)",
+                stats.mutations,
+                stats.mutations as f64 / pixels
+            ),
         );
-        println!(
-            "  mutations/s {:.3} M",
-            stats.mutations as f64 / seconds / 1e6
+        row(
+            "mutations/s",
+            format!("{:.3} M", stats.mutations as f64 / seconds / 1e6),
         );
     }
-    println!(
-        "  rays       {} ({:.3} Mrays/s)",
-        stats.rays,
-        stats.rays as f64 / seconds / 1e6
+    row(
+        "rays",
+        format!(
+            "{} ({:.3} Mrays/s)",
+            stats.rays,
+            stats.rays as f64 / seconds / 1e6
+        ),
     );
-    println!("  threads    {}", stats.threads);
+    row("threads", stats.threads);
+    let accepted = 100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64;
     if settings.algorithm == mlt::Algorithm::Erpt {
-        println!(
-            "  erpt e_d = {:.6}, {:.1}% of mutations accepted",
-            stats.normalization.value,
-            100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
+        row(
+            "erpt",
+            format!(
+                "e_d = {:.6}, {accepted:.1}% of mutations accepted",
+                stats.normalization.value
+            ),
         );
     } else if stats.normalization.value > 0.0 {
         let b = stats.normalization;
-        println!(
-            "  metropolis b = {:.6} ± {:.2}% (from {} samples, the brightest {:.3}% of it), {:.1}% of mutations accepted",
-            b.value,
-            100.0 * b.relative_error,
-            b.samples,
-            100.0 * b.largest_share,
-            100.0 * stats.accepted_mutations as f64 / stats.mutations.max(1) as f64
+        row(
+            "metropolis",
+            format!(
+                "b = {:.6} ± {:.2}% (from {} samples, the brightest {:.3}% of it), {accepted:.1}% of mutations accepted",
+                b.value,
+                100.0 * b.relative_error,
+                b.samples,
+                100.0 * b.largest_share,
+            ),
         );
     }
     let counts = stats.mutation_counts;
@@ -431,29 +470,37 @@ fn print_summary(
                 counts.proposed[mutation as usize],
                 counts.accepted[mutation as usize],
             );
-            println!(
-                "  {:<13} {proposed} proposed, {:.1}% accepted, weight {:.3}",
-                format!("{mutation:?}").to_lowercase(),
-                100.0 * accepted as f64 / proposed.max(1) as f64,
-                stats.mutation_weights.0[mutation as usize]
+            row(
+                &format!("{mutation:?}").to_lowercase(),
+                format!(
+                    "{proposed} proposed, {:.1}% accepted, weight {:.3}",
+                    100.0 * accepted as f64 / proposed.max(1) as f64,
+                    stats.mutation_weights.0[mutation as usize]
+                ),
             );
         }
     }
     if settings.filter_buffers > 0 {
-        println!(
-            "  filter     {} partial images, strength {}, radius {}: {:.1} pixels averaged per pixel, {:.2}% of the luminance moved (total kept)",
-            settings.filter_buffers,
-            settings.filter_strength,
-            settings.filter_radius,
-            stats.filter.mean_neighbours,
-            100.0 * stats.filter.changed_fraction
+        row(
+            "filter",
+            format!(
+                "{} partial images, strength {}, radius {}: {:.1} pixels averaged per pixel, {:.2}% of the luminance moved (total kept)",
+                settings.filter_buffers,
+                settings.filter_strength,
+                settings.filter_radius,
+                stats.filter.mean_neighbours,
+                100.0 * stats.filter.changed_fraction
+            ),
         );
     }
     if stats.invalid_samples > 0 {
-        println!(
-            "  invalid    {} samples with non-finite radiance dropped",
-            stats.invalid_samples
+        row(
+            "invalid",
+            format!(
+                "{} samples with non-finite radiance dropped",
+                stats.invalid_samples
+            ),
         );
     }
-    println!("  status     {stop}");
+    row("status", stop);
 }
