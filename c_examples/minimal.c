@@ -178,6 +178,13 @@ int main(int argc, char **argv) {
         return 2;
     }
     printf("mlt %s\n", mlt_version_string());
+#if MLT_VERSION < 100
+#error "this example needs mlt 0.1 or later"
+#endif
+    if (mlt_version() != MLT_VERSION) {
+        fprintf(stderr, "linked mlt %u, header %u\n", (unsigned)mlt_version(), (unsigned)MLT_VERSION);
+        return 1;
+    }
 
     /* 1. Triangles. Each quad (a, b, c, d) becomes the triangles (a, b, c) and (a, c, d),
      *    which keeps the counter-clockwise order, so both face the same way as the quad.

@@ -34,6 +34,12 @@
 #define MLT_VERSION_PATCH 0
 
 /**
+ * The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
+ * checks; `mlt_version()` returns the linked library's.
+ */
+#define MLT_VERSION (((MLT_VERSION_MAJOR * 10000) + (MLT_VERSION_MINOR * 100)) + MLT_VERSION_PATCH)
+
+/**
  * `MltMaterial.kind`: Lambertian diffuse with albedo `color` (two-sided).
  */
 #define MLT_MATERIAL_DIFFUSE 0
@@ -199,72 +205,6 @@
 #define MLT_MAX_NORMALIZATION_WORK_FRACTION 0.9
 
 /**
- * An automatic bootstrap (`bootstrap_samples` 0) takes one sample per this many
- * planned mutations: at the default 256² × 32 mutations per pixel, 2^18 samples, the
- * best of 2^16, 2^18 and 2^20 on cornell-glass at 10 s of one thread (8 seeds; MMLT's
- * RMSE 41% and 10% higher with the others, path-space MLT's 9–17%: the bootstrap is
- * also what the chains are seeded from). Sized to the work, the bootstrap's share of
- * the render, and so the brightness error's fall with the work, stay the same at any
- * budget.
- */
-#define RenderSettings_AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE 8
-
-/**
- * The fewest samples of an automatic bootstrap.
- */
-#define RenderSettings_MIN_AUTO_BOOTSTRAP_SAMPLES (1 << 16)
-
-/**
- * The automatic bootstrap of a render with a time limit and no mutation count (the
- * normalization pass then makes b's error fall with the render's length).
- */
-#define RenderSettings_TIME_LIMITED_BOOTSTRAP_SAMPLES (1 << 18)
-
-/**
- * The default `direct_samples_per_mutation`: one, the best measured at equal time on
- * the Cornell scenes (benches/equal_time.rs).
- */
-#define RenderSettings_DEFAULT_DIRECT_SAMPLES_PER_MUTATION 1
-
-/**
- * The default `normalization_work_fraction`, chosen by `benches/brightness.rs`. Against
- * a bootstrap alone (fraction 0), 20 seeds of 10 s on one thread on the four bench
- * scenes, MMLT and path-space MLT: at 0.05 every median RMSE is within its standard
- * error (0.5–5%) of fraction 0's (−1.8% to +1.7%), while the brightness spread over the
- * seeds falls (lamp-behind-glass 0.77% → 0.57%) and goes on falling with the render's
- * length; 0.1 cost up to 6% more RMSE (door-ajar), 0.2 up to 8.5%. PSSMLT's large
- * steps (30% of its mutations) already make the share, so it costs PSSMLT nothing;
- * MMLT's pass samples join the image, which gives back about half of what they cost.
- */
-#define RenderSettings_DEFAULT_NORMALIZATION_WORK_FRACTION 0.05
-
-/**
- * The default `erpt_chain_length`: the best at equal time of 5, 10, 20, 40 and 100 on
- * cornell-glass and door-ajar (`benches/equal_time.rs`, medians of 3 renders of 10 s;
- * 5 to 20 within noise of each other, 100, about Cline et al.'s length, 2 to 3 times
- * worse: long chains leave few camera samples per pixel).
- */
-#define RenderSettings_DEFAULT_ERPT_CHAIN_LENGTH 10
-
-/**
- * The partial images a filtered render uses unless told otherwise (the CLI's
- * `--filter`): 7 degrees of freedom per pixel for the variance (before pooling over
- * 5 × 5 pixels), 96 bytes per pixel.
- */
-#define RenderSettings_DEFAULT_FILTER_BUFFERS 8
-
-/**
- * The default `filter_strength`: Rousselle et al.'s choice; 1.0 gained no more on
- * cornell-glass and door-ajar and shifted regions further.
- */
-#define RenderSettings_DEFAULT_FILTER_STRENGTH 0.45
-
-/**
- * The default `filter_radius`: a 15 × 15 search window.
- */
-#define RenderSettings_DEFAULT_FILTER_RADIUS 7
-
-/**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
  */
 typedef enum MltStatus {
@@ -306,11 +246,6 @@ typedef enum MltStatus {
  * safe: any number of threads may render and query one scene at the same time.
  */
 typedef struct MltScene MltScene;
-
-/**
- * The mutations of a path-space chain.
- */
-typedef struct Mutation Mutation;
 
 /**
  * A material. Initialize with `mlt_material_default`.

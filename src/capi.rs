@@ -23,6 +23,10 @@ pub const MLT_VERSION_MAJOR: u32 = 0;
 pub const MLT_VERSION_MINOR: u32 = 1;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
+/// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
+/// checks; `mlt_version()` returns the linked library's.
+pub const MLT_VERSION: u32 =
+    MLT_VERSION_MAJOR * 10000 + MLT_VERSION_MINOR * 100 + MLT_VERSION_PATCH;
 
 /// `MltMaterial.kind`: Lambertian diffuse with albedo `color` (two-sided).
 pub const MLT_MATERIAL_DIFFUSE: i32 = 0;
@@ -533,7 +537,7 @@ fn flag(value: u32, name: &str) -> Result<bool> {
 /// The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
 #[unsafe(no_mangle)]
 pub extern "C" fn mlt_version() -> u32 {
-    MLT_VERSION_MAJOR * 10000 + MLT_VERSION_MINOR * 100 + MLT_VERSION_PATCH
+    MLT_VERSION
 }
 
 /// The library version as "MAJOR.MINOR.PATCH" (static storage).

@@ -317,6 +317,8 @@ impl Default for RenderSettings {
     }
 }
 
+// Rust-side defaults: C hosts get them from `mlt_render_settings_default`.
+/// cbindgen:ignore
 impl RenderSettings {
     /// An automatic bootstrap (`bootstrap_samples` 0) takes one sample per this many
     /// planned mutations: at the default 256² × 32 mutations per pixel, 2^18 samples, the

@@ -399,6 +399,7 @@ fn version_function_matches_the_macros() {
         mlt_version(),
         MLT_VERSION_MAJOR * 10000 + MLT_VERSION_MINOR * 100 + MLT_VERSION_PATCH
     );
+    assert_eq!(mlt_version(), MLT_VERSION);
     // SAFETY: static string.
     let s = unsafe { CStr::from_ptr(mlt_version_string()) };
     assert_eq!(s.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
