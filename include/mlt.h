@@ -5,7 +5,20 @@
  * Conventions: every fallible call returns an MltStatus; on failure
  * mlt_last_error_message() names the offending field, index and value. Out-parameters are
  * written only on success. Initialize descriptor structs with their mlt_*_default().
+ * The progress callback must return normally (no C++ exception or longjmp through it).
  */
+
+/* MLT_API marks the exported functions: visible from the shared library when a host builds
+ * with -fvisibility=hidden, and imported from a DLL on Windows when MLT_SHARED is defined. */
+#ifndef MLT_API
+#  if defined(_WIN32) && defined(MLT_SHARED)
+#    define MLT_API __declspec(dllimport)
+#  elif defined(__GNUC__) || defined(__clang__)
+#    define MLT_API __attribute__((visibility("default")))
+#  else
+#    define MLT_API
+#  endif
+#endif
 
 #ifndef MLT_H
 #define MLT_H
@@ -492,7 +505,10 @@ typedef struct MltSceneInfo {
 /**
  * Progress callback: called on the thread that called `mlt_render` (never from a worker),
  * about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
- * Return `true` to continue and `false` to cancel.
+ * Return `true` to continue and `false` to cancel. It must return normally: a C++
+ * exception thrown through it, or a `longjmp` out of it, skips mlt's cleanup (worker
+ * threads keep running on freed memory) and is undefined behavior; catch inside the
+ * callback and return `false` instead.
  */
 typedef bool (*MltProgressCallback)(float fraction, void *user_data);
 
@@ -617,23 +633,23 @@ extern "C" {
 /**
  * The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
  */
-uint32_t mlt_version(void);
+MLT_API uint32_t mlt_version(void);
 
 /**
  * The library version as "MAJOR.MINOR.PATCH" (static storage).
  */
-const char *mlt_version_string(void);
+MLT_API const char *mlt_version_string(void);
 
 /**
  * A static description of a status (any integer is accepted).
  */
-const char *mlt_status_string(int32_t status);
+MLT_API const char *mlt_status_string(int32_t status);
 
 /**
  * The message of the last failed mlt call on this thread ("" after a success). The pointer
  * stays valid until the next mlt call on this thread.
  */
-const char *mlt_last_error_message(void);
+MLT_API const char *mlt_last_error_message(void);
 
 /**
  * Whether `mlt_scene_create` can build scenes with `backend` (one of `MLT_BACKEND_*`) in
@@ -641,7 +657,7 @@ const char *mlt_last_error_message(void);
  * mlt was compiled with the `embree` feature (otherwise scene creation with it returns
  * `MLT_STATUS_UNSUPPORTED`); false for any other value.
  */
-bool mlt_backend_supported(int32_t backend);
+MLT_API bool mlt_backend_supported(int32_t backend);
 
 /**
  * Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).
@@ -649,7 +665,7 @@ bool mlt_backend_supported(int32_t backend);
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltMaterial`.
  */
-enum MltStatus mlt_material_default(struct MltMaterial *out);
+MLT_API enum MltStatus mlt_material_default(struct MltMaterial *out);
 
 /**
  * Fills `out` with an empty description (no arrays, BVH backend).
@@ -657,7 +673,7 @@ enum MltStatus mlt_material_default(struct MltMaterial *out);
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltSceneDesc`.
  */
-enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
+MLT_API enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
 
 /**
  * Fills `out` with the Cornell box's pinhole camera.
@@ -665,7 +681,7 @@ enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltCamera`.
  */
-enum MltStatus mlt_camera_default(struct MltCamera *out);
+MLT_API enum MltStatus mlt_camera_default(struct MltCamera *out);
 
 /**
  * Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
@@ -678,7 +694,7 @@ enum MltStatus mlt_camera_default(struct MltCamera *out);
  * # Safety
  * `out` must be NULL or point to writable memory for an `MltRenderSettings`.
  */
-enum MltStatus mlt_render_settings_default(struct MltRenderSettings *out);
+MLT_API enum MltStatus mlt_render_settings_default(struct MltRenderSettings *out);
 
 /**
  * Validates `desc`, copies its arrays and builds the acceleration structure. On success
@@ -688,7 +704,7 @@ enum MltStatus mlt_render_settings_default(struct MltRenderSettings *out);
  * `desc` must point to an `MltSceneDesc` whose pointers reference arrays of at least the
  * given lengths; `out` must be writable.
  */
-enum MltStatus mlt_scene_create(const struct MltSceneDesc *desc, struct MltScene **out);
+MLT_API enum MltStatus mlt_scene_create(const struct MltSceneDesc *desc, struct MltScene **out);
 
 /**
  * Releases a scene. NULL is a no-op. The scene must not be in use by another thread.
@@ -696,7 +712,7 @@ enum MltStatus mlt_scene_create(const struct MltSceneDesc *desc, struct MltScene
  * # Safety
  * `scene` must be NULL or a pointer returned by `mlt_scene_create` not yet released.
  */
-void mlt_scene_release(struct MltScene *scene);
+MLT_API void mlt_scene_release(struct MltScene *scene);
 
 /**
  * Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
@@ -704,7 +720,7 @@ void mlt_scene_release(struct MltScene *scene);
  * # Safety
  * `scene` must be a live scene; `out` writable.
  */
-enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct MltSceneInfo *out);
+MLT_API enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct MltSceneInfo *out);
 
 /**
  * Renders `scene` seen by `camera` into `rgb_out`: width × height × 3 floats, linear RGB
@@ -720,7 +736,7 @@ enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct MltSceneI
  * Pointers must be valid as described; `rgb_out` must not be accessed by the host until
  * the call returns.
  */
-enum MltStatus mlt_render(const struct MltScene *scene, const struct MltCamera *camera, const struct MltRenderSettings *settings, float *rgb_out, size_t out_len, MltProgressCallback progress, void *user_data);
+MLT_API enum MltStatus mlt_render(const struct MltScene *scene, const struct MltCamera *camera, const struct MltRenderSettings *settings, float *rgb_out, size_t out_len, MltProgressCallback progress, void *user_data);
 
 /**
  * `mlt_render` that also fills `stats_out` (may be NULL) whenever it writes the image.
@@ -728,7 +744,7 @@ enum MltStatus mlt_render(const struct MltScene *scene, const struct MltCamera *
  * # Safety
  * As `mlt_render`; `stats_out` NULL or writable.
  */
-enum MltStatus mlt_render_ex(const struct MltScene *scene, const struct MltCamera *camera, const struct MltRenderSettings *settings, float *rgb_out, size_t out_len, MltProgressCallback progress, void *user_data, struct MltRenderStats *stats_out);
+MLT_API enum MltStatus mlt_render_ex(const struct MltScene *scene, const struct MltCamera *camera, const struct MltRenderSettings *settings, float *rgb_out, size_t out_len, MltProgressCallback progress, void *user_data, struct MltRenderStats *stats_out);
 
 /**
  * Closest hit for each of `count` rays, written to `hits_out[i]` (a miss has triangle_id
@@ -738,7 +754,7 @@ enum MltStatus mlt_render_ex(const struct MltScene *scene, const struct MltCamer
  * # Safety
  * `rays` and `hits_out` must hold `count` elements.
  */
-enum MltStatus mlt_intersect(const struct MltScene *scene, const struct MltRay *rays, size_t count, struct MltHit *hits_out);
+MLT_API enum MltStatus mlt_intersect(const struct MltScene *scene, const struct MltRay *rays, size_t count, struct MltHit *hits_out);
 
 /**
  * For each of `count` rays, `occluded_out[i]` = 1 if any triangle lies on it within
@@ -747,7 +763,7 @@ enum MltStatus mlt_intersect(const struct MltScene *scene, const struct MltRay *
  * # Safety
  * `rays` and `occluded_out` must hold `count` elements.
  */
-enum MltStatus mlt_occluded(const struct MltScene *scene, const struct MltRay *rays, size_t count, uint8_t *occluded_out);
+MLT_API enum MltStatus mlt_occluded(const struct MltScene *scene, const struct MltRay *rays, size_t count, uint8_t *occluded_out);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -323,7 +323,10 @@ pub struct MltScene {
 
 /// Progress callback: called on the thread that called `mlt_render` (never from a worker),
 /// about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
-/// Return `true` to continue and `false` to cancel.
+/// Return `true` to continue and `false` to cancel. It must return normally: a C++
+/// exception thrown through it, or a `longjmp` out of it, skips mlt's cleanup (worker
+/// threads keep running on freed memory) and is undefined behavior; catch inside the
+/// callback and return `false` instead.
 pub type MltProgressCallback =
     Option<unsafe extern "C" fn(fraction: f32, user_data: *mut c_void) -> bool>;
 
