@@ -378,7 +378,10 @@ typedef struct MltRenderSettings {
    */
   uint32_t max_depth;
   /**
-   * Worker threads; 0 uses every core. The image does not depend on it.
+   * Worker threads; 0 runs on one pool of one thread per core that every such render in
+   * the process shares (renders from several host threads at once then share the cores
+   * instead of oversubscribing them); a count gives the render a pool of its own. The
+   * image does not depend on it.
    */
   uint32_t threads;
   /**

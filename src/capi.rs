@@ -159,7 +159,10 @@ pub struct MltRenderSettings {
     /// Most scattering vertices between camera and light (0: only directly visible
     /// emitters), at most 1024.
     pub max_depth: u32,
-    /// Worker threads; 0 uses every core. The image does not depend on it.
+    /// Worker threads; 0 runs on one pool of one thread per core that every such render in
+    /// the process shares (renders from several host threads at once then share the cores
+    /// instead of oversubscribing them); a count gives the render a pool of its own. The
+    /// image does not depend on it.
     pub threads: u32,
     /// Seed of every random number; equal seeds and settings give bitwise equal images.
     pub seed: u64,

@@ -215,7 +215,9 @@ pub struct RenderSettings {
     /// At most this many scattering vertices between camera and light (0: emitters only).
     pub max_depth: u32,
     pub seed: u64,
-    /// Worker threads; 0 uses every core.
+    /// Worker threads; 0 (the default) runs on one pool of one thread per core shared by
+    /// every such render in the process, so renders from several host threads at once share
+    /// the cores; a count gives the render a pool of its own. The image does not depend on it.
     pub threads: u32,
     /// Stop after this many seconds; 0 means no limit.
     pub time_limit_seconds: f64,
@@ -637,15 +639,13 @@ fn render_into(
             settings.width, settings.height
         )));
     }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(settings.threads as usize)
-        .build()
-        .map_err(|e| {
-            Error::new(
-                MLT_STATUS_OUT_OF_MEMORY,
-                format!("could not start worker threads: {e}"),
-            )
-        })?;
+    let own_pool;
+    let pool = if settings.threads == 0 {
+        shared_pool()?
+    } else {
+        own_pool = new_pool(settings.threads as usize)?;
+        &own_pool
+    };
     let threads = pool.current_num_threads() as u32;
 
     let start = Instant::now();
@@ -721,7 +721,6 @@ fn render_into(
         let estimator = &estimator;
         let direct = direct.as_ref();
         let model = &model;
-        let pool = &pool;
         let worker = s.spawn(move || {
             // Signals even when the render panics, so the caller never waits forever.
             let _signal = SignalOnDrop(done);
@@ -846,6 +845,32 @@ fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
         });
     }
     Ok(film)
+}
+
+/// A pool of `threads` worker threads (0: one per core).
+fn new_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("mlt-worker-{i}"))
+        .build()
+        .map_err(|e| {
+            Error::new(
+                MLT_STATUS_OUT_OF_MEMORY,
+                format!("could not start worker threads: {e}"),
+            )
+        })
+}
+
+/// The pool every render with `threads` 0 runs on: one thread per core for the whole
+/// process, started by the first such render, so that a host rendering from several
+/// threads at once shares the cores instead of starting a pool per render.
+fn shared_pool() -> Result<&'static rayon::ThreadPool> {
+    static SHARED: std::sync::OnceLock<std::result::Result<rayon::ThreadPool, String>> =
+        std::sync::OnceLock::new();
+    SHARED
+        .get_or_init(|| new_pool(0).map_err(|e| e.message))
+        .as_ref()
+        .map_err(|message| Error::new(MLT_STATUS_OUT_OF_MEMORY, message.clone()))
 }
 
 /// Per-work-unit state of a render: the estimator's scratch memory and the splats of the
