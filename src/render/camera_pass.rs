@@ -1,0 +1,171 @@
+//! The pass of camera samples: an estimator of pixel values (the path tracer, BDPT, a
+//! Metropolis render's direct pass) run over the film in bands, pass by pass, each sample's
+//! position and random numbers fixed by its pixel and index so the image never depends on
+//! the thread count.
+
+use crate::control::Control;
+use crate::film::{Film, Splat};
+use crate::integrators::{PixelEstimator, SampleCounters};
+use crate::sampling::{Rng, shifted_sobol_2d};
+use crate::scene::CameraModel;
+use glam::Vec3A;
+use rayon::prelude::*;
+use std::sync::atomic::Ordering;
+/// Stream offset of the per-pixel shifts of the camera samples' positions (apart from the
+/// per-sample streams, which hash the sample index into the seed).
+const PIXEL_SHIFT_STREAM: u64 = 0x5eed_0f15_0000_0000;
+
+/// Rows per unit of parallel work.
+const BAND_ROWS: u32 = 4;
+
+/// Target samples per pass over the whole image: passes bound how long a stop takes and how
+/// unevenly a partial image is sampled.
+const SAMPLES_PER_PASS: u64 = 1 << 18;
+
+/// Per-work-unit state of a render: the estimator's scratch memory and the splats of the
+/// current pass. Created once per render so sampling never allocates.
+struct BandState<S> {
+    scratch: S,
+    splats: Vec<Splat>,
+    light_paths: u64,
+}
+
+/// Runs a pixel estimator over the film, pass by pass; can stop at a sample count and go on
+/// later (a Metropolis render interleaves its direct pass with the chains).
+pub(super) struct CameraSampleJob<'a, E: PixelEstimator> {
+    estimator: &'a E,
+    camera: CameraModel,
+    seed: u64,
+    /// 0 = until stopped.
+    samples_per_pixel: u32,
+    /// Samples per pixel of a full pass.
+    batch: u32,
+    /// Samples per pixel taken so far.
+    samples_taken: u32,
+    states: Vec<BandState<E::Scratch>>,
+}
+
+impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
+    pub(super) fn new(
+        estimator: &'a E,
+        camera: &CameraModel,
+        seed: u64,
+        samples_per_pixel: u32,
+        film: &Film,
+    ) -> Self {
+        let width = film.width;
+        let pixels = width as u64 * film.height as u64;
+        let batch = SAMPLES_PER_PASS.div_ceil(pixels).clamp(1, 64) as u32;
+        let bands = film.height.div_ceil(BAND_ROWS) as usize;
+        let splat_capacity = if estimator.splats() {
+            (BAND_ROWS * width * batch * 2) as usize
+        } else {
+            0
+        };
+        let states = (0..bands)
+            .map(|_| BandState {
+                scratch: estimator.scratch(),
+                splats: Vec::with_capacity(splat_capacity),
+                light_paths: 0,
+            })
+            .collect();
+        CameraSampleJob {
+            estimator,
+            camera: *camera,
+            seed,
+            samples_per_pixel,
+            batch,
+            samples_taken: 0,
+            states,
+        }
+    }
+
+    pub(super) fn run(&mut self, film: &mut Film, control: &Control) {
+        self.run_until(film, control, u32::MAX);
+    }
+
+    /// Takes samples until every pixel has `target` (or all it should have), or the render
+    /// stops.
+    pub(super) fn run_until(&mut self, film: &mut Film, control: &Control, target: u32) {
+        let width = film.width;
+        let batch = self.batch;
+        let total = if self.samples_per_pixel > 0 {
+            self.samples_per_pixel.min(target)
+        } else {
+            target
+        };
+        let states = &mut self.states;
+        // The first pass takes one sample per pixel and always completes, so a render
+        // stopped at any moment still has a sample in every pixel.
+        while self.samples_taken < total && (self.samples_taken == 0 || !control.should_stop()) {
+            let first = self.samples_taken;
+            let end = if first == 0 {
+                1
+            } else {
+                first.saturating_add(batch).min(total)
+            };
+            film.par_bands(BAND_ROWS)
+                .zip(states.par_iter_mut())
+                .for_each(|(band, state)| {
+                    state.splats.clear();
+                    state.light_paths = 0;
+                    if first > 0 && control.should_stop() {
+                        return;
+                    }
+                    let mut counters = SampleCounters::default();
+                    let mut invalid = 0u64;
+                    for (i, (sum, count)) in
+                        band.sums.iter_mut().zip(band.counts.iter_mut()).enumerate()
+                    {
+                        let x = i as u32 % width;
+                        let y = band.first_row + i as u32 / width;
+                        let pixel = y as u64 * width as u64 + x as u64;
+                        let mut pixel_sum = Vec3A::ZERO;
+                        // The pixel's samples spread over it as a (0, 2)-sequence.
+                        let mut shift = Rng::new(self.seed, PIXEL_SHIFT_STREAM + pixel);
+                        let shift = [shift.next_u32(), shift.next_u32()];
+                        for sample in first..end {
+                            let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
+                            let [jx, jy] = shifted_sobol_2d(sample, shift);
+                            let splats_before = state.splats.len();
+                            let l = self.estimator.sample(
+                                &self.camera,
+                                x as f32 + jx,
+                                y as f32 + jy,
+                                &mut rng,
+                                &mut counters,
+                                &mut state.scratch,
+                                &mut state.splats,
+                            );
+                            let splats_valid = state.splats[splats_before..]
+                                .iter()
+                                .all(|s| s.value.is_finite());
+                            if l.is_finite() && splats_valid {
+                                pixel_sum += l;
+                            } else {
+                                state.splats.truncate(splats_before);
+                                invalid += 1;
+                            }
+                        }
+                        for c in 0..3 {
+                            sum[c] += pixel_sum[c] as f64;
+                        }
+                        *count += end - first;
+                    }
+                    let band_samples = band.counts.len() as u64 * (end - first) as u64;
+                    state.light_paths = band_samples;
+                    control
+                        .samples_done
+                        .fetch_add(band_samples, Ordering::Relaxed);
+                    control.rays.fetch_add(counters.rays, Ordering::Relaxed);
+                    control.invalid.fetch_add(invalid, Ordering::Relaxed);
+                });
+            if self.estimator.splats() {
+                for state in states.iter() {
+                    film.add_splats(&state.splats, state.light_paths);
+                }
+            }
+            self.samples_taken = end;
+        }
+    }
+}

@@ -1,0 +1,441 @@
+//! Rendering: the driver that runs an integrator over the film in parallel, with progress
+//! reporting, cancellation and a time limit (`render`). What a render is asked for and its
+//! validation are in `settings`, what it reports in `stats`, and the pass of camera samples
+//! (path tracer, BDPT, a Metropolis render's direct pass) in `camera_pass`.
+
+mod camera_pass;
+mod settings;
+mod stats;
+
+pub use settings::{
+    Algorithm, MLT_MAX_BOOTSTRAP_SAMPLES, MLT_MAX_DEPTH_LIMIT, MLT_MAX_ERPT_CHAIN_LENGTH,
+    MLT_MAX_ERPT_DEPOSIT_ENERGY, MLT_MAX_IMAGE_SIDE, MLT_MAX_NORMALIZATION_WORK_FRACTION,
+    MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS, MLT_MAX_TIME_LIMIT_SECONDS, RenderSettings,
+};
+pub use stats::{RenderStats, StopReason};
+
+use crate::control::Control;
+use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
+use crate::film::Film;
+use crate::filter::FilterSettings;
+use crate::integrators::bdpt::Bdpt;
+use crate::integrators::mlt::driver::MetropolisOutcome;
+use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
+use crate::integrators::mlt::primary_space::{MetropolisSettings, PrimarySpaceTarget};
+use crate::integrators::mlt::pssmlt;
+use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
+use crate::integrators::path::PathTracer;
+use crate::scene::{Camera, CameraModel, Scene};
+use camera_pass::CameraSampleJob;
+use std::sync::atomic::Ordering;
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+/// The estimator a render runs, chosen from the settings.
+enum Estimator<'a> {
+    Path(&'a PathTracer<'a>),
+    Bdpt(&'a Bdpt<'a>),
+    Pssmlt(&'a PathTracer<'a>),
+    Mmlt(&'a BdptMultiplexed<'a>),
+    PssmltBdpt(&'a BdptAllStrategies<'a>),
+    PathSpaceMlt(&'a Bdpt<'a>),
+    Erpt(&'a Bdpt<'a>),
+}
+
+impl Estimator<'_> {
+    /// Film layers of a Metropolis render: one per group of chains, whose deposits are
+    /// scaled by the group's normalization, and one for the normalization pass's samples
+    /// where they join the image (`PassImage`).
+    fn chain_groups(&self) -> usize {
+        fn layers<T: PrimarySpaceTarget>(target: &T) -> usize {
+            target.groups() + target.pass_joins_the_image() as usize
+        }
+        match *self {
+            Estimator::Pssmlt(target) => layers(target),
+            Estimator::Mmlt(target) => layers(target),
+            Estimator::PssmltBdpt(target) => layers(target),
+            Estimator::PathSpaceMlt(_) => 1,
+            Estimator::Path(_) | Estimator::Bdpt(_) | Estimator::Erpt(_) => 0,
+        }
+    }
+}
+
+/// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
+const DIRECT_PASS_DEPTHS: u32 = 2;
+
+impl Estimator<'_> {
+    /// Runs the render; `direct` is the path tracer of a Metropolis render's direct pass.
+    fn run(
+        &self,
+        camera: &CameraModel,
+        settings: &RenderSettings,
+        direct: Option<&PathTracer>,
+        film: &mut Film,
+        control: &Control,
+    ) -> MetropolisOutcome {
+        let seed = settings.seed;
+        let spp = settings.samples_per_pixel;
+        let chains = MetropolisSettings {
+            mutations_per_pixel: settings.mutations_per_pixel,
+            bootstrap_samples: settings.resolved_bootstrap_samples(),
+            chains: settings.chains,
+            large_step_probability: settings.large_step_probability,
+            small_step_sigma: settings.small_step_sigma,
+            normalization_work_fraction: settings.normalization_work_fraction,
+            seed,
+        };
+        // The direct pass keeps pace with the chains: after each round of mutations it
+        // catches up to its share of samples.
+        let ratio = settings.direct_samples_per_mutation;
+        let mut direct_job = direct.map(|direct| {
+            let total = ratio * settings.mutations_per_pixel;
+            let mut job = CameraSampleJob::new(direct, camera, seed, total, film);
+            job.run_until(film, control, 1);
+            job
+        });
+        let mut keep_pace = |film: &mut Film, mutations_per_pixel: f64| {
+            if let Some(job) = direct_job.as_mut() {
+                let target = (ratio as f64 * mutations_per_pixel)
+                    .ceil()
+                    .min(u32::MAX as f64);
+                job.run_until(film, control, target as u32);
+            }
+        };
+        match *self {
+            Estimator::Path(estimator) => {
+                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
+                MetropolisOutcome::default()
+            }
+            Estimator::Bdpt(estimator) => {
+                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
+                MetropolisOutcome::default()
+            }
+            Estimator::Pssmlt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::Mmlt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::PssmltBdpt(target) => {
+                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
+            }
+            Estimator::PathSpaceMlt(bdpt) => {
+                let target = PathSpaceTarget {
+                    bdpt: BdptAllStrategies(Bdpt {
+                        scene: bdpt.scene,
+                        max_depth: bdpt.max_depth,
+                        min_depth: bdpt.min_depth,
+                    }),
+                    camera: *camera,
+                    weights: settings.mutation_weights,
+                    sizes: PerturbationSizes::for_image(camera.width, camera.height),
+                    perturb_in_sample_space: settings.perturb_in_sample_space,
+                };
+                let adapt = settings.adapt_mutation_weights;
+                path_space::run(&target, &chains, adapt, film, control, &mut keep_pace)
+            }
+            Estimator::Erpt(bdpt) => {
+                let erpt = path_space::ErptSettings {
+                    samples_per_pixel: spp,
+                    chain_length: settings.erpt_chain_length,
+                    deposit_energy: settings.erpt_deposit_energy,
+                    seed,
+                    weights: settings.mutation_weights,
+                    perturb_in_sample_space: settings.perturb_in_sample_space,
+                };
+                path_space::run_erpt(bdpt, camera, &erpt, film, control)
+            }
+        }
+    }
+}
+
+/// Called from the rendering call's own thread with the fraction done; return `false` to stop.
+pub type Progress<'a> = &'a mut dyn FnMut(f32) -> bool;
+
+/// How often the caller's thread wakes to report progress and check the time limit.
+const PROGRESS_INTERVAL: Duration = Duration::from_millis(50);
+
+/// Renders into `rgb_out` (width × height × 3 floats, rows top to bottom).
+pub fn render(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    render_into(scene, camera, settings, rgb_out, None, progress)
+}
+
+/// Renders like [`render`], and also writes the image as it was before the post-process
+/// filter into `unfiltered_out` (the same image when the filter is off): what measuring the
+/// filter's bias and gain on one render takes.
+pub fn render_with_unfiltered(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    unfiltered_out: &mut [f32],
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    render_into(
+        scene,
+        camera,
+        settings,
+        rgb_out,
+        Some(unfiltered_out),
+        progress,
+    )
+}
+
+fn render_into(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    rgb_out: &mut [f32],
+    unfiltered_out: Option<&mut [f32]>,
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    settings.validate()?;
+    camera.validate()?;
+    let needed = settings.output_len()?;
+    let shortest = rgb_out
+        .len()
+        .min(unfiltered_out.as_ref().map_or(usize::MAX, |u| u.len()));
+    if shortest < needed {
+        return Err(Error::invalid(format!(
+            "the output buffer holds {shortest} floats but a {} x {} RGB image needs {needed}",
+            settings.width, settings.height
+        )));
+    }
+    let own_pool;
+    let pool = if settings.threads == 0 {
+        shared_pool()?
+    } else {
+        own_pool = new_pool(settings.threads as usize)?;
+        &own_pool
+    };
+    let threads = pool.current_num_threads() as u32;
+
+    let start = Instant::now();
+    let deadline = (settings.time_limit_seconds > 0.0)
+        .then(|| start + Duration::from_secs_f64(settings.time_limit_seconds));
+    let control = Control::new(deadline, settings.algorithm.is_metropolis());
+    let model = camera.model(settings.width, settings.height);
+    model.validate()?;
+    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer.
+    let direct = (settings.algorithm.is_metropolis() && settings.direct_samples_per_mutation > 0)
+        .then(|| PathTracer {
+            scene,
+            max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
+            min_depth: 0,
+        });
+    let min_depth = if direct.is_some() {
+        DIRECT_PASS_DEPTHS
+    } else {
+        0
+    };
+    let path_tracer = PathTracer {
+        scene,
+        max_depth: settings.max_depth,
+        min_depth,
+    };
+    let bdpt = Bdpt {
+        scene,
+        max_depth: settings.max_depth,
+        min_depth,
+    };
+    let multiplexed;
+    let all_strategies;
+    let estimator: Estimator = match settings.algorithm {
+        Algorithm::Path => Estimator::Path(&path_tracer),
+        Algorithm::Bdpt => Estimator::Bdpt(&bdpt),
+        Algorithm::Pssmlt => Estimator::Pssmlt(&path_tracer),
+        Algorithm::Mmlt => {
+            multiplexed = BdptMultiplexed(bdpt);
+            Estimator::Mmlt(&multiplexed)
+        }
+        Algorithm::PssmltBdpt => {
+            all_strategies = BdptAllStrategies(bdpt);
+            Estimator::PssmltBdpt(&all_strategies)
+        }
+        Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
+        Algorithm::Erpt => Estimator::Erpt(&bdpt),
+    };
+    let mut film = try_film(settings, estimator.chain_groups())?;
+    let pixels = settings.width as u64 * settings.height as u64;
+    // Progress counts camera samples and mutations alike; without a count (time limit
+    // only) there is no plan.
+    let planned = if settings.algorithm.is_metropolis() {
+        let direct_samples = if direct.is_some() {
+            settings.direct_samples_per_mutation as u64 * settings.mutations_per_pixel as u64
+        } else {
+            0
+        };
+        if settings.mutations_per_pixel > 0 {
+            (settings.mutations_per_pixel as u64 + direct_samples) * pixels
+        } else {
+            0
+        }
+    } else {
+        settings.samples_per_pixel as u64 * pixels
+    };
+
+    let mut progress = progress;
+    let done = DoneSignal::default();
+    let outcome = std::thread::scope(|s| {
+        let done = &done;
+        let control = &control;
+        let film = &mut film;
+        let estimator = &estimator;
+        let direct = direct.as_ref();
+        let model = &model;
+        let worker = s.spawn(move || {
+            // Signals even when the render panics, so the caller never waits forever.
+            let _signal = SignalOnDrop(done);
+            pool.install(|| estimator.run(model, settings, direct, film, control))
+        });
+        while !done.wait(PROGRESS_INTERVAL) {
+            if let Some(callback) = progress.as_mut() {
+                let fraction = control.fraction(planned, start);
+                if !callback(fraction) {
+                    control.cancel();
+                }
+            }
+            if deadline.is_some_and(|d| Instant::now() >= d) {
+                control.stop();
+            }
+        }
+        worker.join()
+    });
+    let Ok(metropolis) = outcome else {
+        return Err(Error::new(
+            MLT_STATUS_INTERNAL_ERROR,
+            "a rendering thread panicked; this is a bug in mlt",
+        ));
+    };
+    let filter = film.write_rgb(
+        &mut rgb_out[..needed],
+        unfiltered_out.map(|u| &mut u[..needed]),
+    );
+    let stop = if control.was_cancelled() {
+        StopReason::Cancelled
+    } else if planned == 0 || control.work_done() < planned {
+        StopReason::TimeLimitReached
+    } else {
+        StopReason::Completed
+    };
+    if let (StopReason::Completed, Some(callback)) = (stop, progress.as_mut()) {
+        // The last word is always 1.0 for a finished render; a cancel now changes nothing.
+        let _ = callback(1.0);
+    }
+    Ok(RenderStats {
+        stop,
+        samples: control.samples_done.load(Ordering::Relaxed),
+        mutations: control.mutations_done.load(Ordering::Relaxed),
+        rays: control.rays.load(Ordering::Relaxed),
+        invalid_samples: control.invalid.load(Ordering::Relaxed),
+        seconds: start.elapsed().as_secs_f64(),
+        threads,
+        accepted_mutations: metropolis.accepted,
+        normalization: metropolis.normalization,
+        mutation_counts: metropolis.mutation_counts,
+        mutation_weights: metropolis.mutation_weights,
+        filter,
+    })
+}
+
+/// Tells the calling thread the render finished. A mutex and condition variable rather than
+/// a channel: waiting on them never allocates, so allocation counts do not depend on timing.
+#[derive(Default)]
+struct DoneSignal {
+    done: Mutex<bool>,
+    changed: Condvar,
+}
+
+impl DoneSignal {
+    /// Waits up to `timeout`; returns whether the render has finished.
+    fn wait(&self, timeout: Duration) -> bool {
+        let guard = self.done.lock().unwrap_or_else(|e| e.into_inner());
+        let (guard, _) = self
+            .changed
+            .wait_timeout_while(guard, timeout, |done| !*done)
+            .unwrap_or_else(|e| e.into_inner());
+        *guard
+    }
+}
+
+struct SignalOnDrop<'a>(&'a DoneSignal);
+
+impl Drop for SignalOnDrop<'_> {
+    fn drop(&mut self) {
+        *self.0.done.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.0.changed.notify_all();
+    }
+}
+
+/// Allocates the film (with a layer for each of `chain_groups` groups of Metropolis chains),
+/// reporting failure as a status instead of aborting.
+fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
+    let (width, height) = (settings.width, settings.height);
+    let pixels = width as usize * height as usize;
+    // Probe the largest allocations first: `vec!` would abort the process on failure.
+    let out_of_memory = || {
+        Error::new(
+            MLT_STATUS_OUT_OF_MEMORY,
+            format!("could not allocate the film for {width} x {height} pixels"),
+        )
+    };
+    let mut probe: Vec<[f64; 3]> = Vec::new();
+    probe
+        .try_reserve_exact(pixels)
+        .map_err(|_| out_of_memory())?;
+    drop(probe);
+    let buffers = settings.filter_buffers;
+    let mut partials: Vec<[f32; 3]> = Vec::new();
+    partials
+        .try_reserve_exact(pixels * buffers as usize)
+        .map_err(|_| out_of_memory())?;
+    drop(partials);
+    let mut layers: Vec<[f64; 3]> = Vec::new();
+    layers
+        .try_reserve_exact(pixels * chain_groups)
+        .map_err(|_| out_of_memory())?;
+    drop(layers);
+    let mut film = Film::new(width, height, settings.algorithm != Algorithm::Path);
+    if chain_groups > 0 {
+        film.enable_chain_layers(chain_groups);
+    }
+    if buffers > 0 {
+        film.enable_filter(FilterSettings {
+            buffers,
+            strength: settings.filter_strength,
+            radius: settings.filter_radius,
+        });
+    }
+    Ok(film)
+}
+
+/// A pool of `threads` worker threads (0: one per core).
+fn new_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("mlt-worker-{i}"))
+        .build()
+        .map_err(|e| {
+            Error::new(
+                MLT_STATUS_OUT_OF_MEMORY,
+                format!("could not start worker threads: {e}"),
+            )
+        })
+}
+
+/// The pool every render with `threads` 0 runs on: one thread per core for the whole
+/// process, started by the first such render, so that a host rendering from several
+/// threads at once shares the cores instead of starting a pool per render.
+fn shared_pool() -> Result<&'static rayon::ThreadPool> {
+    static SHARED: std::sync::OnceLock<std::result::Result<rayon::ThreadPool, String>> =
+        std::sync::OnceLock::new();
+    SHARED
+        .get_or_init(|| new_pool(0).map_err(|e| e.message))
+        .as_ref()
+        .map_err(|message| Error::new(MLT_STATUS_OUT_OF_MEMORY, message.clone()))
+}
