@@ -1,0 +1,157 @@
+//! Conversions between the C values a host passes and the kernel's Rust values, each
+//! range-checked with a message naming the field.
+
+use super::types::*;
+use crate::accel::Backend;
+use crate::error::*;
+use crate::integrators::mlt::driver::MutationWeights;
+use crate::render::{Algorithm, RenderSettings};
+use crate::scene::{Camera, MaterialKind};
+use glam::Vec3A;
+
+pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
+    match kind {
+        MLT_MATERIAL_DIFFUSE => Ok(MaterialKind::Diffuse),
+        MLT_MATERIAL_MIRROR => Ok(MaterialKind::Mirror),
+        MLT_MATERIAL_DIELECTRIC => Ok(MaterialKind::Dielectric),
+        other => Err(Error::invalid(format!(
+            "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
+        ))),
+    }
+}
+
+pub(super) fn backend(value: i32) -> Result<Backend> {
+    match value {
+        MLT_BACKEND_BVH => Ok(Backend::Bvh),
+        MLT_BACKEND_EMBREE => Ok(Backend::Embree),
+        other => Err(Error::invalid(format!(
+            "desc.backend is {other}; use MLT_BACKEND_BVH (0) or MLT_BACKEND_EMBREE (1)"
+        ))),
+    }
+}
+
+impl From<&MltCamera> for Camera {
+    fn from(c: &MltCamera) -> Self {
+        Camera {
+            eye: c.eye,
+            target: c.target,
+            up: c.up,
+            fov_y_deg: c.fov_y_deg,
+            lens_radius: c.lens_radius,
+            focus_distance: c.focus_distance,
+        }
+    }
+}
+
+pub(super) fn algorithm_to_c(algorithm: Algorithm) -> i32 {
+    match algorithm {
+        Algorithm::Path => MLT_ALGORITHM_PATH,
+        Algorithm::Bdpt => MLT_ALGORITHM_BDPT,
+        Algorithm::Pssmlt => MLT_ALGORITHM_PSSMLT,
+        Algorithm::Mmlt => MLT_ALGORITHM_MMLT,
+        Algorithm::PssmltBdpt => MLT_ALGORITHM_PSSMLT_BDPT,
+        Algorithm::PathSpaceMlt => MLT_ALGORITHM_PATH_SPACE_MLT,
+        Algorithm::Erpt => MLT_ALGORITHM_ERPT,
+    }
+}
+
+pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
+    let algorithm = match s.algorithm {
+        MLT_ALGORITHM_PATH => Algorithm::Path,
+        MLT_ALGORITHM_BDPT => Algorithm::Bdpt,
+        MLT_ALGORITHM_PSSMLT => Algorithm::Pssmlt,
+        MLT_ALGORITHM_MMLT => Algorithm::Mmlt,
+        MLT_ALGORITHM_PSSMLT_BDPT => Algorithm::PssmltBdpt,
+        MLT_ALGORITHM_PATH_SPACE_MLT => Algorithm::PathSpaceMlt,
+        MLT_ALGORITHM_ERPT => Algorithm::Erpt,
+        other => {
+            return Err(Error::invalid(format!(
+                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4), MLT_ALGORITHM_PATH_SPACE_MLT (5) or MLT_ALGORITHM_ERPT (6)"
+            )));
+        }
+    };
+    Ok(RenderSettings {
+        width: s.width,
+        height: s.height,
+        algorithm,
+        samples_per_pixel: s.samples_per_pixel,
+        max_depth: s.max_depth,
+        seed: s.seed,
+        threads: s.threads,
+        time_limit_seconds: s.time_limit_seconds,
+        mutations_per_pixel: s.mutations_per_pixel,
+        bootstrap_samples: s.bootstrap_samples,
+        chains: s.chains,
+        large_step_probability: s.large_step_probability,
+        small_step_sigma: s.small_step_sigma,
+        direct_samples_per_mutation: s.direct_samples_per_mutation,
+        mutation_weights: MutationWeights(s.mutation_weights),
+        erpt_chain_length: s.erpt_chain_length,
+        erpt_deposit_energy: s.erpt_deposit_energy,
+        adapt_mutation_weights: flag(s.adapt_mutation_weights, "adapt_mutation_weights")?,
+        perturb_in_sample_space: flag(s.perturb_in_sample_space, "perturb_in_sample_space")?,
+        filter_buffers: s.filter_buffers,
+        filter_strength: s.filter_strength,
+        filter_radius: s.filter_radius,
+        normalization_work_fraction: s.normalization_work_fraction,
+    })
+}
+
+/// A C boolean setting: 0 or 1, anything else is a mistake.
+pub(super) fn flag(value: u32, name: &str) -> Result<bool> {
+    match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        other => Err(Error::invalid(format!(
+            "settings.{name} is {other}; it must be 0 or 1"
+        ))),
+    }
+}
+
+/// Checks every ray of a batch query, naming the first bad one.
+pub(super) fn checked_rays(rays: &[MltRay]) -> Result<()> {
+    for (i, ray) in rays.iter().enumerate() {
+        check_finite3(&format!("rays[{i}].origin"), ray.origin)?;
+        check_finite3(&format!("rays[{i}].direction"), ray.direction)?;
+        let length = direction_length(ray.direction);
+        if length == 0.0 {
+            return Err(Error::invalid(format!(
+                "rays[{i}].direction is {:?}; it must be non-zero",
+                ray.direction
+            )));
+        }
+        if !(ray.tmin.is_finite() && ray.tmin >= 0.0) {
+            return Err(Error::invalid(format!(
+                "rays[{i}].tmin is {}; it must be finite and >= 0",
+                ray.tmin
+            )));
+        }
+        if ray.tmax.is_nan() || ray.tmax < ray.tmin {
+            return Err(Error::invalid(format!(
+                "rays[{i}].tmax is {}; it must be >= tmin ({})",
+                ray.tmax, ray.tmin
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// |direction| in f64: exact enough, and neither underflows nor overflows for finite floats.
+pub(super) fn direction_length(direction: [f32; 3]) -> f64 {
+    glam::DVec3::from(direction.map(f64::from)).length()
+}
+
+/// The ray with a unit direction and t scaled to match, plus the scale to map t back.
+pub(super) fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f64) {
+    let direction = glam::DVec3::from(ray.direction.map(f64::from));
+    let length = direction.length();
+    (
+        crate::accel::Ray::new(
+            Vec3A::from(ray.origin),
+            (direction / length).as_vec3a(),
+            (ray.tmin as f64 * length) as f32,
+            (ray.tmax as f64 * length) as f32,
+        ),
+        length,
+    )
+}

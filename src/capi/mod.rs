@@ -1,0 +1,499 @@
+//! The C ABI. Every export validates what the host passed, catches panics, and reports
+//! failures as an [`MltStatus`] plus a thread-local message. Conventions:
+//! - out-parameters are written only on success (renders also on cancel / time limit);
+//! - `*_release(NULL)` is a no-op;
+//! - enums coming from C are `int32_t` and range-checked (an invalid value in a Rust enum
+//!   would be undefined behaviour);
+//! - a null pointer is accepted only where a count of 0 makes it unused, or where the header
+//!   says it is optional.
+//!
+//! The C types and constants are in `types` (what include/mlt.h declares), the checks of
+//! host pointers and the panic guard in `marshal`, the conversions between C and Rust values
+//! in `convert`; this file holds the exports.
+
+mod convert;
+mod marshal;
+mod types;
+
+pub use types::*;
+
+use crate::accel::Backend;
+use crate::error::*;
+use crate::render::{self, RenderSettings, StopReason};
+use crate::scene::{Camera, Material, Scene, SceneDesc};
+use convert::*;
+use marshal::*;
+use std::ffi::{c_char, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+
+/// The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_version() -> u32 {
+    MLT_VERSION
+}
+
+/// The library version as "MAJOR.MINOR.PATCH" (static storage).
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_version_string() -> *const c_char {
+    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+}
+
+/// A static description of a status (any integer is accepted).
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_status_string(status: i32) -> *const c_char {
+    let text: &'static std::ffi::CStr = match status {
+        0 => c"success",
+        1 => c"invalid argument",
+        2 => c"unsupported",
+        3 => c"out of memory",
+        4 => c"cancelled by the progress callback",
+        5 => c"time limit reached",
+        6 => c"internal error",
+        _ => c"unknown status",
+    };
+    text.as_ptr()
+}
+
+/// The message of the last failed mlt call on this thread ("" after a success). The pointer
+/// stays valid until the next mlt call on this thread.
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_last_error_message() -> *const c_char {
+    LAST_ERROR.with(|e| e.borrow().as_ptr())
+}
+
+/// Whether `mlt_scene_create` can build scenes with `backend` (one of `MLT_BACKEND_*`) in
+/// this build of the library: true for `MLT_BACKEND_BVH`; for `MLT_BACKEND_EMBREE` only if
+/// mlt was compiled with the `embree` feature (otherwise scene creation with it returns
+/// `MLT_STATUS_UNSUPPORTED`); false for any other value.
+#[unsafe(no_mangle)]
+pub extern "C" fn mlt_backend_supported(backend: i32) -> bool {
+    self::backend(backend).is_ok_and(Backend::is_available)
+}
+
+/// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltMaterial`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_material_default(out: *mut MltMaterial) -> MltStatus {
+    guard(|| {
+        let value = MltMaterial {
+            kind: MLT_MATERIAL_DIFFUSE,
+            color: [0.8; 3],
+            emission: [0.0; 3],
+            ior: 1.5,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with an empty description (no arrays, BVH backend).
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltSceneDesc`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_desc_default(out: *mut MltSceneDesc) -> MltStatus {
+    guard(|| {
+        let value = MltSceneDesc {
+            positions: std::ptr::null(),
+            positions_len: 0,
+            indices: std::ptr::null(),
+            indices_len: 0,
+            material_ids: std::ptr::null(),
+            material_ids_len: 0,
+            materials: std::ptr::null(),
+            materials_len: 0,
+            backend: MLT_BACKEND_BVH,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with the Cornell box's pinhole camera.
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltCamera`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
+    guard(|| {
+        let c = Camera::default();
+        let value = MltCamera {
+            eye: c.eye,
+            target: c.target,
+            up: c.up,
+            fov_y_deg: c.fov_y_deg,
+            lens_radius: c.lens_radius,
+            focus_distance: c.focus_distance,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
+/// (32 mutations per pixel and one direct sample per mutation, an automatic bootstrap
+/// (2^18 samples at this size), 5% of the rays for the normalization pass,
+/// 1024 chains, large steps 0.3, small steps 0.01), 64 samples per pixel for path tracing and
+/// BDPT, max depth 5, seed 0, all cores, no time limit, no post-process filter (strength
+/// 0.45 and radius 7 when `filter_buffers` turns it on).
+///
+/// # Safety
+/// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings) -> MltStatus {
+    guard(|| {
+        let d = RenderSettings::default();
+        let value = MltRenderSettings {
+            width: d.width,
+            height: d.height,
+            algorithm: algorithm_to_c(d.algorithm),
+            samples_per_pixel: d.samples_per_pixel,
+            max_depth: d.max_depth,
+            threads: d.threads,
+            seed: d.seed,
+            time_limit_seconds: d.time_limit_seconds,
+            mutations_per_pixel: d.mutations_per_pixel,
+            bootstrap_samples: d.bootstrap_samples,
+            chains: d.chains,
+            large_step_probability: d.large_step_probability,
+            small_step_sigma: d.small_step_sigma,
+            direct_samples_per_mutation: d.direct_samples_per_mutation,
+            mutation_weights: d.mutation_weights.0,
+            erpt_chain_length: d.erpt_chain_length,
+            erpt_deposit_energy: d.erpt_deposit_energy,
+            adapt_mutation_weights: d.adapt_mutation_weights as u32,
+            perturb_in_sample_space: d.perturb_in_sample_space as u32,
+            filter_buffers: d.filter_buffers,
+            filter_strength: d.filter_strength,
+            filter_radius: d.filter_radius,
+            normalization_work_fraction: d.normalization_work_fraction,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Validates `desc`, copies its arrays and builds the acceleration structure. On success
+/// `*out` receives a scene to release with `mlt_scene_release`; on failure `*out` is untouched.
+///
+/// # Safety
+/// `desc` must point to an `MltSceneDesc` whose pointers reference arrays of at least the
+/// given lengths; `out` must be writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_create(
+    desc: *const MltSceneDesc,
+    out: *mut *mut MltScene,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract for every pointer below.
+        let desc = unsafe { host_ref(desc, "desc") }?;
+        check_pointer(out, "out")?;
+        let positions =
+            unsafe { host_slice(desc.positions, desc.positions_len, "desc.positions") }?;
+        let indices = unsafe { host_slice(desc.indices, desc.indices_len, "desc.indices") }?;
+        let material_ids = unsafe {
+            host_slice(
+                desc.material_ids,
+                desc.material_ids_len,
+                "desc.material_ids",
+            )
+        }?;
+        let host_materials =
+            unsafe { host_slice(desc.materials, desc.materials_len, "desc.materials") }?;
+        let materials = host_materials
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                Ok(Material {
+                    kind: material_kind(m.kind, i)?,
+                    color: m.color,
+                    emission: m.emission,
+                    ior: m.ior,
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let scene = Scene::new(&SceneDesc {
+            positions,
+            indices,
+            material_ids,
+            materials: &materials,
+            backend: backend(desc.backend)?,
+        })?;
+        let handle = Box::into_raw(Box::new(MltScene {
+            scene,
+            backend: desc.backend,
+        }));
+        // SAFETY: `out` checked non-null and aligned above.
+        unsafe { out.write(handle) };
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Releases a scene. NULL is a no-op. The scene must not be in use by another thread.
+///
+/// # Safety
+/// `scene` must be NULL or a pointer returned by `mlt_scene_create` not yet released.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_release(scene: *mut MltScene) {
+    if scene.is_null() {
+        return;
+    }
+    let _ = catch_unwind(AssertUnwindSafe(|| {
+        // SAFETY: created by Box::into_raw in mlt_scene_create, released once (contract).
+        drop(unsafe { Box::from_raw(scene) });
+    }));
+}
+
+/// Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
+///
+/// # Safety
+/// `scene` must be a live scene; `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_get_info(
+    scene: *const MltScene,
+    out: *mut MltSceneInfo,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let info = handle.scene.info();
+        let value = MltSceneInfo {
+            triangle_count: info.triangle_count as u64,
+            degenerate_triangle_count: info.degenerate_triangle_count as u64,
+            emitter_count: info.emitter_count as u64,
+            bounds_min: info.bounds_min,
+            bounds_max: info.bounds_max,
+            backend: handle.backend,
+        };
+        // SAFETY: forwarded contract.
+        unsafe { write_out(out, "out", value) }?;
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Renders `scene` seen by `camera` into `rgb_out`: width × height × 3 floats, linear RGB
+/// radiance, rows from top to bottom, left to right. `out_len` is the number of floats
+/// `rgb_out` holds (at least width·height·3). `progress` may be NULL.
+///
+/// Returns `MLT_STATUS_OK` when every sample was taken. `MLT_STATUS_CANCELLED` or
+/// `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
+/// normalized by the samples it actually received. A cancel or time limit takes effect once
+/// every pixel has at least one sample (the first pass is never interrupted). On any other status `rgb_out` is untouched.
+///
+/// # Safety
+/// Pointers must be valid as described; `rgb_out` must not be accessed by the host until
+/// the call returns.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render(
+    scene: *const MltScene,
+    camera: *const MltCamera,
+    settings: *const MltRenderSettings,
+    rgb_out: *mut f32,
+    out_len: usize,
+    progress: MltProgressCallback,
+    user_data: *mut c_void,
+) -> MltStatus {
+    // SAFETY: forwarded contract; no stats requested.
+    unsafe {
+        mlt_render_ex(
+            scene,
+            camera,
+            settings,
+            rgb_out,
+            out_len,
+            progress,
+            user_data,
+            std::ptr::null_mut(),
+        )
+    }
+}
+
+/// `mlt_render` that also fills `stats_out` (may be NULL) whenever it writes the image.
+///
+/// # Safety
+/// As `mlt_render`; `stats_out` NULL or writable.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn mlt_render_ex(
+    scene: *const MltScene,
+    camera: *const MltCamera,
+    settings: *const MltRenderSettings,
+    rgb_out: *mut f32,
+    out_len: usize,
+    progress: MltProgressCallback,
+    user_data: *mut c_void,
+    stats_out: *mut MltRenderStats,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract for every pointer below.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let camera: Camera = unsafe { host_ref(camera, "camera") }?.into();
+        let settings = render_settings(unsafe { host_ref(settings, "settings") }?)?;
+        if !stats_out.is_null() {
+            check_pointer(stats_out, "stats_out")?;
+        }
+        settings.validate()?;
+        camera.validate()?;
+        let needed = settings.output_len()?;
+        if out_len < needed {
+            return Err(Error::invalid(format!(
+                "out_len is {out_len} floats but a {} x {} RGB image needs {needed}",
+                settings.width, settings.height
+            )));
+        }
+        let image = unsafe { host_slice_mut(rgb_out, needed, "rgb_out") }?;
+        let mut forward = |fraction: f32| match progress {
+            // SAFETY: the host's callback with the host's user data, on the host's thread.
+            Some(callback) => unsafe { callback(fraction, user_data) },
+            None => true,
+        };
+        let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
+        if !stats_out.is_null() {
+            let value = MltRenderStats {
+                samples: stats.samples,
+                rays: stats.rays,
+                invalid_samples: stats.invalid_samples,
+                seconds: stats.seconds,
+                threads: stats.threads,
+                accepted_mutations: stats.accepted_mutations,
+                normalization: stats.normalization.value,
+                mutations: stats.mutations,
+                mutations_proposed: stats.mutation_counts.proposed,
+                mutations_accepted: stats.mutation_counts.accepted,
+                mutation_weights: stats.mutation_weights.0,
+                filter_changed_fraction: stats.filter.changed_fraction,
+                filter_mean_neighbours: stats.filter.mean_neighbours,
+                normalization_samples: stats.normalization.samples,
+                normalization_relative_error: stats.normalization.relative_error,
+                normalization_largest_share: stats.normalization.largest_share,
+            };
+            // SAFETY: checked non-null and aligned above.
+            unsafe { stats_out.write(value) };
+        }
+        Ok(match stats.stop {
+            StopReason::Completed => MLT_STATUS_OK,
+            StopReason::Cancelled => {
+                set_last_error(&format!(
+                    "the progress callback cancelled the render after {} samples and {} mutations",
+                    stats.samples, stats.mutations
+                ));
+                MLT_STATUS_CANCELLED
+            }
+            StopReason::TimeLimitReached => {
+                set_last_error(&format!(
+                    "the time limit of {} s was reached after {} samples and {} mutations",
+                    settings.time_limit_seconds, stats.samples, stats.mutations
+                ));
+                MLT_STATUS_TIME_LIMIT_REACHED
+            }
+        })
+    })
+}
+
+/// Closest hit for each of `count` rays, written to `hits_out[i]` (a miss has triangle_id
+/// `MLT_INVALID_ID` and t = INFINITY). Runs on the calling thread. Every ray is validated
+/// before any result is written.
+///
+/// # Safety
+/// `rays` and `hits_out` must hold `count` elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_intersect(
+    scene: *const MltScene,
+    rays: *const MltRay,
+    count: usize,
+    hits_out: *mut MltHit,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let rays = unsafe { host_slice(rays, count, "rays") }?;
+        if count == 0 {
+            return Ok(MLT_STATUS_OK);
+        }
+        let hits = unsafe { host_slice_mut(hits_out, count, "hits_out") }?;
+        checked_rays(rays)?;
+        for (ray, out) in rays.iter().zip(hits.iter_mut()) {
+            let (unit, length) = unit_ray(ray);
+            *out = match handle.scene.intersect(&unit) {
+                Some(hit) => MltHit {
+                    triangle_id: hit.triangle,
+                    t: (hit.t as f64 / length) as f32,
+                    u: hit.u,
+                    v: hit.v,
+                },
+                None => MltHit {
+                    triangle_id: MLT_INVALID_ID,
+                    t: f32::INFINITY,
+                    u: 0.0,
+                    v: 0.0,
+                },
+            };
+        }
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// For each of `count` rays, `occluded_out[i]` = 1 if any triangle lies on it within
+/// [tmin, tmax], else 0. Runs on the calling thread.
+///
+/// # Safety
+/// `rays` and `occluded_out` must hold `count` elements.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_occluded(
+    scene: *const MltScene,
+    rays: *const MltRay,
+    count: usize,
+    occluded_out: *mut u8,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract.
+        let handle = unsafe { host_ref(scene, "scene") }?;
+        let rays = unsafe { host_slice(rays, count, "rays") }?;
+        if count == 0 {
+            return Ok(MLT_STATUS_OK);
+        }
+        let out = unsafe { host_slice_mut(occluded_out, count, "occluded_out") }?;
+        checked_rays(rays)?;
+        for (ray, o) in rays.iter().zip(out.iter_mut()) {
+            let (unit, _) = unit_ray(ray);
+            *o = handle.scene.occluded(&unit) as u8;
+        }
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn version_constants_match_the_crate() {
+        assert_eq!(
+            env!("CARGO_PKG_VERSION"),
+            format!("{MLT_VERSION_MAJOR}.{MLT_VERSION_MINOR}.{MLT_VERSION_PATCH}")
+        );
+    }
+
+    #[test]
+    fn status_strings_match_descriptions() {
+        for status in [
+            MLT_STATUS_OK,
+            MLT_STATUS_INVALID_ARGUMENT,
+            MLT_STATUS_UNSUPPORTED,
+            MLT_STATUS_OUT_OF_MEMORY,
+            MLT_STATUS_CANCELLED,
+            MLT_STATUS_TIME_LIMIT_REACHED,
+            MLT_STATUS_INTERNAL_ERROR,
+        ] {
+            // SAFETY: static NUL-terminated strings.
+            let s = unsafe { std::ffi::CStr::from_ptr(mlt_status_string(status as i32)) };
+            assert_eq!(s.to_str().unwrap(), status.description());
+        }
+    }
+}

@@ -1,0 +1,320 @@
+//! The C types and constants: what include/mlt.h declares (cbindgen reads them here).
+
+use crate::scene::Scene;
+use std::ffi::c_void;
+
+/// Major version of the mlt library this header belongs to.
+pub const MLT_VERSION_MAJOR: u32 = 0;
+/// Minor version.
+pub const MLT_VERSION_MINOR: u32 = 1;
+/// Patch version.
+pub const MLT_VERSION_PATCH: u32 = 0;
+/// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
+/// checks; `mlt_version()` returns the linked library's.
+pub const MLT_VERSION: u32 =
+    MLT_VERSION_MAJOR * 10000 + MLT_VERSION_MINOR * 100 + MLT_VERSION_PATCH;
+
+/// `MltMaterial.kind`: Lambertian diffuse with albedo `color` (two-sided).
+pub const MLT_MATERIAL_DIFFUSE: i32 = 0;
+/// `MltMaterial.kind`: perfect mirror reflecting `color` (two-sided).
+pub const MLT_MATERIAL_MIRROR: i32 = 1;
+/// `MltMaterial.kind`: smooth dielectric (glass) with index of refraction `ior`, tinted by `color`.
+pub const MLT_MATERIAL_DIELECTRIC: i32 = 2;
+
+/// `MltSceneDesc.backend`: mlt's own SIMD BVH (8-wide with AVX2, else 4-wide; built with
+/// obvhs), always available.
+pub const MLT_BACKEND_BVH: i32 = 0;
+/// `MltSceneDesc.backend`: Intel Embree 3, only when mlt was built with the `embree` feature.
+pub const MLT_BACKEND_EMBREE: i32 = 1;
+
+/// `MltRenderSettings.algorithm`: path tracing with next-event estimation and MIS.
+pub const MLT_ALGORITHM_PATH: i32 = 0;
+/// `MltRenderSettings.algorithm`: bidirectional path tracing, all strategies combined by MIS
+/// (including light tracing onto the film).
+pub const MLT_ALGORITHM_BDPT: i32 = 1;
+/// `MltRenderSettings.algorithm`: primary-sample-space Metropolis light transport (Kelemen
+/// et al. 2002) over the path tracer; uses the `mutations_per_pixel`, `bootstrap_samples`,
+/// `chains`, `large_step_probability` and `small_step_sigma` settings.
+pub const MLT_ALGORITHM_PSSMLT: i32 = 2;
+/// `MltRenderSettings.algorithm`: multiplexed Metropolis light transport (Hachisuka et al. 2014): primary-sample-space
+/// chains over bidirectional path tracing that also pick the path depth and one connection
+/// strategy; one group of chains per depth, each normalized by its own bootstrap estimate.
+pub const MLT_ALGORITHM_MMLT: i32 = 3;
+/// `MltRenderSettings.algorithm`: primary-sample-space MLT over bidirectional path tracing,
+/// all strategies of a sample summed.
+pub const MLT_ALGORITHM_PSSMLT_BDPT: i32 = 4;
+/// `MltRenderSettings.algorithm`: path-space Metropolis light transport (Veach & Guibas
+/// 1997): the chains' states are light paths, changed by Veach's mutations; seeded and
+/// normalized by a bidirectional bootstrap. Uses `mutations_per_pixel`, `bootstrap_samples`
+/// and `chains`.
+pub const MLT_ALGORITHM_PATH_SPACE_MLT: i32 = 5;
+/// `MltRenderSettings.algorithm`: energy redistribution path tracing (Cline, Talbot & Egbert
+/// 2005): each of `samples_per_pixel` BDPT camera samples per pixel starts short chains of
+/// lens, caustic and multi-chain perturbations that spread its energy over nearby paths.
+/// Unbiased. Uses `erpt_chain_length`, `erpt_deposit_energy` and the perturbation weights
+/// of `mutation_weights`.
+pub const MLT_ALGORITHM_ERPT: i32 = 6;
+
+/// Index of the bidirectional mutation in `MltRenderSettings.mutation_weights` and the
+/// per-mutation counts of `MltRenderStats`.
+pub const MLT_MUTATION_BIDIRECTIONAL: i32 = 0;
+/// Index of the lens perturbation.
+pub const MLT_MUTATION_LENS: i32 = 1;
+/// Index of the caustic perturbation.
+pub const MLT_MUTATION_CAUSTIC: i32 = 2;
+/// Index of the multi-chain perturbation.
+pub const MLT_MUTATION_MULTI_CHAIN: i32 = 3;
+
+/// `MltHit.triangle_id` of a ray that hit nothing.
+pub const MLT_INVALID_ID: u32 = u32::MAX;
+
+/// A material. Initialize with `mlt_material_default`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltMaterial {
+    /// One of `MLT_MATERIAL_*`.
+    pub kind: i32,
+    /// Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+    pub color: [f32; 3],
+    /// Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
+    /// Any material may emit: its triangles become area lights.
+    pub emission: [f32; 3],
+    /// Index of refraction of a dielectric (> 0; the outside is vacuum). Must be finite for
+    /// every kind; only dielectrics use it.
+    pub ior: f32,
+}
+
+/// Everything `mlt_scene_create` needs, as plain arrays the host keeps ownership of (they are
+/// copied; the host may free them once the call returns). Initialize with
+/// `mlt_scene_desc_default`.
+///
+/// Degenerate triangles (zero area, e.g. repeated or collinear vertices) are accepted: they
+/// keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltSceneDesc {
+    /// Vertex positions, x y z per vertex; all finite.
+    pub positions: *const f32,
+    /// Number of floats in `positions` (3 per vertex).
+    pub positions_len: usize,
+    /// Vertex indices, 3 per triangle, each < vertex count. Counter-clockwise is the front.
+    pub indices: *const u32,
+    /// Number of entries in `indices` (3 per triangle).
+    pub indices_len: usize,
+    /// One material index per triangle, each < `materials_len`. May be NULL (with length 0):
+    /// every triangle then uses material 0.
+    pub material_ids: *const u32,
+    /// Number of entries in `material_ids`: 0 or the triangle count.
+    pub material_ids_len: usize,
+    pub materials: *const MltMaterial,
+    pub materials_len: usize,
+    /// One of `MLT_BACKEND_*`.
+    pub backend: i32,
+}
+
+/// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with
+/// `mlt_camera_default` (the Cornell box's camera).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltCamera {
+    pub eye: [f32; 3],
+    /// Must differ from `eye`.
+    pub target: [f32; 3],
+    /// Must not be parallel to target - eye.
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+    /// Thin-lens aperture radius; 0 for a pinhole.
+    pub lens_radius: f32,
+    /// Distance of the plane in focus; 0 means |target - eye|.
+    pub focus_distance: f32,
+}
+
+/// How to render. Initialize with `mlt_render_settings_default`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltRenderSettings {
+    /// Image size in pixels, each in [1, 65536].
+    pub width: u32,
+    pub height: u32,
+    /// One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_MMLT`.
+    pub algorithm: i32,
+    /// Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
+    /// `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.
+    pub samples_per_pixel: u32,
+    /// Most scattering vertices between camera and light (0: only directly visible
+    /// emitters), at most 1024.
+    pub max_depth: u32,
+    /// Worker threads; 0 runs on one pool of one thread per core that every such render in
+    /// the process shares (renders from several host threads at once then share the cores
+    /// instead of oversubscribing them); a count gives the render a pool of its own. The
+    /// image does not depend on it.
+    pub threads: u32,
+    /// Seed of every random number; equal seeds and settings give bitwise equal images.
+    pub seed: u64,
+    /// Stop after this many seconds (0: no limit). Finite, at most 1e7.
+    pub time_limit_seconds: f64,
+    /// Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
+    pub mutations_per_pixel: u32,
+    /// Metropolis: independent samples that seed the chains and start the estimate of the
+    /// image normalization, at most 2^28. 0 (the default) sizes it to the render: one
+    /// sample per 8 planned mutations, at least 2^16 (2^18 for a render planned by its time
+    /// limit alone).
+    pub bootstrap_samples: u32,
+    /// Metropolis: number of Markov chains, from 1 to the bootstrap samples. The image does
+    /// not depend on the thread count.
+    pub chains: u32,
+    /// PSSMLT: probability of a large (independent) step, in [0, 1].
+    pub large_step_probability: f32,
+    /// PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
+    pub small_step_sigma: f32,
+    /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
+    /// mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
+    /// depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
+    /// the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
+    /// pass, the chains render every depth.
+    pub direct_samples_per_mutation: u32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
+    /// `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among
+    /// those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
+    /// positive.
+    pub mutation_weights: [f32; 4],
+    /// `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 10.
+    pub erpt_chain_length: u32,
+    /// `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
+    /// sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
+    /// e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
+    pub erpt_deposit_energy: f32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`, 0 or 1: run a warm-up of about one mutation per pixel
+    /// with `mutation_weights`, then weight each mutation by its acceptance rate there
+    /// (within a factor of 8) for the rest of the render, on chains seeded anew. The weights
+    /// used are reported in `MltRenderStats::mutation_weights`. Default 0.
+    pub adapt_mutation_weights: u32,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT` and `MLT_ALGORITHM_ERPT`, 0 or 1: perturb directions at
+    /// diffuse vertices and lights by small steps in their cosine-weighted sample space
+    /// instead of within a cone. Default 0.
+    pub perturb_in_sample_space: u32,
+    /// Metropolis algorithms and `MLT_ALGORITHM_ERPT`: the post-process filter for blotchy
+    /// noise, non-local means guided by per-pixel variances measured from partial images.
+    /// 0 (the default) turns it off; otherwise the number of partial images the deposits are
+    /// split into, from `MLT_MIN_FILTER_BUFFERS` to `MLT_MAX_FILTER_BUFFERS` (8 is a good
+    /// start; each costs 12 bytes per pixel). The image keeps its total: the filter moves
+    /// energy between pixels (a local bias) to lower the error. `MltRenderStats` reports
+    /// what it did.
+    pub filter_buffers: u32,
+    /// The filter's strength, in (0, `MLT_MAX_FILTER_STRENGTH`]; default 0.45. Higher
+    /// smooths more.
+    pub filter_strength: f32,
+    /// The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
+    pub filter_radius: u32,
+    /// Metropolis: the share of the rays spent on independent samples of the chains' target,
+    /// drawn alongside the chains to go on estimating the normalization b, which sets the
+    /// image's brightness; in [0, 0.9], default 0.05. The image is scaled by the final
+    /// estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
+    /// large steps), so its brightness error shrinks as the render goes on. 0: no such
+    /// samples.
+    pub normalization_work_fraction: f32,
+}
+
+/// What a render did (filled by `mlt_render_ex`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MltRenderStats {
+    /// Camera samples taken over the whole image (path tracing, BDPT, the direct pass of a
+    /// Metropolis render).
+    pub samples: u64,
+    /// Rays traced, closest-hit and shadow.
+    pub rays: u64,
+    /// Samples with a non-finite value, dropped (they count as black samples).
+    pub invalid_samples: u64,
+    /// Wall-clock seconds of the render.
+    pub seconds: f64,
+    /// Worker threads used.
+    pub threads: u32,
+    /// Metropolis: accepted mutations, of `mutations`.
+    pub accepted_mutations: u64,
+    /// Metropolis: the normalization b (mean luminance of the path contribution) the image
+    /// was scaled by, its final estimate. `MLT_ALGORITHM_ERPT`: the deposit energy used.
+    pub normalization: f64,
+    /// Metropolis: mutations made by all chains.
+    pub mutations: u64,
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: proposals of each mutation, indexed by
+    /// `MLT_MUTATION_*`.
+    pub mutations_proposed: [u64; 4],
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: accepted proposals of each mutation.
+    pub mutations_accepted: [u64; 4],
+    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: the mutation weights the chains ran with (after the
+    /// warm-up, with `adapt_mutation_weights`). `MLT_ALGORITHM_ERPT`: its weights.
+    pub mutation_weights: [f32; 4],
+    /// With `filter_buffers`: the luminance the filter moved, Σ|change| / Σ luminance (the
+    /// total is kept) …
+    pub filter_changed_fraction: f64,
+    /// … and about how many pixels each pixel was averaged over (the mean sum of weights).
+    pub filter_mean_neighbours: f64,
+    /// Metropolis: independent samples the normalization was estimated from …
+    pub normalization_samples: u64,
+    /// … the estimated standard error of `normalization` over it (from the samples'
+    /// variance: the brightness uncertainty of the image) …
+    pub normalization_relative_error: f64,
+    /// … and the largest share of it a single sample carried (near 1 / samples when no rare
+    /// bright path dominates).
+    pub normalization_largest_share: f64,
+}
+
+/// Facts about a created scene.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MltSceneInfo {
+    pub triangle_count: u64,
+    /// Triangles with zero area: never hit, never emit.
+    pub degenerate_triangle_count: u64,
+    /// Emissive triangles (area lights).
+    pub emitter_count: u64,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    /// The `MLT_BACKEND_*` the scene was built with.
+    pub backend: i32,
+}
+
+/// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
+/// `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
+/// `direction` need not be unit length; t is measured in multiples of it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltRay {
+    pub origin: [f32; 3],
+    /// Finite, >= 0.
+    pub tmin: f32,
+    /// Finite and non-zero.
+    pub direction: [f32; 3],
+    /// >= tmin; may be INFINITY.
+    pub tmax: f32,
+}
+
+/// A closest hit. The hit point is (1-u-v)·v0 + u·v1 + v·v2 of the triangle's vertices in
+/// the order the host gave them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltHit {
+    /// The host's triangle index, or `MLT_INVALID_ID` for a miss (then t = INFINITY).
+    pub triangle_id: u32,
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+/// An immutable scene: triangles, materials, lights and the acceleration structure. Thread
+/// safe: any number of threads may render and query one scene at the same time.
+pub struct MltScene {
+    pub(super) scene: Scene,
+    pub(super) backend: i32,
+}
+
+/// Progress callback: called on the thread that called `mlt_render` (never from a worker),
+/// about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
+/// Return `true` to continue and `false` to cancel. It must return normally: a C++
+/// exception thrown through it, or a `longjmp` out of it, skips mlt's cleanup (worker
+/// threads keep running on freed memory) and is undefined behavior; catch inside the
+/// callback and return `false` instead.
+pub type MltProgressCallback =
+    Option<unsafe extern "C" fn(fraction: f32, user_data: *mut c_void) -> bool>;
