@@ -306,26 +306,31 @@ fn erpt_takes_its_settings_and_reports_mutations() {
 #[test]
 fn time_limit_with_unbounded_samples_completes_at_the_limit_and_says_so() {
     let out = temp_path("timed.png");
-    let output = mlt_render(&[
-        &scene("cornell-box.obj"),
-        &"--algorithm",
-        &"path",
-        &"--spp",
-        &"0",
-        &"--time-limit",
-        &"0.3",
-        &"--width",
-        &"16",
-        &"--height",
-        &"16",
-        &"--threads",
-        &"1",
-        &"--out",
-        &out,
-    ]);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(output.status.success(), "{output:?}");
+    // A 16 x 16 path-traced render of `spp` samples per pixel (0: unbounded) with a time
+    // limit of 0.3 s; its summary.
+    let timed_render = |spp: &str| -> String {
+        let output = mlt_render(&[
+            &scene("cornell-box.obj"),
+            &"--algorithm",
+            &"path",
+            &"--spp",
+            &spp,
+            &"--time-limit",
+            &"0.3",
+            &"--width",
+            &"16",
+            &"--height",
+            &"16",
+            &"--threads",
+            &"1",
+            &"--out",
+            &out,
+        ]);
+        assert!(output.status.success(), "{output:?}");
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    };
     // The user asked for exactly that: not "stopped early".
+    let stdout = timed_render("0");
     assert!(
         stdout.contains("status        completed at the time limit of 0.3 s"),
         "{stdout}"
@@ -334,25 +339,7 @@ fn time_limit_with_unbounded_samples_completes_at_the_limit_and_says_so() {
     assert_eq!((image.width(), image.height()), (16, 16));
 
     // A sample count the time limit cuts short is stopping early.
-    let output = mlt_render(&[
-        &scene("cornell-box.obj"),
-        &"--algorithm",
-        &"path",
-        &"--spp",
-        &"1000000",
-        &"--time-limit",
-        &"0.3",
-        &"--width",
-        &"16",
-        &"--height",
-        &"16",
-        &"--threads",
-        &"1",
-        &"--out",
-        &out,
-    ]);
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    assert!(output.status.success(), "{output:?}");
+    let stdout = timed_render("1000000");
     assert!(
         stdout.contains("status        stopped early: time limit of 0.3 s reached"),
         "{stdout}"
