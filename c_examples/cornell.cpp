@@ -69,6 +69,12 @@ inline MltRenderSettings defaultSettings() {
     check(mlt_render_settings_default(&s), "mlt_render_settings_default");
     return s;
 }
+// Structs mlt fills in are initialized too: struct_size says which fields this header has.
+inline MltRenderStats emptyStats() {
+    MltRenderStats s;
+    check(mlt_render_stats_default(&s), "mlt_render_stats_default");
+    return s;
+}
 
 struct Vec3 {
     float x, y, z;
@@ -159,6 +165,7 @@ public:
 
     MltSceneInfo info() const {
         MltSceneInfo info;
+        check(mlt_scene_info_default(&info), "mlt_scene_info_default");
         check(mlt_scene_get_info(handle_, &info), "mlt_scene_get_info");
         return info;
     }
@@ -317,7 +324,7 @@ int main(int argc, char **argv) try {
         settings.mutations_per_pixel = static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10));
     }
     int lastPercent = -1;
-    MltRenderStats stats;
+    MltRenderStats stats = mltxx::emptyStats();
     const mltxx::Image image = scene.render(
         mltxx::defaultCamera(), settings,
         [&](float fraction) {

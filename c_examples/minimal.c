@@ -2,7 +2,7 @@
  * minimal.c: the smallest complete mlt host.
  *
  * This program builds the Cornell box in code, renders it with mlt's default algorithm
- * (primary-sample-space Metropolis light transport) and writes
+ * (multiplexed Metropolis light transport) and writes
  * the result as a PFM image (a linear, floating-point format most image viewers and
  * tools such as ImageMagick or GIMP can open). Read it top to bottom: every mlt call is
  * explained where it is used.
@@ -17,7 +17,9 @@
  * A few conventions hold for every mlt function; once you know them you know the API:
  *   - Structs you pass in (MltSceneDesc, MltMaterial, MltCamera, MltRenderSettings) are
  *     first filled by their mlt_*_default() initializer, then you change what you need.
- *     A future version may add fields; the initializer gives them sensible values.
+ *     Structs mlt fills in (MltSceneInfo, MltRenderStats) are initialized the same way.
+ *     The initializer also sets struct_size, so a future library with more fields still
+ *     reads and writes exactly the fields this program was compiled with.
  *   - Every fallible call returns an MltStatus. MLT_STATUS_OK (0) means success. Otherwise
  *     mlt_status_string(status) says what kind of failure it was and
  *     mlt_last_error_message() says exactly which field, index or value was wrong.
@@ -178,11 +180,14 @@ int main(int argc, char **argv) {
         return 2;
     }
     printf("mlt %s\n", mlt_version_string());
-#if MLT_VERSION < 100
-#error "this example needs mlt 0.1 or later"
+#if MLT_VERSION < 200
+#error "this example needs mlt 0.2 or later"
 #endif
-    if (mlt_version() != MLT_VERSION) {
-        fprintf(stderr, "linked mlt %u, header %u\n", (unsigned)mlt_version(), (unsigned)MLT_VERSION);
+    /* A library at least as new as the header works: it reads an older header's structs
+     * by their struct_size. An older library may lack what this header declares. */
+    if (mlt_version() < MLT_VERSION) {
+        fprintf(stderr, "linked mlt %u is older than the header %u\n", (unsigned)mlt_version(),
+                (unsigned)MLT_VERSION);
         return 1;
     }
 
@@ -227,6 +232,9 @@ int main(int argc, char **argv) {
     desc.backend = MLT_BACKEND_BVH; /* the default; MLT_BACKEND_EMBREE needs a special build */
     if (!check(mlt_scene_create(&desc, &scene), "mlt_scene_create")) return 1;
 
+    /* Structs mlt fills in are initialized too: their struct_size tells mlt which fields
+     * this program's header has. */
+    if (!check(mlt_scene_info_default(&info), "mlt_scene_info_default")) goto done;
     if (!check(mlt_scene_get_info(scene, &info), "mlt_scene_get_info")) goto done;
     printf("scene: %llu triangles, %llu lights, %llu degenerate\n",
            (unsigned long long)info.triangle_count, (unsigned long long)info.emitter_count,

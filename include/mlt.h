@@ -4,7 +4,8 @@
  * Link: -lmlt (static: also -lm -lpthread -ldl), or the shared library libmlt.so.
  * Conventions: every fallible call returns an MltStatus; on failure
  * mlt_last_error_message() names the offending field, index and value. Out-parameters are
- * written only on success. Initialize descriptor structs with their mlt_*_default().
+ * written only on success. Initialize every struct with its mlt_*_default() (it sets
+ * struct_size, which lets a newer library work with this header).
  * The progress callback must return normally (no C++ exception or longjmp through it).
  */
 
@@ -39,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 1
+#define MLT_VERSION_MINOR 2
 
 /**
  * Patch version.
@@ -265,6 +266,11 @@ typedef struct MltScene MltScene;
  */
 typedef struct MltMaterial {
   /**
+   * sizeof(MltMaterial) of the header the host was built with: set by `mlt_material_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
+  /**
    * One of `MLT_MATERIAL_*`.
    */
   int32_t kind;
@@ -293,6 +299,11 @@ typedef struct MltMaterial {
  * keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
  */
 typedef struct MltSceneDesc {
+  /**
+   * sizeof(MltSceneDesc) of the header the host was built with: set by `mlt_scene_desc_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
   /**
    * Vertex positions, x y z per vertex; all finite.
    */
@@ -331,6 +342,11 @@ typedef struct MltSceneDesc {
  * `mlt_camera_default` (the Cornell box's camera).
  */
 typedef struct MltCamera {
+  /**
+   * sizeof(MltCamera) of the header the host was built with: set by `mlt_camera_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
   float eye[3];
   /**
    * Must differ from `eye`.
@@ -358,6 +374,11 @@ typedef struct MltCamera {
  * How to render. Initialize with `mlt_render_settings_default`.
  */
 typedef struct MltRenderSettings {
+  /**
+   * sizeof(MltRenderSettings) of the header the host was built with: set by `mlt_render_settings_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
   /**
    * Image size in pixels, each in [1, 65536].
    */
@@ -485,40 +506,14 @@ typedef struct MltRenderSettings {
 } MltRenderSettings;
 
 /**
- * Facts about a created scene.
- */
-typedef struct MltSceneInfo {
-  uint64_t triangle_count;
-  /**
-   * Triangles with zero area: never hit, never emit.
-   */
-  uint64_t degenerate_triangle_count;
-  /**
-   * Emissive triangles (area lights).
-   */
-  uint64_t emitter_count;
-  float bounds_min[3];
-  float bounds_max[3];
-  /**
-   * The `MLT_BACKEND_*` the scene was built with.
-   */
-  int32_t backend;
-} MltSceneInfo;
-
-/**
- * Progress callback: called on the thread that called `mlt_render` (never from a worker),
- * about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
- * Return `true` to continue and `false` to cancel. It must return normally: a C++
- * exception thrown through it, or a `longjmp` out of it, skips mlt's cleanup (worker
- * threads keep running on freed memory) and is undefined behavior; catch inside the
- * callback and return `false` instead.
- */
-typedef bool (*MltProgressCallback)(float fraction, void *user_data);
-
-/**
- * What a render did (filled by `mlt_render_ex`).
+ * What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.
  */
 typedef struct MltRenderStats {
+  /**
+   * sizeof(MltRenderStats) of the header the host was built with: set by `mlt_render_stats_default` before the
+   * call. An older header's smaller struct receives the fields it has.
+   */
+  uint32_t struct_size;
   /**
    * Camera samples taken over the whole image (path tracing, BDPT, the direct pass of a
    * Metropolis render).
@@ -593,6 +588,43 @@ typedef struct MltRenderStats {
 } MltRenderStats;
 
 /**
+ * Facts about a created scene (filled by `mlt_scene_get_info`). Initialize with
+ * `mlt_scene_info_default`.
+ */
+typedef struct MltSceneInfo {
+  /**
+   * sizeof(MltSceneInfo) of the header the host was built with: set by `mlt_scene_info_default` before the
+   * call. An older header's smaller struct receives the fields it has.
+   */
+  uint32_t struct_size;
+  uint64_t triangle_count;
+  /**
+   * Triangles with zero area: never hit, never emit.
+   */
+  uint64_t degenerate_triangle_count;
+  /**
+   * Emissive triangles (area lights).
+   */
+  uint64_t emitter_count;
+  float bounds_min[3];
+  float bounds_max[3];
+  /**
+   * The `MLT_BACKEND_*` the scene was built with.
+   */
+  int32_t backend;
+} MltSceneInfo;
+
+/**
+ * Progress callback: called on the thread that called `mlt_render` (never from a worker),
+ * about 20 times a second and once with 1.0 at the end, with the fraction done in [0, 1].
+ * Return `true` to continue and `false` to cancel. It must return normally: a C++
+ * exception thrown through it, or a `longjmp` out of it, skips mlt's cleanup (worker
+ * threads keep running on freed memory) and is undefined behavior; catch inside the
+ * callback and return `false` instead.
+ */
+typedef bool (*MltProgressCallback)(float fraction, void *user_data);
+
+/**
  * A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with
  * `MLT_BACKEND_EMBREE`: (tmin, tmax], which differs only for a hit at exactly t = tmin).
  * `direction` need not be unit length; t is measured in multiples of it.
@@ -663,28 +695,30 @@ MLT_API const char *mlt_last_error_message(void);
 MLT_API bool mlt_backend_supported(int32_t backend);
 
 /**
- * Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).
+ * Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics) and
+ * `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
+ * passes the host's `sizeof(MltMaterial)`; the other `*_init` functions likewise.
  *
  * # Safety
- * `out` must be NULL or point to writable memory for an `MltMaterial`.
+ * `out` must be NULL or point to `struct_size` writable bytes.
  */
-MLT_API enum MltStatus mlt_material_default(struct MltMaterial *out);
+MLT_API enum MltStatus mlt_material_init(struct MltMaterial *out, size_t struct_size);
 
 /**
  * Fills `out` with an empty description (no arrays, BVH backend).
  *
  * # Safety
- * `out` must be NULL or point to writable memory for an `MltSceneDesc`.
+ * `out` must be NULL or point to `struct_size` writable bytes.
  */
-MLT_API enum MltStatus mlt_scene_desc_default(struct MltSceneDesc *out);
+MLT_API enum MltStatus mlt_scene_desc_init(struct MltSceneDesc *out, size_t struct_size);
 
 /**
  * Fills `out` with the Cornell box's pinhole camera.
  *
  * # Safety
- * `out` must be NULL or point to writable memory for an `MltCamera`.
+ * `out` must be NULL or point to `struct_size` writable bytes.
  */
-MLT_API enum MltStatus mlt_camera_default(struct MltCamera *out);
+MLT_API enum MltStatus mlt_camera_init(struct MltCamera *out, size_t struct_size);
 
 /**
  * Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
@@ -695,9 +729,25 @@ MLT_API enum MltStatus mlt_camera_default(struct MltCamera *out);
  * 0.45 and radius 7 when `filter_buffers` turns it on).
  *
  * # Safety
- * `out` must be NULL or point to writable memory for an `MltRenderSettings`.
+ * `out` must be NULL or point to `struct_size` writable bytes.
  */
-MLT_API enum MltStatus mlt_render_settings_default(struct MltRenderSettings *out);
+MLT_API enum MltStatus mlt_render_settings_init(struct MltRenderSettings *out, size_t struct_size);
+
+/**
+ * Prepares `out` to receive a render's statistics: zeros and `struct_size`.
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_render_stats_init(struct MltRenderStats *out, size_t struct_size);
+
+/**
+ * Prepares `out` to receive a scene's facts: zeros and `struct_size`.
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_scene_info_init(struct MltSceneInfo *out, size_t struct_size);
 
 /**
  * Validates `desc`, copies its arrays and builds the acceleration structure. On success
@@ -773,3 +823,28 @@ MLT_API enum MltStatus mlt_occluded(const struct MltScene *scene, const struct M
 #endif  // __cplusplus
 
 #endif  /* MLT_H */
+
+#ifndef MLT_H_INITIALIZERS
+#define MLT_H_INITIALIZERS
+/* The initializers: each fills a struct with its defaults and sets struct_size to this
+ * header's sizeof, so a newer library reads (and writes) only the fields this host has.
+ * Call one on every struct before filling it in or passing it to receive results. */
+static inline MltStatus mlt_material_default(MltMaterial *out) {
+    return mlt_material_init(out, sizeof(MltMaterial));
+}
+static inline MltStatus mlt_scene_desc_default(MltSceneDesc *out) {
+    return mlt_scene_desc_init(out, sizeof(MltSceneDesc));
+}
+static inline MltStatus mlt_camera_default(MltCamera *out) {
+    return mlt_camera_init(out, sizeof(MltCamera));
+}
+static inline MltStatus mlt_render_settings_default(MltRenderSettings *out) {
+    return mlt_render_settings_init(out, sizeof(MltRenderSettings));
+}
+static inline MltStatus mlt_render_stats_default(MltRenderStats *out) {
+    return mlt_render_stats_init(out, sizeof(MltRenderStats));
+}
+static inline MltStatus mlt_scene_info_default(MltSceneInfo *out) {
+    return mlt_scene_info_init(out, sizeof(MltSceneInfo));
+}
+#endif  /* MLT_H_INITIALIZERS */

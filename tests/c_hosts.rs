@@ -84,15 +84,32 @@ fn scratch_dir() -> PathBuf {
     dir
 }
 
-/// Compiles `source` (C unless `as_cpp`, with `std`), links the static library, and returns
-/// the executable.
+/// Compiles `source` (C unless `as_cpp`, with `std`) against include/mlt.h, links the
+/// static library, and returns the executable.
 fn build(source: &str, exe_name: &str, as_cpp: bool, extra: &[&str]) -> PathBuf {
+    build_with_header(
+        &crate_dir().join("include"),
+        source,
+        exe_name,
+        as_cpp,
+        extra,
+    )
+}
+
+/// [`build`] against the mlt.h in `include_dir`.
+fn build_with_header(
+    include_dir: &Path,
+    source: &str,
+    exe_name: &str,
+    as_cpp: bool,
+    extra: &[&str],
+) -> PathBuf {
     let out = scratch_dir().join(exe_name);
     let _ = std::fs::remove_file(&out);
     let mut cmd = common::compiler(as_cpp);
     cmd.args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
         .arg("-I")
-        .arg(crate_dir().join("include"))
+        .arg(include_dir)
         .args(extra)
         .arg(crate_dir().join("c_examples").join(source))
         // Whatever follows is a library, not source in the language given by `-x`.
@@ -273,6 +290,28 @@ fn check_picture(image: &Pfm, name: &str) {
 fn minimal_c_compiles_as_c99_and_matches_the_rust_api() {
     let exe = build("minimal.c", "minimal_c99", false, &["-std=c99"]);
     let stdout = run_and_check(&exe, "minimal_c99");
+    assert!(stdout.contains("32 triangles"), "{stdout}");
+}
+
+/// A host compiled against an older header (tests/previous_header/mlt.h: the settings and
+/// stats before the post-process filter's fields) passes smaller structs; mlt reads what
+/// they have and defaults the rest, so the image is the current API's, bit for bit.
+#[test]
+fn a_host_built_against_the_previous_header_renders() {
+    let previous = crate_dir().join("tests").join("previous_header");
+    let header = std::fs::read_to_string(previous.join("mlt.h")).unwrap();
+    assert!(
+        !header.contains("filter_buffers;") && header.contains("struct_size;"),
+        "the previous header lacks the filter fields and has struct_size"
+    );
+    let exe = build_with_header(
+        &previous,
+        "minimal.c",
+        "minimal_previous_header",
+        false,
+        &["-std=c99"],
+    );
+    let stdout = run_and_check(&exe, "minimal_previous_header");
     assert!(stdout.contains("32 triangles"), "{stdout}");
 }
 

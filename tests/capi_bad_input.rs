@@ -70,7 +70,7 @@ const SENTINEL_F32: f32 = -12345.0;
 fn default_material() -> MltMaterial {
     let mut m = std::mem::MaybeUninit::<MltMaterial>::uninit();
     // SAFETY: writable memory for an MltMaterial.
-    assert_ok(unsafe { mlt_material_default(m.as_mut_ptr()) });
+    assert_ok(unsafe { mlt_material_init(m.as_mut_ptr(), size_of::<MltMaterial>()) });
     // SAFETY: initialized on success.
     unsafe { m.assume_init() }
 }
@@ -78,22 +78,36 @@ fn default_material() -> MltMaterial {
 fn default_camera() -> MltCamera {
     let mut c = std::mem::MaybeUninit::<MltCamera>::uninit();
     // SAFETY: as above.
-    assert_ok(unsafe { mlt_camera_default(c.as_mut_ptr()) });
+    assert_ok(unsafe { mlt_camera_init(c.as_mut_ptr(), size_of::<MltCamera>()) });
     unsafe { c.assume_init() }
 }
 
 fn default_settings() -> MltRenderSettings {
     let mut s = std::mem::MaybeUninit::<MltRenderSettings>::uninit();
     // SAFETY: as above.
-    assert_ok(unsafe { mlt_render_settings_default(s.as_mut_ptr()) });
+    assert_ok(unsafe { mlt_render_settings_init(s.as_mut_ptr(), size_of::<MltRenderSettings>()) });
     unsafe { s.assume_init() }
 }
 
 fn default_desc() -> MltSceneDesc {
     let mut d = std::mem::MaybeUninit::<MltSceneDesc>::uninit();
     // SAFETY: as above.
-    assert_ok(unsafe { mlt_scene_desc_default(d.as_mut_ptr()) });
+    assert_ok(unsafe { mlt_scene_desc_init(d.as_mut_ptr(), size_of::<MltSceneDesc>()) });
     unsafe { d.assume_init() }
+}
+
+fn render_stats_default() -> MltRenderStats {
+    let mut s = MltRenderStats::default();
+    // SAFETY: writable memory of this size.
+    assert_ok(unsafe { mlt_render_stats_init(&mut s, size_of::<MltRenderStats>()) });
+    s
+}
+
+fn scene_info_default() -> MltSceneInfo {
+    let mut i = MltSceneInfo::default();
+    // SAFETY: writable memory of this size.
+    assert_ok(unsafe { mlt_scene_info_init(&mut i, size_of::<MltSceneInfo>()) });
+    i
 }
 
 fn small_settings(width: u32, height: u32, spp: u32) -> MltRenderSettings {
@@ -160,6 +174,7 @@ impl HostScene {
             materials: self.materials.as_ptr(),
             materials_len: self.materials.len(),
             backend: self.backend,
+            ..default_desc()
         }
     }
 
@@ -201,7 +216,7 @@ impl Drop for Handle {
 
 impl Handle {
     fn info(&self) -> MltSceneInfo {
-        let mut info = MltSceneInfo::default();
+        let mut info = scene_info_default();
         // SAFETY: live scene, writable out.
         assert_ok(unsafe { mlt_scene_get_info(self.0, &mut info) });
         info
@@ -238,7 +253,7 @@ impl Handle {
         settings: &MltRenderSettings,
     ) -> (Vec<f32>, MltRenderStats) {
         let mut rgb = vec![0.0f32; 4 * 4 * 3];
-        let mut stats = MltRenderStats::default();
+        let mut stats = render_stats_default();
         // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
         let status = unsafe {
             mlt_render_ex(
@@ -263,7 +278,7 @@ impl Handle {
         let mut image = vec![SENTINEL_F32; len];
         let mut stats = MltRenderStats {
             samples: 77,
-            ..Default::default()
+            ..render_stats_default()
         };
         // SAFETY: valid pointers; `len` floats.
         let status = unsafe {
@@ -343,10 +358,22 @@ fn assert_valid_image(image: &[f32], what: &str) {
 fn default_initializers_reject_null() {
     // SAFETY: NULL is an accepted input (documented: returns an error).
     unsafe {
-        assert_invalid(mlt_material_default(null_mut()), &["out", "NULL"]);
-        assert_invalid(mlt_scene_desc_default(null_mut()), &["out", "NULL"]);
-        assert_invalid(mlt_camera_default(null_mut()), &["out", "NULL"]);
-        assert_invalid(mlt_render_settings_default(null_mut()), &["out", "NULL"]);
+        assert_invalid(
+            mlt_material_init(null_mut(), size_of::<MltMaterial>()),
+            &["out", "NULL"],
+        );
+        assert_invalid(
+            mlt_scene_desc_init(null_mut(), size_of::<MltSceneDesc>()),
+            &["out", "NULL"],
+        );
+        assert_invalid(
+            mlt_camera_init(null_mut(), size_of::<MltCamera>()),
+            &["out", "NULL"],
+        );
+        assert_invalid(
+            mlt_render_settings_init(null_mut(), size_of::<MltRenderSettings>()),
+            &["out", "NULL"],
+        );
     }
 }
 
@@ -462,6 +489,240 @@ fn supported_backends() -> Vec<i32> {
         .into_iter()
         .filter(|&b| mlt_backend_supported(b))
         .collect()
+}
+
+// ---------------------------------------------------------------------------------------
+// struct_size: hosts built against an older (or newer) header
+// ---------------------------------------------------------------------------------------
+
+/// The size of a layout whose fields end where `first_missing` starts, padded as C pads it.
+fn earlier_size<T>(first_missing: usize) -> u32 {
+    first_missing.next_multiple_of(align_of::<T>()) as u32
+}
+
+/// Sizes no header ever had: never initialized, too small, between layouts, from the future.
+fn unknown_sizes<T>() -> [usize; 4] {
+    [0, 3, size_of::<T>() - align_of::<T>(), size_of::<T>() + 8]
+}
+
+#[test]
+fn initializers_refuse_null_and_unknown_sizes() {
+    type Init = fn(*mut u8, usize) -> MltStatus;
+    // Each takes its own struct; `storage` below is large and aligned enough for any.
+    // SAFETY (each closure): forwards the pointer and size to the initializer under test.
+    let initializers: [(&str, usize, Init); 6] = [
+        (
+            "mlt_material_default",
+            size_of::<MltMaterial>(),
+            |p, n| unsafe { mlt_material_init(p.cast(), n) },
+        ),
+        (
+            "mlt_scene_desc_default",
+            size_of::<MltSceneDesc>(),
+            |p, n| unsafe { mlt_scene_desc_init(p.cast(), n) },
+        ),
+        (
+            "mlt_camera_default",
+            size_of::<MltCamera>(),
+            |p, n| unsafe { mlt_camera_init(p.cast(), n) },
+        ),
+        (
+            "mlt_render_settings_default",
+            size_of::<MltRenderSettings>(),
+            |p, n| unsafe { mlt_render_settings_init(p.cast(), n) },
+        ),
+        (
+            "mlt_render_stats_default",
+            size_of::<MltRenderStats>(),
+            |p, n| unsafe { mlt_render_stats_init(p.cast(), n) },
+        ),
+        (
+            "mlt_scene_info_default",
+            size_of::<MltSceneInfo>(),
+            |p, n| unsafe { mlt_scene_info_init(p.cast(), n) },
+        ),
+    ];
+    for (name, size, init) in initializers {
+        let mut storage = [0xABu8; 512];
+        let aligned = storage
+            .as_mut_ptr()
+            .wrapping_add(storage.as_ptr().align_offset(8));
+        // The storage holds any size tried (< 512 - 8).
+        assert_invalid(init(null_mut(), size), &["out", "NULL"]);
+        for bad in [0, 3, size - 8, size + 8] {
+            assert_invalid(
+                init(aligned, bad),
+                &["out.struct_size", &bad.to_string(), name],
+            );
+            assert!(
+                storage.iter().all(|&b| b == 0xAB),
+                "{name}: out untouched on failure"
+            );
+        }
+        assert_ok(init(aligned, size));
+        // SAFETY: 4 initialized, aligned bytes of `storage`.
+        let written = unsafe { aligned.cast::<u32>().read() };
+        assert_eq!(written as usize, size, "{name} sets struct_size");
+    }
+}
+
+#[test]
+fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
+    let host = HostScene::floor_and_light();
+    let scene = host.create();
+    for size in unknown_sizes::<MltRenderSettings>() {
+        let settings = MltRenderSettings {
+            struct_size: size as u32,
+            ..small_settings(4, 4, 1)
+        };
+        scene.render_fails(
+            &floor_camera(),
+            &settings,
+            &["settings.struct_size", &size.to_string()],
+        );
+    }
+    for size in unknown_sizes::<MltCamera>() {
+        let camera = MltCamera {
+            struct_size: size as u32,
+            ..floor_camera()
+        };
+        scene.render_fails(&camera, &small_settings(4, 4, 1), &["camera.struct_size"]);
+    }
+    for size in unknown_sizes::<MltRenderStats>() {
+        let mut stats = MltRenderStats {
+            struct_size: size as u32,
+            samples: 77,
+            ..render_stats_default()
+        };
+        let mut image = vec![SENTINEL_F32; 48];
+        // SAFETY: valid pointers; 48 floats.
+        let status = unsafe {
+            mlt_render_ex(
+                scene.0,
+                &floor_camera(),
+                &small_settings(4, 4, 1),
+                image.as_mut_ptr(),
+                48,
+                None,
+                null_mut(),
+                &mut stats,
+            )
+        };
+        assert_invalid(
+            status,
+            &["stats_out.struct_size", "mlt_render_stats_default"],
+        );
+        assert!(image.iter().all(|&v| v == SENTINEL_F32) && stats.samples == 77);
+    }
+    for size in unknown_sizes::<MltSceneInfo>() {
+        let mut info = MltSceneInfo {
+            struct_size: size as u32,
+            triangle_count: 99,
+            ..scene_info_default()
+        };
+        // SAFETY: live scene, writable out.
+        assert_invalid(
+            unsafe { mlt_scene_get_info(scene.0, &mut info) },
+            &["out.struct_size"],
+        );
+        assert_eq!(info.triangle_count, 99);
+    }
+    for size in unknown_sizes::<MltSceneDesc>() {
+        let desc = MltSceneDesc {
+            struct_size: size as u32,
+            ..host.desc()
+        };
+        host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["desc.struct_size"]);
+    }
+    for size in unknown_sizes::<MltMaterial>() {
+        let mut materials = host.clone();
+        materials.materials[0].struct_size = size as u32;
+        materials.create_fails(
+            &materials.desc(),
+            MLT_STATUS_INVALID_ARGUMENT,
+            &["desc.materials[0].struct_size"],
+        );
+    }
+    // An array's stride is its first element's size: every element must carry the same.
+    let mut mixed = host.clone();
+    mixed.materials[1].struct_size += 8;
+    mixed.create_fails(
+        &mixed.desc(),
+        MLT_STATUS_INVALID_ARGUMENT,
+        &["desc.materials[1].struct_size", "desc.materials[0]'s"],
+    );
+}
+
+/// A host built against the header before the post-process filter (its settings end at
+/// `perturb_in_sample_space`, its stats at `mutation_weights`) renders the image a current
+/// host gets with the filter off, and mlt writes none of the stats it does not have. The C
+/// version of this host is `tests/c_hosts.rs`'s `a_host_built_against_the_previous_header_renders`.
+#[test]
+fn an_older_layout_reads_what_it_has_and_defaults_the_rest() {
+    let scene = HostScene::floor_and_light().create();
+    let current = MltRenderSettings {
+        algorithm: MLT_ALGORITHM_PSSMLT,
+        mutations_per_pixel: 2,
+        ..small_settings(4, 4, 1)
+    };
+    let (expected, expected_stats) = scene.render_4x4_with_stats(&floor_camera(), &current);
+    // Past an older host's struct lies memory of its own: mlt must not read it.
+    let older = MltRenderSettings {
+        struct_size: earlier_size::<MltRenderSettings>(std::mem::offset_of!(
+            MltRenderSettings,
+            filter_buffers
+        )),
+        filter_buffers: 999,
+        filter_strength: f32::NAN,
+        filter_radius: 0,
+        normalization_work_fraction: -1.0,
+        ..current
+    };
+    let first_missing_stat = std::mem::offset_of!(MltRenderStats, filter_changed_fraction);
+    let mut stats = MltRenderStats {
+        struct_size: earlier_size::<MltRenderStats>(first_missing_stat),
+        filter_changed_fraction: -7.0,
+        normalization_samples: 77,
+        normalization_largest_share: -7.0,
+        ..render_stats_default()
+    };
+    let mut rgb = vec![0.0f32; 48];
+    // SAFETY: valid pointers; 48 floats.
+    let status = unsafe {
+        mlt_render_ex(
+            scene.0,
+            &floor_camera(),
+            &older,
+            rgb.as_mut_ptr(),
+            48,
+            None,
+            null_mut(),
+            &mut stats,
+        )
+    };
+    assert_ok(status);
+    assert_eq!(
+        rgb, expected,
+        "the same image as with today's defaults for the missing fields"
+    );
+    assert_eq!(
+        (stats.samples, stats.mutations),
+        (expected_stats.samples, expected_stats.mutations)
+    );
+    assert_eq!(stats.normalization, expected_stats.normalization);
+    assert_eq!(
+        (
+            stats.filter_changed_fraction,
+            stats.normalization_samples,
+            stats.normalization_largest_share
+        ),
+        (-7.0, 77, -7.0),
+        "fields past the host's struct are not written"
+    );
+    assert_eq!(
+        stats.struct_size,
+        earlier_size::<MltRenderStats>(first_missing_stat)
+    );
 }
 
 // ---------------------------------------------------------------------------------------
@@ -977,7 +1238,7 @@ fn a_scene_of_only_degenerate_triangles_renders_black() {
 fn get_info_null_pointers() {
     let mut info = MltSceneInfo {
         triangle_count: 99,
-        ..Default::default()
+        ..scene_info_default()
     };
     // SAFETY: NULL must be rejected.
     let status = unsafe { mlt_scene_get_info(null(), &mut info) };
@@ -1260,7 +1521,7 @@ fn erpt_settings_out_of_range() {
             ..erpt
         };
         let mut rgb = vec![0.0f32; 4 * 4 * 3];
-        let mut stats = MltRenderStats::default();
+        let mut stats = render_stats_default();
         // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
         let status = unsafe {
             mlt_render_ex(
@@ -1922,7 +2183,7 @@ fn last_error_is_cleared_by_each_kind_of_success() {
     let scene = HostScene::floor_and_light().create();
     let fail = || {
         // SAFETY: NULL must be rejected.
-        let s = unsafe { mlt_camera_default(null_mut()) };
+        let s = unsafe { mlt_camera_init(null_mut(), size_of::<MltCamera>()) };
         assert_invalid(s, &["out"]);
         assert!(!last_error().is_empty());
     };
@@ -2049,7 +2310,7 @@ fn cancelling_from_the_progress_callback() {
     };
     let settings = small_settings(8, 8, MLT_MAX_SAMPLES_PER_PIXEL);
     let mut image = vec![SENTINEL_F32; 192];
-    let mut stats = MltRenderStats::default();
+    let mut stats = render_stats_default();
     // SAFETY: valid pointers; `log` outlives the call.
     let status = unsafe {
         mlt_render_ex(
@@ -2084,7 +2345,7 @@ fn time_limit_with_huge_sample_count() {
         ..small_settings(8, 8, MLT_MAX_SAMPLES_PER_PIXEL)
     };
     let mut image = vec![SENTINEL_F32; 192];
-    let mut stats = MltRenderStats::default();
+    let mut stats = render_stats_default();
     let start = std::time::Instant::now();
     // SAFETY: valid pointers.
     let status = unsafe {

@@ -110,14 +110,3 @@ pub(super) unsafe fn host_slice_mut<'a, T>(
     // SAFETY: as host_slice, and the host guarantees exclusive access for the call.
     Ok(unsafe { std::slice::from_raw_parts_mut(pointer, len) })
 }
-
-/// Writes an out-parameter after checking it.
-///
-/// # Safety
-/// If non-null, `pointer` must be valid for a write of `T`.
-pub(super) unsafe fn write_out<T>(pointer: *mut T, name: &str, value: T) -> Result<()> {
-    check_pointer(pointer, name)?;
-    // SAFETY: non-null and aligned; writable by the caller's contract.
-    unsafe { pointer.write(value) };
-    Ok(())
-}

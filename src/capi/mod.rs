@@ -7,11 +7,16 @@
 //! - a null pointer is accepted only where a count of 0 makes it unused, or where the header
 //!   says it is optional.
 //!
+//! - every struct the host fills or receives starts with `struct_size`, so a host built
+//!   against an older header keeps working (`extensible`).
+//!
 //! The C types and constants are in `types` (what include/mlt.h declares), the checks of
 //! host pointers and the panic guard in `marshal`, the conversions between C and Rust values
-//! in `convert`; this file holds the exports.
+//! in `convert`, the reading and writing of growing structs in `extensible`; this file holds
+//! the exports.
 
 mod convert;
+mod extensible;
 mod marshal;
 mod types;
 
@@ -19,9 +24,10 @@ pub use types::*;
 
 use crate::accel::Backend;
 use crate::error::*;
-use crate::render::{self, RenderSettings, StopReason};
+use crate::render::{self, StopReason};
 use crate::scene::{Camera, Material, Scene, SceneDesc};
 use convert::*;
+use extensible::*;
 use marshal::*;
 use std::ffi::{c_char, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -70,69 +76,39 @@ pub extern "C" fn mlt_backend_supported(backend: i32) -> bool {
     self::backend(backend).is_ok_and(Backend::is_available)
 }
 
-/// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics).
+/// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics) and
+/// `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
+/// passes the host's `sizeof(MltMaterial)`; the other `*_init` functions likewise.
 ///
 /// # Safety
-/// `out` must be NULL or point to writable memory for an `MltMaterial`.
+/// `out` must be NULL or point to `struct_size` writable bytes.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn mlt_material_default(out: *mut MltMaterial) -> MltStatus {
-    guard(|| {
-        let value = MltMaterial {
-            kind: MLT_MATERIAL_DIFFUSE,
-            color: [0.8; 3],
-            emission: [0.0; 3],
-            ior: 1.5,
-        };
-        // SAFETY: forwarded contract.
-        unsafe { write_out(out, "out", value) }?;
-        Ok(MLT_STATUS_OK)
-    })
+pub unsafe extern "C" fn mlt_material_init(out: *mut MltMaterial, struct_size: usize) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
 }
 
 /// Fills `out` with an empty description (no arrays, BVH backend).
 ///
 /// # Safety
-/// `out` must be NULL or point to writable memory for an `MltSceneDesc`.
+/// `out` must be NULL or point to `struct_size` writable bytes.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn mlt_scene_desc_default(out: *mut MltSceneDesc) -> MltStatus {
-    guard(|| {
-        let value = MltSceneDesc {
-            positions: std::ptr::null(),
-            positions_len: 0,
-            indices: std::ptr::null(),
-            indices_len: 0,
-            material_ids: std::ptr::null(),
-            material_ids_len: 0,
-            materials: std::ptr::null(),
-            materials_len: 0,
-            backend: MLT_BACKEND_BVH,
-        };
-        // SAFETY: forwarded contract.
-        unsafe { write_out(out, "out", value) }?;
-        Ok(MLT_STATUS_OK)
-    })
+pub unsafe extern "C" fn mlt_scene_desc_init(
+    out: *mut MltSceneDesc,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
 }
 
 /// Fills `out` with the Cornell box's pinhole camera.
 ///
 /// # Safety
-/// `out` must be NULL or point to writable memory for an `MltCamera`.
+/// `out` must be NULL or point to `struct_size` writable bytes.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
-    guard(|| {
-        let c = Camera::default();
-        let value = MltCamera {
-            eye: c.eye,
-            target: c.target,
-            up: c.up,
-            fov_y_deg: c.fov_y_deg,
-            lens_radius: c.lens_radius,
-            focus_distance: c.focus_distance,
-        };
-        // SAFETY: forwarded contract.
-        unsafe { write_out(out, "out", value) }?;
-        Ok(MLT_STATUS_OK)
-    })
+pub unsafe extern "C" fn mlt_camera_init(out: *mut MltCamera, struct_size: usize) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
 }
 
 /// Fills `out` with the default settings: 256 x 256, multiplexed MLT with the direct pass
@@ -143,40 +119,40 @@ pub unsafe extern "C" fn mlt_camera_default(out: *mut MltCamera) -> MltStatus {
 /// 0.45 and radius 7 when `filter_buffers` turns it on).
 ///
 /// # Safety
-/// `out` must be NULL or point to writable memory for an `MltRenderSettings`.
+/// `out` must be NULL or point to `struct_size` writable bytes.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn mlt_render_settings_default(out: *mut MltRenderSettings) -> MltStatus {
-    guard(|| {
-        let d = RenderSettings::default();
-        let value = MltRenderSettings {
-            width: d.width,
-            height: d.height,
-            algorithm: algorithm_to_c(d.algorithm),
-            samples_per_pixel: d.samples_per_pixel,
-            max_depth: d.max_depth,
-            threads: d.threads,
-            seed: d.seed,
-            time_limit_seconds: d.time_limit_seconds,
-            mutations_per_pixel: d.mutations_per_pixel,
-            bootstrap_samples: d.bootstrap_samples,
-            chains: d.chains,
-            large_step_probability: d.large_step_probability,
-            small_step_sigma: d.small_step_sigma,
-            direct_samples_per_mutation: d.direct_samples_per_mutation,
-            mutation_weights: d.mutation_weights.0,
-            erpt_chain_length: d.erpt_chain_length,
-            erpt_deposit_energy: d.erpt_deposit_energy,
-            adapt_mutation_weights: d.adapt_mutation_weights as u32,
-            perturb_in_sample_space: d.perturb_in_sample_space as u32,
-            filter_buffers: d.filter_buffers,
-            filter_strength: d.filter_strength,
-            filter_radius: d.filter_radius,
-            normalization_work_fraction: d.normalization_work_fraction,
-        };
-        // SAFETY: forwarded contract.
-        unsafe { write_out(out, "out", value) }?;
-        Ok(MLT_STATUS_OK)
-    })
+pub unsafe extern "C" fn mlt_render_settings_init(
+    out: *mut MltRenderSettings,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Prepares `out` to receive a render's statistics: zeros and `struct_size`.
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render_stats_init(
+    out: *mut MltRenderStats,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Prepares `out` to receive a scene's facts: zeros and `struct_size`.
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_info_init(
+    out: *mut MltSceneInfo,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
 }
 
 /// Validates `desc`, copies its arrays and builds the acceleration structure. On success
@@ -192,7 +168,7 @@ pub unsafe extern "C" fn mlt_scene_create(
 ) -> MltStatus {
     guard(|| {
         // SAFETY: forwarded contract for every pointer below.
-        let desc = unsafe { host_ref(desc, "desc") }?;
+        let desc = unsafe { read_host(desc, "desc") }?;
         check_pointer(out, "out")?;
         let positions =
             unsafe { host_slice(desc.positions, desc.positions_len, "desc.positions") }?;
@@ -205,7 +181,7 @@ pub unsafe extern "C" fn mlt_scene_create(
             )
         }?;
         let host_materials =
-            unsafe { host_slice(desc.materials, desc.materials_len, "desc.materials") }?;
+            unsafe { read_host_array(desc.materials, desc.materials_len, "desc.materials") }?;
         let materials = host_materials
             .iter()
             .enumerate()
@@ -262,8 +238,10 @@ pub unsafe extern "C" fn mlt_scene_get_info(
     guard(|| {
         // SAFETY: forwarded contract.
         let handle = unsafe { host_ref(scene, "scene") }?;
+        let fields = unsafe { host_fields(out, "out") }?;
         let info = handle.scene.info();
         let value = MltSceneInfo {
+            struct_size: 0, // the host's stays
             triangle_count: info.triangle_count as u64,
             degenerate_triangle_count: info.degenerate_triangle_count as u64,
             emitter_count: info.emitter_count as u64,
@@ -271,8 +249,8 @@ pub unsafe extern "C" fn mlt_scene_get_info(
             bounds_max: info.bounds_max,
             backend: handle.backend,
         };
-        // SAFETY: forwarded contract.
-        unsafe { write_out(out, "out", value) }?;
+        // SAFETY: checked by host_fields; writable by the contract.
+        unsafe { write_host(out, fields, &value) };
         Ok(MLT_STATUS_OK)
     })
 }
@@ -333,11 +311,13 @@ pub unsafe extern "C" fn mlt_render_ex(
     guard(|| {
         // SAFETY: forwarded contract for every pointer below.
         let handle = unsafe { host_ref(scene, "scene") }?;
-        let camera: Camera = unsafe { host_ref(camera, "camera") }?.into();
-        let settings = render_settings(unsafe { host_ref(settings, "settings") }?)?;
-        if !stats_out.is_null() {
-            check_pointer(stats_out, "stats_out")?;
-        }
+        let camera: Camera = (&unsafe { read_host(camera, "camera") }?).into();
+        let settings = render_settings(&unsafe { read_host(settings, "settings") }?)?;
+        let stats_fields = if stats_out.is_null() {
+            None
+        } else {
+            Some(unsafe { host_fields(stats_out, "stats_out") }?)
+        };
         settings.validate()?;
         camera.validate()?;
         let needed = settings.output_len()?;
@@ -354,8 +334,9 @@ pub unsafe extern "C" fn mlt_render_ex(
             None => true,
         };
         let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
-        if !stats_out.is_null() {
+        if let Some(fields) = stats_fields {
             let value = MltRenderStats {
+                struct_size: 0, // the host's stays
                 samples: stats.samples,
                 rays: stats.rays,
                 invalid_samples: stats.invalid_samples,
@@ -373,8 +354,8 @@ pub unsafe extern "C" fn mlt_render_ex(
                 normalization_relative_error: stats.normalization.relative_error,
                 normalization_largest_share: stats.normalization.largest_share,
             };
-            // SAFETY: checked non-null and aligned above.
-            unsafe { stats_out.write(value) };
+            // SAFETY: checked by host_fields above; writable by the contract.
+            unsafe { write_host(stats_out, fields, &value) };
         }
         Ok(match stats.stop {
             StopReason::Completed => MLT_STATUS_OK,

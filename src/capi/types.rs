@@ -6,7 +6,7 @@ use std::ffi::c_void;
 /// Major version of the mlt library this header belongs to.
 pub const MLT_VERSION_MAJOR: u32 = 0;
 /// Minor version.
-pub const MLT_VERSION_MINOR: u32 = 1;
+pub const MLT_VERSION_MINOR: u32 = 2;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
 /// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
@@ -72,6 +72,9 @@ pub const MLT_INVALID_ID: u32 = u32::MAX;
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltMaterial {
+    /// sizeof(MltMaterial) of the header the host was built with: set by `mlt_material_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
     /// One of `MLT_MATERIAL_*`.
     pub kind: i32,
     /// Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
@@ -93,6 +96,9 @@ pub struct MltMaterial {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltSceneDesc {
+    /// sizeof(MltSceneDesc) of the header the host was built with: set by `mlt_scene_desc_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
     /// Vertex positions, x y z per vertex; all finite.
     pub positions: *const f32,
     /// Number of floats in `positions` (3 per vertex).
@@ -117,6 +123,9 @@ pub struct MltSceneDesc {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltCamera {
+    /// sizeof(MltCamera) of the header the host was built with: set by `mlt_camera_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
     pub eye: [f32; 3],
     /// Must differ from `eye`.
     pub target: [f32; 3],
@@ -134,6 +143,9 @@ pub struct MltCamera {
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltRenderSettings {
+    /// sizeof(MltRenderSettings) of the header the host was built with: set by `mlt_render_settings_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
     /// Image size in pixels, each in [1, 65536].
     pub width: u32,
     pub height: u32,
@@ -216,10 +228,13 @@ pub struct MltRenderSettings {
     pub normalization_work_fraction: f32,
 }
 
-/// What a render did (filled by `mlt_render_ex`).
+/// What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MltRenderStats {
+    /// sizeof(MltRenderStats) of the header the host was built with: set by `mlt_render_stats_default` before the
+    /// call. An older header's smaller struct receives the fields it has.
+    pub struct_size: u32,
     /// Camera samples taken over the whole image (path tracing, BDPT, the direct pass of a
     /// Metropolis render).
     pub samples: u64,
@@ -261,10 +276,14 @@ pub struct MltRenderStats {
     pub normalization_largest_share: f64,
 }
 
-/// Facts about a created scene.
+/// Facts about a created scene (filled by `mlt_scene_get_info`). Initialize with
+/// `mlt_scene_info_default`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MltSceneInfo {
+    /// sizeof(MltSceneInfo) of the header the host was built with: set by `mlt_scene_info_default` before the
+    /// call. An older header's smaller struct receives the fields it has.
+    pub struct_size: u32,
     pub triangle_count: u64,
     /// Triangles with zero area: never hit, never emit.
     pub degenerate_triangle_count: u64,

@@ -420,6 +420,7 @@ impl Mesh {
         self.materials
             .iter()
             .map(|m| mlt::capi::MltMaterial {
+                struct_size: size_of::<mlt::capi::MltMaterial>() as u32,
                 kind: match m.kind {
                     mlt::MaterialKind::Diffuse => mlt::capi::MLT_MATERIAL_DIFFUSE,
                     mlt::MaterialKind::Mirror => mlt::capi::MLT_MATERIAL_MIRROR,
