@@ -22,12 +22,6 @@ fn erpt_settings(size: u32, samples_per_pixel: u32, seed: u64) -> RenderSettings
     }
 }
 
-fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Vec<f32> {
-    let mut image = vec![0.0; (settings.width * settings.height * 3) as usize];
-    render(scene, camera, settings, &mut image, None).unwrap();
-    image
-}
-
 fn erpt_estimate(
     scene: &Scene,
     camera: &Camera,
@@ -87,7 +81,7 @@ fn agrees_with_the_path_tracer(
     perturb_in_sample_space: bool,
 ) {
     let (scene, camera) = load_canonical(scene_name);
-    let reference = path_traced_estimate(&scene, &camera, 64, 256, 1000..1008);
+    let reference = path_reference(scene_name);
     let test = erpt_estimate(&scene, &camera, samples_per_pixel, perturb_in_sample_space);
     let (tm, tv) = test.mean();
     let (rm, rv) = reference.mean();
@@ -103,14 +97,7 @@ fn agrees_with_the_path_tracer(
     }
     // 16 renders a side: region variances have 15 degrees of freedom (see
     // `assert_estimates_agree`); 51 comparisons.
-    assert_estimates_agree(
-        &format!("{scene_name} ERPT"),
-        &test,
-        &reference,
-        4,
-        5.0,
-        6.0,
-    );
+    assert_estimates_agree(&format!("{scene_name} ERPT"), &test, reference, 4, 5.0, 6.0);
 }
 
 #[test]
@@ -135,17 +122,7 @@ fn cornell_glass_in_sample_space_agrees_with_the_path_tracer() {
 #[test]
 fn door_ajar_agrees_with_bdpt() {
     let (scene, camera) = load_canonical("door-ajar");
-    let renders: Vec<Vec<f32>> = (1000..1016)
-        .map(|seed| {
-            let settings = RenderSettings {
-                algorithm: Algorithm::Bdpt,
-                ..erpt_settings(64, 64, seed)
-            };
-            render_image(&scene, &camera, &settings)
-        })
-        .collect();
-    // Light-tracing splats correlate a render's pixels.
-    let reference = Estimate::from_correlated_renders(64, 64, &renders);
+    let reference = bdpt_reference("door-ajar", 64);
     let test = erpt_estimate(&scene, &camera, DOOR_AJAR_SAMPLES, false);
     let (tm, tv) = test.mean();
     let (rm, rv) = reference.mean();
@@ -159,7 +136,7 @@ fn door_ajar_agrees_with_bdpt() {
             100.0 * se / rm[c]
         );
     }
-    assert_estimates_agree("door-ajar ERPT", &test, &reference, 4, 5.0, 6.0);
+    assert_estimates_agree("door-ajar ERPT", &test, reference, 4, 5.0, 6.0);
 }
 
 const DOOR_AJAR_SAMPLES: u32 = 24;

@@ -39,37 +39,6 @@ fn metropolis_settings(
     }
 }
 
-fn render_image(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Vec<f32> {
-    let mut image = vec![0.0; (settings.width * settings.height * 3) as usize];
-    render(scene, camera, settings, &mut image, None).unwrap();
-    image
-}
-
-fn path_reference(scene: &Scene, camera: &Camera) -> Estimate {
-    path_traced_estimate(scene, camera, 64, 256, 1000..1008)
-}
-
-/// BDPT's estimate, the reference where the path tracer is too slow to be sharp (the door-ajar
-/// scene): `tests/bdpt.rs` checks BDPT against the path tracer there.
-fn bdpt_reference(scene: &Scene, camera: &Camera, samples_per_pixel: u32) -> Estimate {
-    let renders: Vec<Vec<f32>> = (1000..1016)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: 64,
-                height: 64,
-                algorithm: Algorithm::Bdpt,
-                samples_per_pixel,
-                max_depth: 5,
-                seed,
-                ..Default::default()
-            };
-            render_image(scene, camera, &settings)
-        })
-        .collect();
-    // Light-tracing splats correlate a render's pixels.
-    Estimate::from_correlated_renders(64, 64, &renders)
-}
-
 /// Bootstrap samples that make b, and so the image mean, good enough for a 2% error to be
 /// resolvable on the Cornell scenes.
 fn cornell_bootstrap_samples(variant: Variant) -> u32 {
@@ -145,7 +114,7 @@ fn furnace_matches_the_geometric_series(variant: Variant) {
 
 fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
     let (scene, camera) = load_canonical(scene_name);
-    let reference = path_reference(&scene, &camera);
+    let reference = path_reference(scene_name);
     let bootstrap_samples = cornell_bootstrap_samples(variant);
     let normalization = (
         bootstrap_samples,
@@ -164,7 +133,7 @@ fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
     assert_estimates_agree(
         &format!("{scene_name} {variant:?}"),
         &test,
-        &reference,
+        reference,
         4,
         5.0,
         6.0,
@@ -178,7 +147,7 @@ fn agrees_with_the_path_tracer(variant: Variant, scene_name: &str) {
 /// (the test's setting before the pass) for as good a b.
 fn agrees_with_bdpt_on_the_door_ajar_scene(variant: Variant) {
     let (scene, camera) = load_canonical("door-ajar");
-    let reference = bdpt_reference(&scene, &camera, 32);
+    let reference = bdpt_reference("door-ajar", 32);
     // At 64 mutations per pixel the chains' and the direct pass's noise (light through the
     // crack) left the 2% check too little margin. 24 renders also steady the variance
     // estimate (23 degrees of freedom).
@@ -186,7 +155,7 @@ fn agrees_with_bdpt_on_the_door_ajar_scene(variant: Variant) {
     assert_estimates_agree(
         &format!("door-ajar {variant:?}"),
         &test,
-        &reference,
+        reference,
         4,
         5.0,
         6.0,
@@ -276,7 +245,9 @@ fn path_space_perturbations_in_sample_space_agree_with_bdpt_on_a_glass_caustic()
 
 fn perturbations_agree_with_bdpt_on_a_glass_caustic(adapted_in_sample_space: bool) {
     let (scene, camera) = glass_caustic();
-    let reference = bdpt_reference(&scene, &camera, 128);
+    let reference = cached_estimate("bdpt glass caustic 128", || {
+        bdpt_estimate(&scene, &camera, 128)
+    });
     let renders: Vec<Vec<f32>> = (0..16)
         .map(|seed| {
             let settings = RenderSettings {
@@ -297,7 +268,7 @@ fn perturbations_agree_with_bdpt_on_a_glass_caustic(adapted_in_sample_space: boo
         })
         .collect();
     let test = Estimate::from_correlated_renders(64, 64, &renders);
-    assert_estimates_agree("glass caustic", &test, &reference, 4, 5.0, 6.0);
+    assert_estimates_agree("glass caustic", &test, reference, 4, 5.0, 6.0);
 }
 
 fn image_is_identical_for_any_thread_count(variant: Variant) {
@@ -319,7 +290,7 @@ fn image_is_identical_for_any_thread_count(variant: Variant) {
 
 fn cancelled_render_is_normalized_by_the_mutations_made(variant: Variant) {
     let (scene, camera) = load_canonical("cornell-box");
-    let reference = path_reference(&scene, &camera).mean().0;
+    let reference = path_reference("cornell-box").mean().0;
     let settings = RenderSettings {
         mutations_per_pixel: 1 << 20,
         ..metropolis_settings(variant, 64, 0, 5)

@@ -344,6 +344,71 @@ pub fn path_traced_estimate(
     Estimate::from_renders(size as usize, size as usize, &renders)
 }
 
+/// Renders `settings` into a new image (the render must succeed).
+pub fn render_image(scene: &Scene, camera: &Camera, settings: &mlt::RenderSettings) -> Vec<f32> {
+    let mut image = vec![0.0; (settings.width * settings.height * 3) as usize];
+    mlt::render(scene, camera, settings, &mut image, None).unwrap();
+    image
+}
+
+/// An estimate computed once per test binary under `key`: the tests comparing against the
+/// same reference share it (one asking while another computes it waits for that one).
+pub fn cached_estimate(key: &str, compute: impl FnOnce() -> Estimate) -> &'static Estimate {
+    type Slot = &'static std::sync::OnceLock<Estimate>;
+    static SLOTS: std::sync::Mutex<Vec<(String, Slot)>> = std::sync::Mutex::new(Vec::new());
+    let slot: Slot = {
+        let mut slots = SLOTS.lock().unwrap();
+        match slots.iter().find(|(k, _)| k == key) {
+            Some(&(_, slot)) => slot,
+            None => {
+                let slot: Slot = Box::leak(Box::default());
+                slots.push((key.to_owned(), slot));
+                slot
+            }
+        }
+    };
+    slot.get_or_init(compute)
+}
+
+/// The path tracer's estimate of a canonical scene, the reference of the Metropolis and
+/// ERPT tests on the Cornell scenes: 8 renders of 64 × 64 pixels at 256 samples.
+pub fn path_reference(scene_name: &str) -> &'static Estimate {
+    cached_estimate(&format!("path {scene_name}"), || {
+        let (scene, camera) = load_canonical(scene_name);
+        path_traced_estimate(&scene, &camera, 64, 256, 1000..1008)
+    })
+}
+
+/// BDPT's estimate (16 renders of 64 × 64 pixels, max depth 5), the reference where the
+/// path tracer is too slow to be sharp (the door-ajar scene, caustics): `tests/bdpt.rs`
+/// checks BDPT against the path tracer.
+pub fn bdpt_estimate(scene: &Scene, camera: &Camera, samples_per_pixel: u32) -> Estimate {
+    let renders: Vec<Vec<f32>> = (1000..1016)
+        .map(|seed| {
+            let settings = mlt::RenderSettings {
+                width: 64,
+                height: 64,
+                algorithm: mlt::Algorithm::Bdpt,
+                samples_per_pixel,
+                max_depth: 5,
+                seed,
+                ..Default::default()
+            };
+            render_image(scene, camera, &settings)
+        })
+        .collect();
+    // Light-tracing splats correlate a render's pixels.
+    Estimate::from_correlated_renders(64, 64, &renders)
+}
+
+/// [`bdpt_estimate`] of a canonical scene, once per test binary.
+pub fn bdpt_reference(scene_name: &str, samples_per_pixel: u32) -> &'static Estimate {
+    cached_estimate(&format!("bdpt {scene_name} {samples_per_pixel}"), || {
+        let (scene, camera) = load_canonical(scene_name);
+        bdpt_estimate(&scene, &camera, samples_per_pixel)
+    })
+}
+
 /// Asserts that two independent estimates of the same image agree: the image mean within
 /// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
 /// partition within `region_sigmas`. Also asserts the comparison is sharp: a 2% brightness
