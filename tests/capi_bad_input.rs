@@ -3,6 +3,14 @@
 //! and out-parameters must be left untouched on failure. Plus the behaviours the header
 //! promises around them: degenerate triangles, cancellation, time limits, thread safety and
 //! the last-error life cycle.
+//!
+//! The bad values are table-driven: `cases!` writes a table one case a line, each case a
+//! valid input with one change, labelled with that change's source text, and the needles the
+//! message must contain; `non_finite_cases!` gives NaN, +inf and -inf to every float field
+//! listed. `assert_cases` checks every case of a table (status, message, outputs untouched)
+//! and then fails listing each failing case by its label, so a broken validation shows as
+//! the cases it breaks. Behaviours that are not one bad value (cancellation, time limits,
+//! concurrency, the last error's life cycle) are tests of their own.
 
 mod common;
 
@@ -35,17 +43,51 @@ fn status_string(status: i32) -> String {
         .to_owned()
 }
 
+/// The outcome of checking one case: `Err` says what is wrong.
+type Check = std::result::Result<(), String>;
+
+/// Whether a call returned `expected` and left a last error message containing every one of
+/// `needles`; the error says what differs.
+fn check_error(status: MltStatus, expected: MltStatus, needles: &[impl AsRef<str>]) -> Check {
+    let message = last_error();
+    if status != expected {
+        return Err(format!(
+            "{status:?} instead of {expected:?}; message {message:?}"
+        ));
+    }
+    let missing: Vec<&str> = needles
+        .iter()
+        .map(AsRef::as_ref)
+        .filter(|needle| !message.contains(needle))
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "the message {message:?} should mention {missing:?}"
+        ));
+    }
+    Ok(())
+}
+
+/// `Err(what)` unless `condition`: the "untouched on failure" checks of a case.
+fn ensure(condition: bool, what: &str) -> Check {
+    if condition {
+        Ok(())
+    } else {
+        Err(what.to_owned())
+    }
+}
+
+#[track_caller]
+fn pass(result: Check) {
+    if let Err(error) = result {
+        panic!("{error}");
+    }
+}
+
 /// Asserts `status` and that the last error message contains every one of `needles`.
 #[track_caller]
 fn assert_error(status: MltStatus, expected: MltStatus, needles: &[&str]) {
-    let message = last_error();
-    assert_eq!(status, expected, "message: {message:?}");
-    for needle in needles {
-        assert!(
-            message.contains(needle),
-            "the message {message:?} should mention {needle:?}"
-        );
-    }
+    pass(check_error(status, expected, needles));
 }
 
 #[track_caller]
@@ -53,10 +95,96 @@ fn assert_invalid(status: MltStatus, needles: &[&str]) {
     assert_error(status, MLT_STATUS_INVALID_ARGUMENT, needles);
 }
 
+/// Whether a call succeeded and cleared the last error.
+fn check_ok(status: MltStatus) -> Check {
+    let message = last_error();
+    ensure(
+        status == MLT_STATUS_OK,
+        &format!("{status:?}; message {message:?}"),
+    )?;
+    ensure(message.is_empty(), "a success clears the last error")
+}
+
 #[track_caller]
 fn assert_ok(status: MltStatus) {
-    assert_eq!(status, MLT_STATUS_OK, "message: {:?}", last_error());
-    assert_eq!(last_error(), "", "a success clears the last error");
+    pass(check_ok(status));
+}
+
+/// One bad input of a table: the label that names it in failure messages, the input, and
+/// what the last error message must contain.
+struct Case<T> {
+    label: String,
+    input: T,
+    needles: Vec<String>,
+}
+
+/// A table of cases, one a line: `cases![x = base; change => [needles], ...]` gives each
+/// case the input `base` (evaluated anew for each) with `change` applied to it as `x` (an
+/// assignment, or a block of them), labelled with the change's source text.
+macro_rules! cases {
+    ($x:ident = $base:expr; $($change:expr => [$($needle:expr),* $(,)?]),+ $(,)?) => {
+        vec![$({
+            let mut $x = $base;
+            $change;
+            Case {
+                label: stringify!($change).to_owned(),
+                input: $x,
+                needles: vec![$($needle.to_string()),*],
+            }
+        }),+]
+    };
+}
+
+/// NaN and both infinities: no float a host passes may be one (unless the header says so).
+const NON_FINITE: [f32; 3] = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
+
+/// `non_finite_cases![x = base; place => "name" + "rule", ...]`: for each float `place` of
+/// `x`, a case for each of NaN, +inf and -inf put there, whose message must say
+/// "<name> is <value>" and contain each `rule` (what the valid values are).
+macro_rules! non_finite_cases {
+    ($x:ident = $base:expr; $($place:expr => $name:literal $(+ $rule:literal)*),+ $(,)?) => {{
+        let mut cases = Vec::new();
+        $(for value in NON_FINITE {
+            let mut $x = $base;
+            $place = value;
+            cases.push(Case {
+                label: format!("{} = {value}", stringify!($place)),
+                input: $x,
+                needles: vec![format!("{} is {value}", $name) $(, $rule.to_string())*],
+            });
+        })+
+        cases
+    }};
+}
+
+/// Checks every case with `check` (given its input and needles), then fails listing each case
+/// that failed by its label, with why.
+#[track_caller]
+fn assert_cases<T>(table: &str, cases: &[Case<T>], check: impl Fn(&T, &[String]) -> Check) {
+    assert_all(
+        table,
+        cases
+            .iter()
+            .map(|case| (case.label.clone(), check(&case.input, &case.needles))),
+    );
+}
+
+/// Fails listing every `(label, result)` that is an error, after looking at all of them.
+#[track_caller]
+fn assert_all(table: &str, results: impl IntoIterator<Item = (String, Check)>) {
+    let results: Vec<_> = results.into_iter().collect();
+    assert!(!results.is_empty(), "{table}: the table is empty");
+    let failures: Vec<String> = results
+        .iter()
+        .filter_map(|(label, result)| result.as_ref().err().map(|e| format!("  {label}: {e}")))
+        .collect();
+    assert!(
+        failures.is_empty(),
+        "{table}: {} of {} cases failed:\n{}",
+        failures.len(),
+        results.len(),
+        failures.join("\n")
+    );
 }
 
 /// An aligned, non-null pointer value no allocation will ever have: the "untouched" marker
@@ -186,18 +314,32 @@ impl HostScene {
         assert!(!out.is_null());
         Handle(out)
     }
+}
 
-    /// `mlt_scene_create` of a modified description, expecting failure: checks the status,
-    /// the message and that `*out` was not written.
-    #[track_caller]
-    fn create_fails(&self, desc: &MltSceneDesc, expected: MltStatus, needles: &[&str]) {
-        let _ = self;
-        let mut out = sentinel_scene();
-        // SAFETY: every non-null pointer in `desc` references an array of its length.
-        let status = unsafe { mlt_scene_create(desc, &mut out) };
-        assert_error(status, expected, needles);
-        assert_eq!(out, sentinel_scene(), "*out must be untouched on failure");
+/// `mlt_scene_create` of a bad description: the status, the message, and `*out` untouched.
+fn check_create_refused(
+    desc: &MltSceneDesc,
+    expected: MltStatus,
+    needles: &[impl AsRef<str>],
+) -> Check {
+    let mut out = sentinel_scene();
+    // SAFETY: every pointer in `desc` references an array of its length, or is one mlt must
+    // refuse before reading (NULL, misaligned, or with a length no memory holds).
+    let status = unsafe { mlt_scene_create(desc, &mut out) };
+    if status == MLT_STATUS_OK {
+        // SAFETY: a scene mlt created (wrongly), released once.
+        unsafe { mlt_scene_release(out) };
     }
+    check_error(status, expected, needles)?;
+    ensure(out == sentinel_scene(), "*out must be untouched on failure")
+}
+
+/// Every case's description (`desc` of its input) is refused as invalid (`check_create_refused`).
+#[track_caller]
+fn assert_create_refuses<T>(table: &str, cases: &[Case<T>], desc: impl Fn(&T) -> MltSceneDesc) {
+    assert_cases(table, cases, |input, needles| {
+        check_create_refused(&desc(input), MLT_STATUS_INVALID_ARGUMENT, needles)
+    });
 }
 
 /// Owns a scene, as a C++ host's RAII wrapper would.
@@ -271,9 +413,14 @@ impl Handle {
         (rgb, stats)
     }
 
-    /// A render that must fail: status, message, and the image buffer untouched.
-    #[track_caller]
-    fn render_fails(&self, camera: &MltCamera, settings: &MltRenderSettings, needles: &[&str]) {
+    /// A render mlt must refuse as invalid: the needles in the message, and neither the
+    /// image nor the stats written.
+    fn check_render_refused(
+        &self,
+        camera: &MltCamera,
+        settings: &MltRenderSettings,
+        needles: &[impl AsRef<str>],
+    ) -> Check {
         let len = 16 * 16 * 3;
         let mut image = vec![SENTINEL_F32; len];
         let mut stats = MltRenderStats {
@@ -293,12 +440,28 @@ impl Handle {
                 &mut stats,
             )
         };
-        assert_invalid(status, needles);
-        assert!(
+        check_error(status, MLT_STATUS_INVALID_ARGUMENT, needles)?;
+        ensure(
             image.iter().all(|&v| v == SENTINEL_F32),
-            "rgb_out must be untouched on failure"
-        );
-        assert_eq!(stats.samples, 77, "stats_out must be untouched on failure");
+            "rgb_out must be untouched on failure",
+        )?;
+        ensure(
+            stats.samples == 77,
+            "stats_out must be untouched on failure",
+        )
+    }
+
+    /// Every case's settings, rendered with `camera`, are refused (`check_render_refused`).
+    #[track_caller]
+    fn assert_refuses_settings(
+        &self,
+        table: &str,
+        camera: &MltCamera,
+        cases: &[Case<MltRenderSettings>],
+    ) {
+        assert_cases(table, cases, |settings, needles| {
+            self.check_render_refused(camera, settings, needles)
+        });
     }
 
     fn intersect(&self, rays: &[MltRay]) -> (MltStatus, Vec<MltHit>) {
@@ -354,28 +517,7 @@ fn assert_valid_image(image: &[f32], what: &str) {
 // Initializers, versions, status strings, release
 // ---------------------------------------------------------------------------------------
 
-#[test]
-fn default_initializers_reject_null() {
-    // SAFETY: NULL is an accepted input (documented: returns an error).
-    unsafe {
-        assert_invalid(
-            mlt_material_init(null_mut(), size_of::<MltMaterial>()),
-            &["out", "NULL"],
-        );
-        assert_invalid(
-            mlt_scene_desc_init(null_mut(), size_of::<MltSceneDesc>()),
-            &["out", "NULL"],
-        );
-        assert_invalid(
-            mlt_camera_init(null_mut(), size_of::<MltCamera>()),
-            &["out", "NULL"],
-        );
-        assert_invalid(
-            mlt_render_settings_init(null_mut(), size_of::<MltRenderSettings>()),
-            &["out", "NULL"],
-        );
-    }
-}
+// Each initializer refusing NULL: `initializers_refuse_null_and_unknown_sizes` (struct_size).
 
 #[test]
 fn defaults_are_valid_and_documented() {
@@ -505,6 +647,8 @@ fn unknown_sizes<T>() -> [usize; 4] {
     [0, 3, size_of::<T>() - align_of::<T>(), size_of::<T>() + 8]
 }
 
+/// NULL and every unknown size, for each of the six initializers: refused, naming the
+/// initializer, with `out` untouched; the struct's own size is taken and written.
 #[test]
 fn initializers_refuse_null_and_unknown_sizes() {
     type Init = fn(*mut u8, usize) -> MltStatus;
@@ -542,51 +686,58 @@ fn initializers_refuse_null_and_unknown_sizes() {
             |p, n| unsafe { mlt_scene_info_init(p.cast(), n) },
         ),
     ];
+    let mut results = Vec::new();
     for (name, size, init) in initializers {
         let mut storage = [0xABu8; 512];
         let aligned = storage
             .as_mut_ptr()
             .wrapping_add(storage.as_ptr().align_offset(8));
+        let status = init(null_mut(), size);
+        results.push((
+            format!("{name}: out NULL"),
+            check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
+        ));
         // The storage holds any size tried (< 512 - 8).
-        assert_invalid(init(null_mut(), size), &["out", "NULL"]);
         for bad in [0, 3, size - 8, size + 8] {
-            assert_invalid(
-                init(aligned, bad),
-                &["out.struct_size", &bad.to_string(), name],
-            );
-            assert!(
-                storage.iter().all(|&b| b == 0xAB),
-                "{name}: out untouched on failure"
-            );
+            let status = init(aligned, bad);
+            let needles = ["out.struct_size", &bad.to_string(), name];
+            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
+                .and_then(|()| ensure(storage.iter().all(|&b| b == 0xAB), "out written"));
+            results.push((format!("{name}: struct_size {bad}"), result));
         }
-        assert_ok(init(aligned, size));
-        // SAFETY: 4 initialized, aligned bytes of `storage`.
+        let status = init(aligned, size);
+        // SAFETY: 4 aligned bytes of `storage`, initialized.
         let written = unsafe { aligned.cast::<u32>().read() };
-        assert_eq!(written as usize, size, "{name} sets struct_size");
+        let result =
+            check_ok(status).and_then(|()| ensure(written as usize == size, "struct_size not set"));
+        results.push((format!("{name}: its own size {size}"), result));
     }
+    assert_all("initializers", results);
 }
 
+/// Each struct mlt reads or writes, with each size no header had, where the call reads it.
 #[test]
 fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
     let host = HostScene::floor_and_light();
     let scene = host.create();
+    let (camera, settings) = (floor_camera(), small_settings(4, 4, 1));
+    let mut results = Vec::new();
     for size in unknown_sizes::<MltRenderSettings>() {
-        let settings = MltRenderSettings {
+        let bad = MltRenderSettings {
             struct_size: size as u32,
-            ..small_settings(4, 4, 1)
+            ..settings
         };
-        scene.render_fails(
-            &floor_camera(),
-            &settings,
-            &["settings.struct_size", &size.to_string()],
-        );
+        let needles = ["settings.struct_size", &size.to_string()];
+        let result = scene.check_render_refused(&camera, &bad, &needles);
+        results.push((format!("settings.struct_size = {size}"), result));
     }
     for size in unknown_sizes::<MltCamera>() {
-        let camera = MltCamera {
+        let bad = MltCamera {
             struct_size: size as u32,
-            ..floor_camera()
+            ..camera
         };
-        scene.render_fails(&camera, &small_settings(4, 4, 1), &["camera.struct_size"]);
+        let result = scene.check_render_refused(&bad, &settings, &["camera.struct_size"]);
+        results.push((format!("camera.struct_size = {size}"), result));
     }
     for size in unknown_sizes::<MltRenderStats>() {
         let mut stats = MltRenderStats {
@@ -599,8 +750,8 @@ fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
         let status = unsafe {
             mlt_render_ex(
                 scene.0,
-                &floor_camera(),
-                &small_settings(4, 4, 1),
+                &camera,
+                &settings,
                 image.as_mut_ptr(),
                 48,
                 None,
@@ -608,11 +759,14 @@ fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
                 &mut stats,
             )
         };
-        assert_invalid(
-            status,
-            &["stats_out.struct_size", "mlt_render_stats_default"],
-        );
-        assert!(image.iter().all(|&v| v == SENTINEL_F32) && stats.samples == 77);
+        let needles = ["stats_out.struct_size", "mlt_render_stats_default"];
+        let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles).and_then(|()| {
+            ensure(
+                image.iter().all(|&v| v == SENTINEL_F32) && stats.samples == 77,
+                "rgb_out or stats_out written",
+            )
+        });
+        results.push((format!("stats_out.struct_size = {size}"), result));
     }
     for size in unknown_sizes::<MltSceneInfo>() {
         let mut info = MltSceneInfo {
@@ -621,36 +775,40 @@ fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
             ..scene_info_default()
         };
         // SAFETY: live scene, writable out.
-        assert_invalid(
-            unsafe { mlt_scene_get_info(scene.0, &mut info) },
-            &["out.struct_size"],
-        );
-        assert_eq!(info.triangle_count, 99);
+        let status = unsafe { mlt_scene_get_info(scene.0, &mut info) };
+        let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out.struct_size"])
+            .and_then(|()| ensure(info.triangle_count == 99, "out written"));
+        results.push((
+            format!("mlt_scene_get_info out.struct_size = {size}"),
+            result,
+        ));
     }
     for size in unknown_sizes::<MltSceneDesc>() {
         let desc = MltSceneDesc {
             struct_size: size as u32,
             ..host.desc()
         };
-        host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["desc.struct_size"]);
+        let result =
+            check_create_refused(&desc, MLT_STATUS_INVALID_ARGUMENT, &["desc.struct_size"]);
+        results.push((format!("desc.struct_size = {size}"), result));
     }
     for size in unknown_sizes::<MltMaterial>() {
-        let mut materials = host.clone();
-        materials.materials[0].struct_size = size as u32;
-        materials.create_fails(
-            &materials.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["desc.materials[0].struct_size"],
-        );
+        let mut bad = host.clone();
+        bad.materials[0].struct_size = size as u32;
+        let needles = ["desc.materials[0].struct_size"];
+        let result = check_create_refused(&bad.desc(), MLT_STATUS_INVALID_ARGUMENT, &needles);
+        results.push((format!("materials[0].struct_size = {size}"), result));
     }
     // An array's stride is its first element's size: every element must carry the same.
     let mut mixed = host.clone();
     mixed.materials[1].struct_size += 8;
-    mixed.create_fails(
-        &mixed.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["desc.materials[1].struct_size", "desc.materials[0]'s"],
-    );
+    let needles = ["desc.materials[1].struct_size", "desc.materials[0]'s"];
+    let result = check_create_refused(&mixed.desc(), MLT_STATUS_INVALID_ARGUMENT, &needles);
+    results.push((
+        "materials[1].struct_size = materials[0]'s + 8".into(),
+        result,
+    ));
+    assert_all("struct_size", results);
 }
 
 /// A host built against the header before the post-process filter (its settings end at
@@ -730,110 +888,37 @@ fn an_older_layout_reads_what_it_has_and_defaults_the_rest() {
 // ---------------------------------------------------------------------------------------
 
 #[test]
-fn scene_create_null_desc() {
+fn scene_create_null_desc_or_out() {
     let mut out = sentinel_scene();
     // SAFETY: NULL desc must be rejected.
     let status = unsafe { mlt_scene_create(null(), &mut out) };
     assert_invalid(status, &["desc", "NULL"]);
     assert_eq!(out, sentinel_scene());
-}
-
-#[test]
-fn scene_create_null_out() {
     let host = HostScene::floor_and_light();
     // SAFETY: NULL out must be rejected.
     let status = unsafe { mlt_scene_create(&host.desc(), null_mut()) };
     assert_invalid(status, &["out", "NULL"]);
 }
 
+/// Array pointers mlt must refuse before reading them: NULL with a length, misaligned, and
+/// lengths whose byte size overflows.
 #[test]
-fn scene_create_null_positions_with_length() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        positions: null(),
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["positions", "NULL"]);
-}
-
-#[test]
-fn scene_create_null_indices_with_length() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        indices: null(),
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["indices", "NULL"]);
-}
-
-#[test]
-fn scene_create_null_materials_with_length() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        materials: null(),
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["materials", "NULL"]);
-}
-
-#[test]
-fn scene_create_null_material_ids_with_length() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        material_ids: null(),
-        ..host.desc()
-    };
-    host.create_fails(
-        &desc,
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["material_ids", "NULL"],
-    );
-}
-
-#[test]
-fn scene_create_misaligned_arrays() {
+fn scene_create_bad_arrays() {
     let host = HostScene::floor_and_light();
     // u64 storage: one byte past its start is misaligned for every multi-byte type.
     let storage = [0u64; 8];
     let odd = storage.as_ptr().cast::<u8>().wrapping_add(1);
-    let desc = MltSceneDesc {
-        positions: odd.cast(),
-        ..host.desc()
-    };
-    host.create_fails(
-        &desc,
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["positions", "aligned"],
-    );
-    let desc = MltSceneDesc {
-        indices: odd.cast(),
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["indices", "aligned"]);
-}
-
-#[test]
-fn scene_create_length_larger_than_memory() {
-    // A length whose byte size overflows must be refused before anything is read.
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        positions_len: usize::MAX / 2,
-        ..host.desc()
-    };
-    host.create_fails(
-        &desc,
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["positions", "address space"],
-    );
-    let desc = MltSceneDesc {
-        indices_len: usize::MAX,
-        ..host.desc()
-    };
-    host.create_fails(
-        &desc,
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["indices", "address space"],
-    );
+    let cases = cases![d = host.desc();
+        d.positions = null() => ["positions", "NULL"],
+        d.indices = null() => ["indices", "NULL"],
+        d.materials = null() => ["materials", "NULL"],
+        d.material_ids = null() => ["material_ids", "NULL"],
+        d.positions = odd.cast() => ["positions", "aligned"],
+        d.indices = odd.cast() => ["indices", "aligned"],
+        d.positions_len = usize::MAX / 2 => ["positions", "address space"],
+        d.indices_len = usize::MAX => ["indices", "address space"],
+    ];
+    assert_create_refuses("scene arrays", &cases, |d| *d);
 }
 
 #[test]
@@ -859,37 +944,29 @@ fn scene_create_null_arrays_with_zero_length_are_an_empty_scene() {
 // ---------------------------------------------------------------------------------------
 
 #[test]
-fn positions_len_not_a_multiple_of_3() {
+fn scene_create_bad_counts() {
     let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        positions_len: 23,
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["positions", "23"]);
+    let cases = cases![d = host.desc();
+        d.positions_len = 23 => ["positions", "23"],
+        d.indices_len = 11 => ["indices", "11"],
+        d.material_ids_len = 3 => ["material_ids", "3", "4 triangles"],
+        {
+            (d.materials, d.materials_len) = (null(), 0);
+            (d.material_ids, d.material_ids_len) = (null(), 0);
+        } => ["materials", "empty"],
+    ];
+    assert_create_refuses("scene counts", &cases, |d| *d);
 }
 
 #[test]
-fn indices_len_not_a_multiple_of_3() {
+fn scene_create_indices_out_of_range() {
     let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        indices_len: 11,
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["indices", "11"]);
-}
-
-#[test]
-fn material_ids_len_differs_from_triangle_count() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        material_ids_len: 3,
-        ..host.desc()
-    };
-    host.create_fails(
-        &desc,
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["material_ids", "3", "4 triangles"],
-    );
+    let cases = cases![h = host.clone();
+        h.indices[7] = 8 => ["indices[7]", "8", "8 vertices"],
+        h.indices[7] = u32::MAX => ["indices[7]", "4294967295"],
+        h.material_ids[3] = 2 => ["material_ids[3]", "2", "2 materials"],
+    ];
+    assert_create_refuses("scene indices", &cases, HostScene::desc);
 }
 
 #[test]
@@ -907,194 +984,75 @@ fn missing_material_ids_mean_material_0() {
     assert_eq!(scene.info().emitter_count, 0, "material 0 does not emit");
 }
 
-#[test]
-fn triangles_without_materials() {
-    let host = HostScene::floor_and_light();
-    let desc = MltSceneDesc {
-        materials: null(),
-        materials_len: 0,
-        material_ids: null(),
-        material_ids_len: 0,
-        ..host.desc()
-    };
-    host.create_fails(&desc, MLT_STATUS_INVALID_ARGUMENT, &["materials", "empty"]);
-}
-
-#[test]
-fn vertex_index_out_of_range() {
-    let mut host = HostScene::floor_and_light();
-    host.indices[7] = 8;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["indices[7]", "8", "8 vertices"],
-    );
-    host.indices[7] = u32::MAX;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["indices[7]", "4294967295"],
-    );
-}
-
-#[test]
-fn material_id_out_of_range() {
-    let mut host = HostScene::floor_and_light();
-    host.material_ids[3] = 2;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["material_ids[3]", "2", "2 materials"],
-    );
-}
-
 // ---------------------------------------------------------------------------------------
 // mlt_scene_create: float values and enums
 // ---------------------------------------------------------------------------------------
 
+/// Every float of the vertices and materials must be finite (`ior` too where it is ignored,
+/// on a diffuse material), colors within [0, 1] and emission not negative.
 #[test]
-fn non_finite_positions() {
-    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
-        let mut host = HostScene::floor_and_light();
-        host.positions[13] = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["positions[13]", "vertex 4", "y", &bad.to_string()],
-        );
-    }
+fn scene_create_bad_floats() {
+    let host = HostScene::floor_and_light();
+    let mut cases = cases![h = host.clone();
+        h.positions[13] = f32::NAN => ["positions[13]", "vertex 4", "y", "NaN"],
+        h.positions[13] = f32::INFINITY => ["positions[13]", "vertex 4", "y", "inf"],
+        h.positions[13] = f32::NEG_INFINITY => ["positions[13]", "vertex 4", "y", "-inf"],
+        h.materials[0].color[2] = -0.5 => ["materials[0].color.z", "-0.5"],
+        h.materials[1].color[0] = 1.5 => ["materials[1].color.x", "1.5"],
+        h.materials[1].emission[2] = -1.0 => ["materials[1].emission.z", "-1", "negative"],
+    ];
+    cases.extend(non_finite_cases![h = host.clone();
+        h.materials[0].color[0] => "desc.materials[0].color.x" + "finite",
+        h.materials[0].color[1] => "desc.materials[0].color.y" + "finite",
+        h.materials[0].color[2] => "desc.materials[0].color.z" + "finite",
+        h.materials[1].emission[0] => "desc.materials[1].emission.x" + "finite",
+        h.materials[1].emission[1] => "desc.materials[1].emission.y" + "finite",
+        h.materials[1].emission[2] => "desc.materials[1].emission.z" + "finite",
+        h.materials[0].ior => "desc.materials[0].ior" + "finite",
+    ]);
+    assert_create_refuses("scene floats", &cases, HostScene::desc);
 }
 
 #[test]
-fn non_finite_colors() {
-    for bad in [f32::NAN, f32::INFINITY] {
-        let mut host = HostScene::floor_and_light();
-        host.materials[0].color[1] = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["materials[0].color.y", &bad.to_string()],
-        );
-    }
+fn scene_create_bad_dielectric_ior() {
+    let mut dielectric = HostScene::floor_and_light();
+    dielectric.materials[0].kind = MLT_MATERIAL_DIELECTRIC;
+    let mut cases = cases![h = dielectric.clone();
+        h.materials[0].ior = 0.0 => ["materials[0].ior", "greater than 0"],
+        h.materials[0].ior = -0.0 => ["materials[0].ior", "greater than 0"],
+        h.materials[0].ior = -1.5 => ["materials[0].ior", "greater than 0"],
+    ];
+    cases.extend(non_finite_cases![h = dielectric.clone();
+        h.materials[0].ior => "desc.materials[0].ior" + "finite",
+    ]);
+    assert_create_refuses("dielectric ior", &cases, HostScene::desc);
 }
 
 #[test]
-fn colors_outside_0_1() {
-    let mut host = HostScene::floor_and_light();
-    host.materials[0].color[2] = -0.5;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["materials[0].color.z", "-0.5"],
-    );
-    let mut host = HostScene::floor_and_light();
-    host.materials[1].color[0] = 1.5;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["materials[1].color.x", "1.5"],
-    );
-}
-
-#[test]
-fn non_finite_emission() {
-    for bad in [f32::NAN, f32::INFINITY] {
-        let mut host = HostScene::floor_and_light();
-        host.materials[1].emission[0] = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["materials[1].emission.x", &bad.to_string()],
-        );
-    }
-}
-
-#[test]
-fn negative_emission() {
-    let mut host = HostScene::floor_and_light();
-    host.materials[1].emission[2] = -1.0;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["materials[1].emission.z", "-1", "negative"],
-    );
-}
-
-#[test]
-fn non_finite_ior() {
-    for bad in [f32::NAN, f32::INFINITY] {
-        let mut host = HostScene::floor_and_light();
-        host.materials[0].kind = MLT_MATERIAL_DIELECTRIC;
-        host.materials[0].ior = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["materials[0].ior", &bad.to_string()],
-        );
-    }
-}
-
-#[test]
-fn ior_not_positive() {
-    for bad in [0.0, -0.0, -1.5] {
-        let mut host = HostScene::floor_and_light();
-        host.materials[0].kind = MLT_MATERIAL_DIELECTRIC;
-        host.materials[0].ior = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["materials[0].ior", "greater than 0"],
-        );
-    }
-}
-
-#[test]
-fn ior_is_ignored_for_non_dielectrics_but_must_be_finite() {
-    // The header: "Ignored otherwise". Zero or negative is accepted for diffuse and mirror...
+fn ior_is_ignored_for_non_dielectrics() {
+    // The header: "Ignored otherwise". Zero or negative is accepted for diffuse and mirror
+    // (a non-finite one is not: `scene_create_bad_floats`).
     for kind in [MLT_MATERIAL_DIFFUSE, MLT_MATERIAL_MIRROR] {
         let mut host = HostScene::floor_and_light();
         host.materials[0].kind = kind;
         host.materials[0].ior = -1.0;
         drop(host.create());
     }
-    // ...but a NaN is still reported (every float the host passes must be finite).
-    let mut host = HostScene::floor_and_light();
-    host.materials[0].ior = f32::NAN;
-    host.create_fails(
-        &host.desc(),
-        MLT_STATUS_INVALID_ARGUMENT,
-        &["materials[0].ior", "NaN"],
-    );
 }
 
 #[test]
-fn unknown_material_kind() {
-    for bad in [3, -1, i32::MAX] {
-        let mut host = HostScene::floor_and_light();
-        host.materials[1].kind = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &[
-                "materials[1].kind",
-                &bad.to_string(),
-                "MLT_MATERIAL_DIFFUSE",
-            ],
-        );
-    }
-}
-
-#[test]
-fn unknown_backend() {
-    for bad in [2, -1, i32::MIN] {
-        let mut host = HostScene::floor_and_light();
-        host.backend = bad;
-        host.create_fails(
-            &host.desc(),
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["backend", &bad.to_string()],
-        );
-    }
+fn scene_create_unknown_enums() {
+    let host = HostScene::floor_and_light();
+    let cases = cases![h = host.clone();
+        h.materials[1].kind = 3 => ["materials[1].kind is 3", "MLT_MATERIAL_DIFFUSE"],
+        h.materials[1].kind = -1 => ["materials[1].kind is -1", "MLT_MATERIAL_DIFFUSE"],
+        h.materials[1].kind = i32::MAX
+            => ["materials[1].kind is 2147483647", "MLT_MATERIAL_DIFFUSE"],
+        h.backend = 2 => ["backend", "2"],
+        h.backend = -1 => ["backend", "-1"],
+        h.backend = i32::MIN => ["backend", "-2147483648"],
+    ];
+    assert_create_refuses("scene enums", &cases, HostScene::desc);
 }
 
 #[test]
@@ -1102,11 +1060,12 @@ fn unknown_backend() {
 fn embree_backend_is_unsupported_without_the_feature() {
     let mut host = HostScene::floor_and_light();
     host.backend = MLT_BACKEND_EMBREE;
-    host.create_fails(
+    let needles = ["Embree", "`embree` feature"];
+    pass(check_create_refused(
         &host.desc(),
         MLT_STATUS_UNSUPPORTED,
-        &["Embree", "`embree` feature"],
-    );
+        &needles,
+    ));
 }
 
 #[test]
@@ -1255,68 +1214,93 @@ fn get_info_null_pointers() {
 // ---------------------------------------------------------------------------------------
 
 #[test]
-fn render_null_pointers() {
+fn render_bad_pointers_and_buffers() {
     let scene = HostScene::floor_and_light().create();
-    let camera = floor_camera();
-    let settings = small_settings(4, 4, 1);
-    let mut image = vec![SENTINEL_F32; 48];
-    let p = image.as_mut_ptr();
-    // SAFETY: each call passes one NULL that must be rejected; the rest is valid.
-    unsafe {
-        let s = mlt_render(null(), &camera, &settings, p, 48, None, null_mut());
-        assert_invalid(s, &["scene", "NULL"]);
-        let s = mlt_render(scene.0, null(), &settings, p, 48, None, null_mut());
-        assert_invalid(s, &["camera", "NULL"]);
-        let s = mlt_render(scene.0, &camera, null(), p, 48, None, null_mut());
-        assert_invalid(s, &["settings", "NULL"]);
-        let s = mlt_render(
-            scene.0,
-            &camera,
-            &settings,
-            null_mut(),
-            48,
-            None,
-            null_mut(),
-        );
-        assert_invalid(s, &["rgb_out", "NULL"]);
-    }
-    assert!(image.iter().all(|&v| v == SENTINEL_F32));
-}
-
-#[test]
-fn render_misaligned_output() {
-    let scene = HostScene::floor_and_light().create();
-    let mut storage = vec![0u64; 32];
-    let odd = storage
-        .as_mut_ptr()
-        .cast::<u8>()
-        .wrapping_add(1)
-        .cast::<f32>();
-    // SAFETY: a misaligned pointer must be rejected before any write.
-    let s = unsafe {
-        mlt_render(
-            scene.0,
-            &floor_camera(),
-            &small_settings(4, 4, 1),
-            odd,
-            48,
-            None,
-            null_mut(),
-        )
+    let (camera, settings) = (floor_camera(), small_settings(4, 4, 1));
+    // Every case could write (wrongly) only into `buffer`: rgb_out at its start or one byte
+    // past it (misaligned), stats_out one byte past its middle (misaligned).
+    let mut buffer = vec![SENTINEL_F32; 128];
+    let rgb = buffer.as_mut_ptr();
+    let odd_rgb = rgb.cast::<u8>().wrapping_add(1);
+    let odd_stats = rgb.wrapping_add(64).cast::<u8>().wrapping_add(1);
+    assert!(
+        size_of::<MltRenderStats>() < 63 * size_of::<f32>(),
+        "stats fit the buffer"
+    );
+    let valid = RenderCall {
+        scene: scene.0,
+        camera: &camera,
+        settings: &settings,
+        rgb_out: rgb,
+        out_len: 48,
+        stats_out: null_mut(),
     };
-    assert_invalid(s, &["rgb_out", "aligned"]);
-    assert!(storage.iter().all(|&b| b == 0));
+    let cases = cases![c = valid;
+        c.scene = null() => ["scene", "NULL"],
+        c.camera = null() => ["camera", "NULL"],
+        c.settings = null() => ["settings", "NULL"],
+        c.rgb_out = null_mut() => ["rgb_out", "NULL"],
+        c.rgb_out = odd_rgb.cast() => ["rgb_out", "aligned"],
+        c.out_len = 47 => ["out_len", "47", "48"],
+        c.out_len = 0 => ["out_len", "0"],
+        c.stats_out = odd_stats.cast() => ["stats_out", "aligned"],
+    ];
+    assert_cases("render arguments", &cases, |call, needles| {
+        // SAFETY: every pointer is valid for the call or one mlt must refuse before using it.
+        let status = unsafe { call.run() };
+        check_error(status, MLT_STATUS_INVALID_ARGUMENT, needles)?;
+        // SAFETY: `buffer`'s memory, only read here.
+        let untouched = unsafe { std::slice::from_raw_parts(rgb, 128) };
+        ensure(
+            untouched.iter().all(|&v| v == SENTINEL_F32),
+            "rgb_out or stats_out written",
+        )
+    });
 }
 
-#[test]
-fn render_output_buffer_too_small() {
-    let scene = HostScene::floor_and_light().create();
-    let settings = small_settings(4, 4, 1);
-    let (status, image) = scene.render(&floor_camera(), &settings, 47);
-    assert_invalid(status, &["out_len", "47", "48"]);
-    assert!(image.iter().all(|&v| v == SENTINEL_F32));
-    let (status, _) = scene.render(&floor_camera(), &settings, 0);
-    assert_invalid(status, &["out_len", "0"]);
+/// The arguments of a render, as a host passes them.
+#[derive(Clone, Copy)]
+struct RenderCall {
+    scene: *const MltScene,
+    camera: *const MltCamera,
+    settings: *const MltRenderSettings,
+    rgb_out: *mut f32,
+    out_len: usize,
+    stats_out: *mut MltRenderStats,
+}
+
+impl RenderCall {
+    /// `mlt_render_ex`, or `mlt_render` when `stats_out` is NULL (a host that wants no stats).
+    ///
+    /// # Safety
+    /// As `mlt_render_ex`.
+    unsafe fn run(&self) -> MltStatus {
+        let &RenderCall {
+            scene,
+            camera,
+            settings,
+            rgb_out,
+            out_len,
+            stats_out,
+        } = self;
+        // SAFETY: forwarded contract.
+        unsafe {
+            if stats_out.is_null() {
+                mlt_render(scene, camera, settings, rgb_out, out_len, None, null_mut())
+            } else {
+                mlt_render_ex(
+                    scene,
+                    camera,
+                    settings,
+                    rgb_out,
+                    out_len,
+                    None,
+                    null_mut(),
+                    stats_out,
+                )
+            }
+        }
+    }
 }
 
 #[test]
@@ -1328,121 +1312,35 @@ fn render_larger_buffer_is_fine_and_the_tail_untouched() {
     assert!(image[48..].iter().all(|&v| v == SENTINEL_F32));
 }
 
-#[test]
-fn stats_out_misaligned() {
-    let scene = HostScene::floor_and_light().create();
-    let mut image = vec![SENTINEL_F32; 48];
-    let mut storage = [0u64; 16];
-    let odd = storage
-        .as_mut_ptr()
-        .cast::<u8>()
-        .wrapping_add(1)
-        .cast::<MltRenderStats>();
-    // SAFETY: the misaligned stats pointer must be rejected before rendering.
-    let s = unsafe {
-        mlt_render_ex(
-            scene.0,
-            &floor_camera(),
-            &small_settings(4, 4, 1),
-            image.as_mut_ptr(),
-            48,
-            None,
-            null_mut(),
-            odd,
-        )
-    };
-    assert_invalid(s, &["stats_out", "aligned"]);
-    assert!(image.iter().all(|&v| v == SENTINEL_F32));
-}
-
 // ---------------------------------------------------------------------------------------
 // mlt_render: settings
 // ---------------------------------------------------------------------------------------
 
+/// The settings every algorithm checks, on a path-traced render.
 #[test]
-fn zero_or_huge_image_size() {
+fn bad_settings() {
     let scene = HostScene::floor_and_light().create();
-    let camera = floor_camera();
-    for (w, h, field, value) in [
-        (0, 4, "width", "0"),
-        (4, 0, "height", "0"),
-        (MLT_MAX_IMAGE_SIDE + 1, 4, "width", "65537"),
-        (4, u32::MAX, "height", "4294967295"),
-    ] {
-        scene.render_fails(&camera, &small_settings(w, h, 1), &[field, value, "65536"]);
-    }
-}
-
-#[test]
-fn absurd_samples_depth_threads() {
-    let scene = HostScene::floor_and_light().create();
-    let camera = floor_camera();
-    let base = small_settings(4, 4, 1);
-    let s = MltRenderSettings {
-        samples_per_pixel: MLT_MAX_SAMPLES_PER_PIXEL + 1,
-        ..base
-    };
-    scene.render_fails(&camera, &s, &["samples_per_pixel", "16777217"]);
-    let s = MltRenderSettings {
-        max_depth: MLT_MAX_DEPTH_LIMIT + 1,
-        ..base
-    };
-    scene.render_fails(&camera, &s, &["max_depth", "1025"]);
-    let s = MltRenderSettings {
-        threads: MLT_MAX_THREADS + 1,
-        ..base
-    };
-    scene.render_fails(&camera, &s, &["threads", "4097"]);
-    let s = MltRenderSettings {
-        threads: u32::MAX,
-        ..base
-    };
-    scene.render_fails(&camera, &s, &["threads", "4294967295"]);
-}
-
-#[test]
-fn bad_time_limits() {
-    let scene = HostScene::floor_and_light().create();
-    let camera = floor_camera();
-    for (bad, text) in [
-        (-1.0, "-1"),
-        (-0.001, "-0.001"),
-        (f64::NAN, "NaN"),
-        (f64::INFINITY, "inf"),
-        (1.0e8, "100000000"),
-    ] {
-        let s = MltRenderSettings {
-            time_limit_seconds: bad,
-            ..small_settings(4, 4, 1)
-        };
-        scene.render_fails(&camera, &s, &["time_limit_seconds", text]);
-    }
-}
-
-#[test]
-fn zero_samples_without_time_limit() {
-    let scene = HostScene::floor_and_light().create();
-    scene.render_fails(
-        &floor_camera(),
-        &small_settings(4, 4, 0),
-        &["samples_per_pixel is 0", "time limit"],
-    );
-}
-
-#[test]
-fn unknown_algorithm() {
-    let scene = HostScene::floor_and_light().create();
-    for bad in [7, -1, i32::MAX] {
-        let s = MltRenderSettings {
-            algorithm: bad,
-            ..small_settings(4, 4, 1)
-        };
-        scene.render_fails(
-            &floor_camera(),
-            &s,
-            &["algorithm", &bad.to_string(), "MLT_ALGORITHM_PATH"],
-        );
-    }
+    let cases = cases![s = small_settings(4, 4, 1);
+        s.width = 0 => ["settings.width is 0", "65536"],
+        s.height = 0 => ["settings.height is 0", "65536"],
+        s.width = MLT_MAX_IMAGE_SIDE + 1 => ["settings.width is 65537", "65536"],
+        s.height = u32::MAX => ["settings.height is 4294967295", "65536"],
+        s.samples_per_pixel = MLT_MAX_SAMPLES_PER_PIXEL + 1 => ["samples_per_pixel is 16777217"],
+        s.samples_per_pixel = 0 => ["samples_per_pixel is 0", "time limit"],
+        s.max_depth = MLT_MAX_DEPTH_LIMIT + 1 => ["settings.max_depth is 1025"],
+        s.threads = MLT_MAX_THREADS + 1 => ["settings.threads is 4097"],
+        s.threads = u32::MAX => ["settings.threads is 4294967295"],
+        s.time_limit_seconds = -1.0 => ["time_limit_seconds is -1"],
+        s.time_limit_seconds = -0.001 => ["time_limit_seconds is -0.001"],
+        s.time_limit_seconds = f64::NAN => ["time_limit_seconds is NaN"],
+        s.time_limit_seconds = f64::INFINITY => ["time_limit_seconds is inf"],
+        s.time_limit_seconds = f64::NEG_INFINITY => ["time_limit_seconds is -inf"],
+        s.time_limit_seconds = 1.0e8 => ["time_limit_seconds is 100000000", "up to 10000000"],
+        s.algorithm = 7 => ["settings.algorithm is 7", "MLT_ALGORITHM_PATH"],
+        s.algorithm = -1 => ["settings.algorithm is -1", "MLT_ALGORITHM_PATH"],
+        s.algorithm = i32::MAX => ["settings.algorithm is 2147483647", "MLT_ALGORITHM_PATH"],
+    ];
+    scene.assert_refuses_settings("settings", &floor_camera(), &cases);
 }
 
 #[test]
@@ -1452,67 +1350,18 @@ fn erpt_settings_out_of_range() {
         algorithm: MLT_ALGORITHM_ERPT,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 8] = [
-        (
-            MltRenderSettings {
-                erpt_chain_length: 0,
-                ..erpt
-            },
-            &["erpt_chain_length is 0", "between 1 and 1048576"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_chain_length: MLT_MAX_ERPT_CHAIN_LENGTH + 1,
-                ..erpt
-            },
-            &["erpt_chain_length is 1048577"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_chain_length: u32::MAX,
-                ..erpt
-            },
-            &["erpt_chain_length is 4294967295"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_deposit_energy: -1.0,
-                ..erpt
-            },
-            &["erpt_deposit_energy is -1"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_deposit_energy: f32::NAN,
-                ..erpt
-            },
-            &["erpt_deposit_energy is NaN"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_deposit_energy: f32::INFINITY,
-                ..erpt
-            },
-            &["erpt_deposit_energy is inf"],
-        ),
-        (
-            MltRenderSettings {
-                erpt_deposit_energy: 1e31,
-                ..erpt
-            },
-            &["erpt_deposit_energy", "1e30"],
-        ),
-        (
-            MltRenderSettings {
-                samples_per_pixel: 0,
-                ..erpt
-            },
-            &["samples_per_pixel is 0", "time limit"],
-        ),
+    let mut cases = cases![s = erpt;
+        s.erpt_chain_length = 0 => ["erpt_chain_length is 0", "between 1 and 1048576"],
+        s.erpt_chain_length = MLT_MAX_ERPT_CHAIN_LENGTH + 1 => ["erpt_chain_length is 1048577"],
+        s.erpt_chain_length = u32::MAX => ["erpt_chain_length is 4294967295"],
+        s.erpt_deposit_energy = -1.0 => ["erpt_deposit_energy is -1"],
+        s.erpt_deposit_energy = 1e31 => ["erpt_deposit_energy", "1e30"],
+        s.samples_per_pixel = 0 => ["samples_per_pixel is 0", "time limit"],
     ];
-    for (settings, needles) in &cases {
-        scene.render_fails(&floor_camera(), settings, needles);
-    }
+    cases.extend(non_finite_cases![s = erpt;
+        s.erpt_deposit_energy => "settings.erpt_deposit_energy" + "up to 1e30",
+    ]);
+    scene.assert_refuses_settings("ERPT settings", &floor_camera(), &cases);
     // In range, with an explicit deposit energy and the shortest chains, it renders.
     for (erpt_chain_length, erpt_deposit_energy) in [(1, 0.0), (100, 1e-3), (1, 1e30)] {
         let settings = MltRenderSettings {
@@ -1520,27 +1369,10 @@ fn erpt_settings_out_of_range() {
             erpt_deposit_energy,
             ..erpt
         };
-        let mut rgb = vec![0.0f32; 4 * 4 * 3];
-        let mut stats = render_stats_default();
-        // SAFETY: valid pointers; `rgb` holds the 48 floats passed.
-        let status = unsafe {
-            mlt_render_ex(
-                scene.0,
-                &floor_camera(),
-                &settings,
-                rgb.as_mut_ptr(),
-                rgb.len(),
-                None,
-                null_mut(),
-                &mut stats,
-            )
-        };
-        assert_eq!(
-            status, MLT_STATUS_OK,
-            "{erpt_chain_length}, {erpt_deposit_energy}"
-        );
-        assert_eq!(stats.samples, 16);
-        assert!(rgb.iter().all(|v| v.is_finite()));
+        let (rgb, stats) = scene.render_4x4_with_stats(&floor_camera(), &settings);
+        let case = format!("{erpt_chain_length}, {erpt_deposit_energy}");
+        assert_eq!(stats.samples, 16, "{case}");
+        assert!(rgb.iter().all(|v| v.is_finite()), "{case}");
     }
 }
 
@@ -1555,74 +1387,20 @@ fn filter_settings_out_of_range() {
         filter_buffers: 8,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 9] = [
-        (
-            MltRenderSettings {
-                filter_buffers: 1,
-                ..metropolis
-            },
-            &["filter_buffers is 1", "0 (no filter) or from 2 to 32"],
-        ),
-        (
-            MltRenderSettings {
-                filter_buffers: 33,
-                ..metropolis
-            },
-            &["filter_buffers is 33"],
-        ),
-        (
-            MltRenderSettings {
-                filter_strength: f32::NAN,
-                ..metropolis
-            },
-            &["filter_strength is NaN"],
-        ),
-        (
-            MltRenderSettings {
-                filter_strength: 0.0,
-                ..metropolis
-            },
-            &["filter_strength is 0", "positive"],
-        ),
-        (
-            MltRenderSettings {
-                filter_strength: -1.0,
-                ..metropolis
-            },
-            &["filter_strength is -1"],
-        ),
-        (
-            MltRenderSettings {
-                filter_strength: 1e9,
-                ..metropolis
-            },
-            &["filter_strength is 1000000000", "up to 100"],
-        ),
-        (
-            MltRenderSettings {
-                filter_radius: 0,
-                ..metropolis
-            },
-            &["filter_radius is 0", "from 1 to 32"],
-        ),
-        (
-            MltRenderSettings {
-                filter_radius: u32::MAX,
-                ..metropolis
-            },
-            &["filter_radius is 4294967295"],
-        ),
-        (
-            MltRenderSettings {
-                algorithm: MLT_ALGORITHM_PATH,
-                ..metropolis
-            },
-            &["filter_buffers is 8", "Path", "Metropolis and ERPT"],
-        ),
+    let mut cases = cases![s = metropolis;
+        s.filter_buffers = 1 => ["filter_buffers is 1", "0 (no filter) or from 2 to 32"],
+        s.filter_buffers = 33 => ["filter_buffers is 33"],
+        s.filter_strength = 0.0 => ["filter_strength is 0", "positive"],
+        s.filter_strength = -1.0 => ["filter_strength is -1"],
+        s.filter_strength = 1e9 => ["filter_strength is 1000000000", "up to 100"],
+        s.filter_radius = 0 => ["filter_radius is 0", "from 1 to 32"],
+        s.filter_radius = u32::MAX => ["filter_radius is 4294967295"],
+        s.algorithm = MLT_ALGORITHM_PATH => ["filter_buffers is 8", "Path", "Metropolis and ERPT"],
     ];
-    for (settings, needles) in &cases {
-        scene.render_fails(&floor_camera(), settings, needles);
-    }
+    cases.extend(non_finite_cases![s = metropolis;
+        s.filter_strength => "settings.filter_strength" + "positive, up to 100",
+    ]);
+    scene.assert_refuses_settings("filter settings", &floor_camera(), &cases);
     // In range, every algorithm the filter applies to renders and reports it.
     for algorithm in [
         MLT_ALGORITHM_PSSMLT,
@@ -1654,147 +1432,37 @@ fn metropolis_settings_out_of_range() {
         chains: 4,
         ..small_settings(4, 4, 1)
     };
-    let cases: [(MltRenderSettings, &[&str]); 19] = [
-        (
-            MltRenderSettings {
-                mutations_per_pixel: 0,
-                ..metropolis
-            },
-            &["mutations_per_pixel is 0", "time limit"],
-        ),
-        (
-            MltRenderSettings {
-                mutations_per_pixel: MLT_MAX_SAMPLES_PER_PIXEL + 1,
-                direct_samples_per_mutation: 0,
-                ..metropolis
-            },
-            &["mutations_per_pixel", "16777217"],
-        ),
-        (
-            MltRenderSettings {
-                mutations_per_pixel: 1 << 20,
-                direct_samples_per_mutation: 17,
-                ..metropolis
-            },
-            &["direct_samples_per_mutation is 17", "mutations_per_pixel"],
-        ),
-        (
-            MltRenderSettings {
-                bootstrap_samples: (1 << 28) + 1,
-                ..metropolis
-            },
-            &["bootstrap_samples is 268435457", "0 (automatic)"],
-        ),
-        (
-            MltRenderSettings {
-                bootstrap_samples: 0,
-                chains: 1 << 20,
-                ..metropolis
-            },
-            &["chains is 1048576", "bootstrap samples (65536)"],
-        ),
-        (
-            MltRenderSettings {
-                normalization_work_fraction: f32::NAN,
-                ..metropolis
-            },
-            &["normalization_work_fraction is NaN", "0 to 0.9"],
-        ),
-        (
-            MltRenderSettings {
-                normalization_work_fraction: -0.1,
-                ..metropolis
-            },
-            &["normalization_work_fraction is -0.1"],
-        ),
-        (
-            MltRenderSettings {
-                normalization_work_fraction: 0.95,
-                ..metropolis
-            },
-            &["normalization_work_fraction is 0.95"],
-        ),
-        (
-            MltRenderSettings {
-                chains: 0,
-                ..metropolis
-            },
-            &["chains is 0"],
-        ),
-        (
-            MltRenderSettings {
-                chains: 65,
-                ..metropolis
-            },
-            &["chains is 65", "bootstrap samples (64)"],
-        ),
-        (
-            MltRenderSettings {
-                large_step_probability: f32::NAN,
-                ..metropolis
-            },
-            &["large_step_probability is NaN"],
-        ),
-        (
-            MltRenderSettings {
-                large_step_probability: 1.5,
-                ..metropolis
-            },
-            &["large_step_probability is 1.5"],
-        ),
-        (
-            MltRenderSettings {
-                small_step_sigma: 0.0,
-                ..metropolis
-            },
-            &["small_step_sigma is 0"],
-        ),
-        (
-            MltRenderSettings {
-                small_step_sigma: f32::INFINITY,
-                ..metropolis
-            },
-            &["small_step_sigma is inf"],
-        ),
-        (
-            MltRenderSettings {
-                mutation_weights: [0.5, f32::NAN, 0.25, 0.25],
-                ..metropolis
-            },
-            &["mutation_weights[1] is NaN"],
-        ),
-        (
-            MltRenderSettings {
-                mutation_weights: [0.5, 0.25, -1.0, 0.25],
-                ..metropolis
-            },
-            &["mutation_weights[2] is -1"],
-        ),
-        (
-            MltRenderSettings {
-                mutation_weights: [0.0, 1.0, 1.0, 1.0],
-                ..metropolis
-            },
-            &["mutation_weights[0]", "bidirectional", "positive"],
-        ),
-        (
-            MltRenderSettings {
-                adapt_mutation_weights: 2,
-                ..metropolis
-            },
-            &["adapt_mutation_weights is 2", "0 or 1"],
-        ),
-        (
-            MltRenderSettings {
-                perturb_in_sample_space: u32::MAX,
-                ..metropolis
-            },
-            &["perturb_in_sample_space is 4294967295", "0 or 1"],
-        ),
+    let mut cases = cases![s = metropolis;
+        s.mutations_per_pixel = 0 => ["mutations_per_pixel is 0", "time limit"],
+        { s.mutations_per_pixel = MLT_MAX_SAMPLES_PER_PIXEL + 1; s.direct_samples_per_mutation = 0 }
+            => ["mutations_per_pixel is 16777217"],
+        { s.mutations_per_pixel = 1 << 20; s.direct_samples_per_mutation = 17 }
+            => ["direct_samples_per_mutation is 17", "mutations_per_pixel"],
+        s.bootstrap_samples = (1 << 28) + 1 => ["bootstrap_samples is 268435457", "0 (automatic)"],
+        { s.bootstrap_samples = 0; s.chains = 1 << 20 }
+            => ["chains is 1048576", "bootstrap samples (65536)"],
+        s.chains = 0 => ["chains is 0"],
+        s.chains = 65 => ["chains is 65", "bootstrap samples (64)"],
+        s.normalization_work_fraction = -0.1 => ["normalization_work_fraction is -0.1"],
+        s.normalization_work_fraction = 0.95 => ["normalization_work_fraction is 0.95"],
+        s.large_step_probability = 1.5 => ["large_step_probability is 1.5"],
+        s.small_step_sigma = 0.0 => ["small_step_sigma is 0"],
+        s.mutation_weights = [0.5, 0.25, -1.0, 0.25] => ["mutation_weights[2] is -1"],
+        s.mutation_weights = [0.0, 1.0, 1.0, 1.0]
+            => ["mutation_weights[0]", "bidirectional", "positive"],
+        s.adapt_mutation_weights = 2 => ["adapt_mutation_weights is 2", "0 or 1"],
+        s.perturb_in_sample_space = u32::MAX => ["perturb_in_sample_space is 4294967295", "0 or 1"],
     ];
-    for (settings, needles) in &cases {
-        scene.render_fails(&floor_camera(), settings, needles);
-    }
+    cases.extend(non_finite_cases![s = metropolis;
+        s.normalization_work_fraction => "settings.normalization_work_fraction" + "0 to 0.9",
+        s.large_step_probability => "settings.large_step_probability" + "in [0, 1]",
+        s.small_step_sigma => "settings.small_step_sigma" + "in (0, 1]",
+        s.mutation_weights[0] => "settings.mutation_weights[0]" + "finite, from 0 to 1e6",
+        s.mutation_weights[1] => "settings.mutation_weights[1]" + "finite, from 0 to 1e6",
+        s.mutation_weights[2] => "settings.mutation_weights[2]" + "finite, from 0 to 1e6",
+        s.mutation_weights[3] => "settings.mutation_weights[3]" + "finite, from 0 to 1e6",
+    ]);
+    scene.assert_refuses_settings("Metropolis settings", &floor_camera(), &cases);
     // The same settings in range render, with every Metropolis algorithm.
     for algorithm in [
         MLT_ALGORITHM_PSSMLT,
@@ -1841,130 +1509,41 @@ fn limits_themselves_are_accepted() {
 // ---------------------------------------------------------------------------------------
 
 #[test]
-fn non_finite_camera_values() {
+fn bad_cameras() {
     let scene = HostScene::floor_and_light().create();
-    let settings = small_settings(4, 4, 1);
-    let base = floor_camera();
-    let cases: [(MltCamera, &str); 6] = [
-        (
-            MltCamera {
-                eye: [f32::NAN, 1.0, -4.0],
-                ..base
-            },
-            "camera.eye.x",
-        ),
-        (
-            MltCamera {
-                target: [0.0, f32::INFINITY, 0.0],
-                ..base
-            },
-            "camera.target.y",
-        ),
-        (
-            MltCamera {
-                up: [0.0, 1.0, f32::NAN],
-                ..base
-            },
-            "camera.up.z",
-        ),
-        (
-            MltCamera {
-                fov_y_deg: f32::INFINITY,
-                ..base
-            },
-            "camera.fov_y_deg",
-        ),
-        (
-            MltCamera {
-                lens_radius: f32::NAN,
-                ..base
-            },
-            "camera.lens_radius",
-        ),
-        (
-            MltCamera {
-                focus_distance: f32::NEG_INFINITY,
-                ..base
-            },
-            "camera.focus_distance",
-        ),
+    let mut cases = cases![c = floor_camera();
+        c.target = [0.0, 1.0, -4.0] => ["camera.eye", "camera.target", "coincide"],
+        c.up = [0.0, 0.0, 1.0] => ["camera.up", "parallel"],
+        c.up = [0.0, 0.0, -3.0] => ["camera.up", "parallel"],
+        c.up = [0.0; 3] => ["camera.up", "zero"],
+        c.fov_y_deg = 0.0 => ["camera.fov_y_deg is 0", "(0, 180)"],
+        c.fov_y_deg = -0.0 => ["camera.fov_y_deg is -0"],
+        c.fov_y_deg = 180.0 => ["camera.fov_y_deg is 180"],
+        c.fov_y_deg = 200.0 => ["camera.fov_y_deg is 200"],
+        c.fov_y_deg = -30.0 => ["camera.fov_y_deg is -30"],
+        c.lens_radius = -1.0 => ["camera.lens_radius is -1"],
+        c.focus_distance = -2.0 => ["camera.focus_distance is -2"],
+        // Finite eye and target whose difference overflows f32: no view direction.
+        { c.eye = [3.0e38, 0.0, 0.0]; c.target = [-3.0e38, 0.0, 0.0] } => ["camera", "overflows"],
     ];
-    for (camera, field) in cases {
-        scene.render_fails(&camera, &settings, &[field, "finite"]);
-    }
-}
-
-#[test]
-fn eye_equals_target() {
-    let scene = HostScene::floor_and_light().create();
-    let camera = MltCamera {
-        target: [0.0, 1.0, -4.0],
-        ..floor_camera()
-    };
-    scene.render_fails(
-        &camera,
-        &small_settings(4, 4, 1),
-        &["camera.eye", "camera.target", "coincide"],
-    );
-}
-
-#[test]
-fn up_parallel_to_view_or_zero() {
-    let scene = HostScene::floor_and_light().create();
+    cases.extend(non_finite_cases![c = floor_camera();
+        c.eye[0] => "camera.eye.x" + "finite",
+        c.eye[1] => "camera.eye.y" + "finite",
+        c.eye[2] => "camera.eye.z" + "finite",
+        c.target[0] => "camera.target.x" + "finite",
+        c.target[1] => "camera.target.y" + "finite",
+        c.target[2] => "camera.target.z" + "finite",
+        c.up[0] => "camera.up.x" + "finite",
+        c.up[1] => "camera.up.y" + "finite",
+        c.up[2] => "camera.up.z" + "finite",
+        c.fov_y_deg => "camera.fov_y_deg" + "finite",
+        c.lens_radius => "camera.lens_radius" + "finite",
+        c.focus_distance => "camera.focus_distance" + "finite",
+    ]);
     let settings = small_settings(4, 4, 1);
-    for up in [[0.0, 0.0, 1.0], [0.0, 0.0, -3.0]] {
-        let camera = MltCamera {
-            up,
-            ..floor_camera()
-        };
-        scene.render_fails(&camera, &settings, &["camera.up", "parallel"]);
-    }
-    let camera = MltCamera {
-        up: [0.0; 3],
-        ..floor_camera()
-    };
-    scene.render_fails(&camera, &settings, &["camera.up", "zero"]);
-}
-
-#[test]
-fn bad_field_of_view() {
-    let scene = HostScene::floor_and_light().create();
-    let settings = small_settings(4, 4, 1);
-    for fov in [0.0, -0.0, 180.0, 200.0, -30.0, f32::NAN] {
-        let camera = MltCamera {
-            fov_y_deg: fov,
-            ..floor_camera()
-        };
-        scene.render_fails(&camera, &settings, &["camera.fov_y_deg", &fov.to_string()]);
-    }
-}
-
-#[test]
-fn negative_lens_values() {
-    let scene = HostScene::floor_and_light().create();
-    let settings = small_settings(4, 4, 1);
-    let camera = MltCamera {
-        lens_radius: -1.0,
-        ..floor_camera()
-    };
-    scene.render_fails(&camera, &settings, &["camera.lens_radius", "-1"]);
-    let camera = MltCamera {
-        focus_distance: -2.0,
-        ..floor_camera()
-    };
-    scene.render_fails(&camera, &settings, &["camera.focus_distance", "-2"]);
-}
-
-#[test]
-fn camera_whose_view_vector_overflows() {
-    // Finite eye and target whose difference overflows f32: the view direction is undefined.
-    let scene = HostScene::floor_and_light().create();
-    let camera = MltCamera {
-        eye: [3.0e38, 0.0, 0.0],
-        target: [-3.0e38, 0.0, 0.0],
-        ..floor_camera()
-    };
-    scene.render_fails(&camera, &small_settings(4, 4, 1), &["camera"]);
+    assert_cases("cameras", &cases, |camera, needles| {
+        scene.check_render_refused(camera, &settings, needles)
+    });
 }
 
 // ---------------------------------------------------------------------------------------
@@ -2035,93 +1614,45 @@ fn ray_queries_with_impossible_counts() {
 fn bad_rays() {
     let scene = HostScene::floor_and_light().create();
     let good = ray([0.0, 1.0, 0.0], [0.0, -1.0, 0.0]);
-    let cases: Vec<(MltRay, Vec<&str>)> = vec![
-        (
-            MltRay {
-                origin: [f32::NAN, 0.0, 0.0],
-                ..good
-            },
-            vec!["rays[1].origin.x", "NaN"],
-        ),
-        (
-            MltRay {
-                origin: [0.0, f32::INFINITY, 0.0],
-                ..good
-            },
-            vec!["rays[1].origin.y", "inf"],
-        ),
-        (
-            MltRay {
-                direction: [0.0, 0.0, f32::NAN],
-                ..good
-            },
-            vec!["rays[1].direction.z", "NaN"],
-        ),
-        (
-            MltRay {
-                direction: [0.0; 3],
-                ..good
-            },
-            vec!["rays[1].direction", "non-zero"],
-        ),
-        (
-            MltRay { tmin: -1.0, ..good },
-            vec!["rays[1].tmin", "-1", ">= 0"],
-        ),
-        (
-            MltRay {
-                tmin: f32::NAN,
-                ..good
-            },
-            vec!["rays[1].tmin", "NaN"],
-        ),
-        (
-            MltRay {
-                tmin: f32::INFINITY,
-                ..good
-            },
-            vec!["rays[1].tmin", "inf"],
-        ),
-        (
-            MltRay {
-                tmin: 2.0,
-                tmax: 1.0,
-                ..good
-            },
-            vec!["rays[1].tmax", "1", "tmin (2)"],
-        ),
-        (
-            MltRay {
-                tmax: f32::NAN,
-                ..good
-            },
-            vec!["rays[1].tmax", "NaN"],
-        ),
-        (
-            MltRay {
-                tmax: f32::NEG_INFINITY,
-                ..good
-            },
-            vec!["rays[1].tmax", "-inf"],
-        ),
+    let mut cases = cases![r = good;
+        r.direction = [0.0; 3] => ["rays[1].direction", "non-zero"],
+        r.tmin = -1.0 => ["rays[1].tmin is -1", ">= 0"],
+        { r.tmin = 2.0; r.tmax = 1.0 } => ["rays[1].tmax is 1", "tmin (2)"],
+        // tmax may be +inf (no limit), not NaN or -inf.
+        r.tmax = f32::NAN => ["rays[1].tmax is NaN"],
+        r.tmax = f32::NEG_INFINITY => ["rays[1].tmax is -inf"],
     ];
-    for (bad, needles) in cases {
+    cases.extend(non_finite_cases![r = good;
+        r.origin[0] => "rays[1].origin.x" + "finite",
+        r.origin[1] => "rays[1].origin.y" + "finite",
+        r.origin[2] => "rays[1].origin.z" + "finite",
+        r.direction[0] => "rays[1].direction.x" + "finite",
+        r.direction[1] => "rays[1].direction.y" + "finite",
+        r.direction[2] => "rays[1].direction.z" + "finite",
+        r.tmin => "rays[1].tmin" + "finite and >= 0",
+    ]);
+    assert_cases("rays", &cases, |&bad, needles| {
         let rays = [good, bad];
         let (status, hits) = scene.intersect(&rays);
-        assert_invalid(status, &needles);
-        assert!(
-            hits.iter()
-                .all(|h| h.triangle_id == SENTINEL_HIT.triangle_id),
-            "hits_out written although rays[1] is bad: {bad:?}"
-        );
+        check_error(status, MLT_STATUS_INVALID_ARGUMENT, needles)
+            .and_then(|()| {
+                ensure(
+                    hits.iter()
+                        .all(|h| h.triangle_id == SENTINEL_HIT.triangle_id),
+                    "hits_out written although rays[1] is bad",
+                )
+            })
+            .map_err(|e| format!("mlt_intersect: {e}"))?;
         let (status, flags) = scene.occluded(&rays);
-        assert_invalid(status, &needles);
-        assert_eq!(
-            flags,
-            [0xAB, 0xAB],
-            "occluded_out written although rays[1] is bad"
-        );
-    }
+        check_error(status, MLT_STATUS_INVALID_ARGUMENT, needles)
+            .and_then(|()| {
+                ensure(
+                    flags == [0xAB, 0xAB],
+                    "occluded_out written although rays[1] is bad",
+                )
+            })
+            .map_err(|e| format!("mlt_occluded: {e}"))
+    });
 }
 
 #[test]
