@@ -33,7 +33,7 @@
 //! is usually real energy, and removing it is bias, not noise removal.
 
 use crate::scene::luminance;
-use glam::Vec3A;
+use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 
 /// Fewest partial images the filter accepts: two already give a spread.
@@ -208,7 +208,7 @@ fn variance_of_the_mean(
     let mut shares = vec![0.0f64; buffers];
     for pixel in partials.chunks_exact(buffers) {
         for (share, p) in shares.iter_mut().zip(pixel) {
-            *share += luminance(Vec3A::from(*p)).max(0.0) as f64;
+            *share += luminance(Spectrum::from(*p)).max(0.0) as f64;
         }
     }
     let total: f64 = shares.iter().sum();

@@ -9,6 +9,7 @@ pub use material::{Material, MaterialKind};
 use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::sampling::Distribution1D;
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
@@ -55,7 +56,7 @@ pub struct AreaLight {
     pub edge1: Vec3A,
     pub edge2: Vec3A,
     pub normal: Vec3A,
-    pub emission: Vec3A,
+    pub emission: Spectrum,
     /// Selection probability / area: the area density of light sampling on this light.
     pub area_pdf: f32,
     /// Internal index of the light's triangle.
@@ -130,8 +131,8 @@ impl Scene {
             let material = material_of(id);
             let cross = (v1 - v0).cross(v2 - v0);
             let normal = cross.normalize();
-            let emission = Vec3A::from(desc.materials[material as usize].emission);
-            if emission.max_element() > 0.0 {
+            let emission = Spectrum::from(desc.materials[material as usize].emission);
+            if emission.max_component() > 0.0 {
                 lights.push(AreaLight {
                     v0,
                     edge1: v1 - v0,
@@ -208,8 +209,8 @@ impl Scene {
 /// Rec. 709 luminance of linear RGB: the scalar used for light selection and (later) for
 /// Metropolis acceptance.
 #[inline]
-pub fn luminance(rgb: Vec3A) -> f32 {
-    rgb.dot(Vec3A::new(0.2126, 0.7152, 0.0722))
+pub fn luminance(rgb: Spectrum) -> f32 {
+    rgb.luminance()
 }
 
 fn validate_arrays(desc: &SceneDesc) -> Result<()> {

@@ -42,6 +42,7 @@ use crate::accel::Ray;
 use crate::bsdf::{self, TransportMode};
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Probabilities of δ = n_a − n_d = −2, −1, 0, 1, 2: mostly the same length, as Veach
@@ -118,7 +119,7 @@ pub(crate) fn split_density_sum(
 /// ratio's factor f(y)T(y→x) / (f(x)T(x→y)).
 pub(crate) struct Proposal {
     pub ratio: f32,
-    pub value: Vec3A,
+    pub value: Spectrum,
     pub pixel: u32,
 }
 
