@@ -157,7 +157,7 @@ impl Scene {
         let area = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
         let light_power: Vec<f32> = lights
             .iter()
-            .map(|light| luminance(light.emission) * area(light))
+            .map(|light| light.emission.luminance() * area(light))
             .collect();
         let light_distribution = Distribution1D::new(&light_power);
         for (index, light) in lights.iter_mut().enumerate() {
@@ -204,13 +204,6 @@ impl Scene {
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel.occluded(ray)
     }
-}
-
-/// Rec. 709 luminance of linear RGB: the scalar used for light selection and (later) for
-/// Metropolis acceptance.
-#[inline]
-pub fn luminance(rgb: Spectrum) -> f32 {
-    rgb.luminance()
 }
 
 fn validate_arrays(desc: &SceneDesc) -> Result<()> {

@@ -45,7 +45,7 @@ impl PathSample {
     /// (dropped: a chain must not be drawn to a NaN).
     #[inline]
     pub fn usable_luminance(value: Spectrum) -> f32 {
-        let luminance = crate::scene::luminance(value);
+        let luminance = value.luminance();
         if luminance > 0.0 && luminance.is_finite() && value.is_finite() {
             luminance
         } else {

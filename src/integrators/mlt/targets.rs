@@ -515,7 +515,7 @@ impl PrimarySpaceTarget for BdptMultiplexed<'_> {
 #[cfg(all(test, feature = "cli"))]
 mod tests {
     use super::*;
-    use crate::scene::{Scene, luminance};
+    use crate::scene::Scene;
 
     #[test]
     fn strategies_cover_each_depth_once() {
@@ -591,7 +591,7 @@ mod tests {
                     let entries: f32 = point
                         .entries
                         .iter()
-                        .map(|e| luminance(Spectrum::from(e.value.to_array())))
+                        .map(|e| Spectrum::from(e.value.to_array()).luminance())
                         .sum();
                     assert!((entries - point.target).abs() <= 1e-5 * point.target);
                     split[group] += point.target / target.points_per_sample(group) as f32;

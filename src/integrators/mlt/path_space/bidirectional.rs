@@ -109,7 +109,7 @@ pub(crate) fn split_density_sum(
         .filter_map(|i| {
             let s = (a + 1) as usize + i;
             let (c, _) = space.unweighted_contribution(path, s, true)?;
-            let luminance = crate::scene::luminance(c);
+            let luminance = c.luminance();
             (luminance > 0.0).then(|| 1.0 / luminance)
         })
         .sum()
@@ -494,7 +494,7 @@ mod tests {
     }
 
     fn luminance(rgb: DVec3) -> f64 {
-        rgb.dot(DVec3::new(0.2126, 0.7152, 0.0722))
+        rgb.dot(DVec3::from_array(crate::spectrum::LUMINANCE_WEIGHTS))
     }
 
     /// |cos| at both ends over the squared distance.
