@@ -2,6 +2,7 @@
 //! an image normalized pixel by pixel (so a partial render is still a valid estimate).
 
 use crate::filter::{FilterSettings, FilterStats, filter_splats};
+use crate::spectrum::Spectrum;
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -11,7 +12,20 @@ use rayon::prelude::*;
 #[derive(Clone, Copy, Debug)]
 pub struct Splat {
     pub pixel: u32,
+    /// The contribution in the film's RGB (a 16-byte-aligned `Spectrum` would double the
+    /// splat's size).
     pub value: Vec3,
+}
+
+impl Splat {
+    /// A contribution of `value` to `pixel`: where a spectrum becomes the film's RGB.
+    #[inline]
+    pub fn new(pixel: u32, value: Spectrum) -> Splat {
+        Splat {
+            pixel,
+            value: Vec3::from_array(value.to_array()),
+        }
+    }
 }
 
 pub struct Film {

@@ -32,8 +32,7 @@
 //! benchmark runs, each pixel is reached by a few chains only, so a partial that stands out
 //! is usually real energy, and removing it is bias, not noise removal.
 
-use crate::scene::luminance;
-use glam::Vec3A;
+use crate::spectrum::{LUMINANCE_WEIGHTS, Spectrum};
 use rayon::prelude::*;
 
 /// Fewest partial images the filter accepts: two already give a spread.
@@ -181,7 +180,8 @@ pub fn filter_splats(
             1.0
         }
     });
-    let lum = |v: &[f64; 3]| 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2];
+    let [r, g, b] = LUMINANCE_WEIGHTS;
+    let lum = |v: &[f64; 3]| r * v[0] + g * v[1] + b * v[2];
     let (mut changed, mut energy) = (0.0, 0.0);
     for (t, f) in totals.iter().zip(&mut filtered) {
         for c in 0..3 {
@@ -208,7 +208,7 @@ fn variance_of_the_mean(
     let mut shares = vec![0.0f64; buffers];
     for pixel in partials.chunks_exact(buffers) {
         for (share, p) in shares.iter_mut().zip(pixel) {
-            *share += luminance(Vec3A::from(*p)).max(0.0) as f64;
+            *share += Spectrum::from(*p).luminance().max(0.0) as f64;
         }
     }
     let total: f64 = shares.iter().sum();

@@ -36,6 +36,7 @@ pub mod integrators;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod spectrum;
 
 #[cfg(feature = "cli")]
 pub mod io;

@@ -1,6 +1,7 @@
 //! Smooth dielectric interface: Fresnel-weighted choice between reflection and refraction.
 
 use super::scattering::{ScatterSample, TransportMode, reflect};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Unpolarized Fresnel reflectance for light arriving with |cos θ| = `cos_i` on the side
@@ -55,7 +56,7 @@ impl Interface {
 #[inline]
 pub(super) fn sample(
     ior: f32,
-    color: Vec3A,
+    color: Spectrum,
     normal: Vec3A,
     wo: Vec3A,
     u_lobe: f32,
@@ -111,7 +112,7 @@ pub(super) fn refracted(ior: f32, normal: Vec3A, wo: Vec3A) -> Option<Vec3A> {
 #[inline]
 fn refraction(
     wi: Vec3A,
-    color: Vec3A,
+    color: Spectrum,
     eta: f32,
     fresnel: f32,
     mode: TransportMode,
@@ -133,7 +134,7 @@ fn refraction(
 #[inline]
 pub(super) fn scatter(
     ior: f32,
-    color: Vec3A,
+    color: Spectrum,
     normal: Vec3A,
     wo: Vec3A,
     wi: Vec3A,
@@ -178,7 +179,7 @@ mod tests {
     #[test]
     fn scatter_gives_what_sample_gave() {
         let n = Vec3A::new(0.2, 0.9, -0.1).normalize();
-        let color = Vec3A::new(0.9, 0.8, 0.7);
+        let color = Spectrum::new(0.9, 0.8, 0.7);
         for wo in [Vec3A::new(0.5, 0.8, 0.1), Vec3A::new(-0.3, -0.6, 0.4)] {
             let wo = wo.normalize();
             for mode in [TransportMode::Radiance, TransportMode::Importance] {
@@ -200,7 +201,7 @@ mod tests {
         let n = Vec3A::new(0.2, 0.9, -0.1).normalize();
         for wo in [Vec3A::new(0.5, 0.8, 0.1), Vec3A::new(-0.3, -0.6, 0.4)] {
             let wo = wo.normalize();
-            let s = sample(1.5, Vec3A::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
+            let s = sample(1.5, Spectrum::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
             assert_eq!(refracted(1.5, n, wo), Some(s.wi));
         }
         // Beyond the critical angle from inside: no refraction.
@@ -213,14 +214,22 @@ mod tests {
         let n = Vec3A::Y;
         let wo = Vec3A::new(0.5, 0.8, 0.0).normalize();
         // u_lobe = 0.999 picks refraction (F is small at this angle).
-        let s = sample(1.5, Vec3A::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
+        let s = sample(1.5, Spectrum::ONE, n, wo, 0.999, TransportMode::Radiance).unwrap();
         let sin_i = wo.cross(n).length();
         let sin_t = s.wi.cross(n).length();
         assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
         assert!(s.wi.y < 0.0);
-        assert!((s.weight.x - 1.0 / 2.25).abs() < 1e-6);
+        assert!((s.weight[0] - 1.0 / 2.25).abs() < 1e-6);
         // The reversed path (arriving from inside along s.wi) leaves along wo.
-        let back = sample(1.5, Vec3A::ONE, n, s.wi, 0.999, TransportMode::Importance).unwrap();
+        let back = sample(
+            1.5,
+            Spectrum::ONE,
+            n,
+            s.wi,
+            0.999,
+            TransportMode::Importance,
+        )
+        .unwrap();
         assert!((back.wi - wo).length() < 1e-5);
     }
 }

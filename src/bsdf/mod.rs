@@ -11,6 +11,7 @@ pub use scattering::{ScatterSample, TransportMode, reflect};
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::scene::{Material, MaterialKind};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
 
@@ -24,7 +25,7 @@ pub fn sample(
     u_lobe: f32,
     mode: TransportMode,
 ) -> Option<ScatterSample> {
-    let color = Vec3A::from(material.color);
+    let color = Spectrum::from(material.color);
     let cos_o = wo.dot(normal);
     match material.kind {
         MaterialKind::Diffuse => {
@@ -56,16 +57,16 @@ pub fn sample(
 
 /// BSDF value f(wo, wi) (without the cosine) for non-specular materials; zero otherwise.
 #[inline]
-pub fn eval(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Vec3A {
+pub fn eval(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectrum {
     match material.kind {
         MaterialKind::Diffuse => {
             if wo.dot(normal) * wi.dot(normal) > 0.0 {
-                Vec3A::from(material.color) * FRAC_1_PI
+                Spectrum::from(material.color) * FRAC_1_PI
             } else {
-                Vec3A::ZERO
+                Spectrum::ZERO
             }
         }
-        _ => Vec3A::ZERO,
+        _ => Spectrum::ZERO,
     }
 }
 
@@ -98,7 +99,7 @@ pub fn scatter(
     wi: Vec3A,
     mode: TransportMode,
 ) -> Option<ScatterSample> {
-    let color = Vec3A::from(material.color);
+    let color = Spectrum::from(material.color);
     let (cos_o, cos_i) = (wo.dot(normal), wi.dot(normal));
     let same_side = cos_o * cos_i > 0.0;
     match material.kind {
@@ -185,7 +186,7 @@ mod tests {
             let p = pdf(&m, n, wo, s.wi);
             assert!((p - s.pdf).abs() < 1e-3 * p.max(1.0));
             let expected = f * cos / p;
-            assert!((expected - s.weight).abs().max_element() < 1e-3);
+            assert!((expected - s.weight).abs().max_component() < 1e-3);
             assert!(s.wi.dot(n) < 0.0, "stays on the side of wo");
         }
     }

@@ -1,6 +1,7 @@
 //! What every BSDF speaks: the quantity a path carries, a sampled scattering, and mirror
 //! reflection.
 
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Which quantity a path carries; refraction scales radiance but not importance.
@@ -15,7 +16,7 @@ pub enum TransportMode {
 pub struct ScatterSample {
     pub wi: Vec3A,
     /// BSDF × |cos θi| / pdf: the factor the path throughput is multiplied by.
-    pub weight: Vec3A,
+    pub weight: Spectrum,
     /// Solid-angle density of `wi` (for specular lobes, the discrete lobe probability).
     pub pdf: f32,
     /// A Dirac lobe: no other strategy can generate this direction.

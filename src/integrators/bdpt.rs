@@ -18,6 +18,7 @@ use crate::bsdf::{self, TransportMode};
 use crate::film::Splat;
 use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere, uniform_triangle};
 use crate::scene::{CameraModel, MaterialKind, Scene};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
 
@@ -49,7 +50,7 @@ struct Vertex {
     /// Unit direction towards the previous vertex of its own subpath (surfaces only).
     wo: Vec3A,
     /// Subpath throughput up to and including this vertex's sampling.
-    beta: Vec3A,
+    beta: Spectrum,
     pdf_forward: f32,
     pdf_reverse: f32,
     /// Internal triangle index (surfaces and lights).
@@ -64,7 +65,7 @@ impl Vertex {
         p: Vec3A::ZERO,
         normal: Vec3A::ZERO,
         wo: Vec3A::ZERO,
-        beta: Vec3A::ZERO,
+        beta: Spectrum::ZERO,
         pdf_forward: 0.0,
         pdf_reverse: 0.0,
         triangle: 0,
@@ -111,12 +112,12 @@ impl Bdpt<'_> {
 
     /// Radiance a surface vertex emits towards direction `w` (front side only).
     #[inline]
-    fn emitted(&self, v: &Vertex, w: Vec3A) -> Vec3A {
+    fn emitted(&self, v: &Vertex, w: Vec3A) -> Spectrum {
         let shading = &self.scene.shading[v.triangle as usize];
         if shading.light_area_pdf > 0.0 && w.dot(v.normal) > 0.0 {
-            Vec3A::from(self.scene.materials[shading.material as usize].emission)
+            Spectrum::from(self.scene.materials[shading.material as usize].emission)
         } else {
-            Vec3A::ZERO
+            Spectrum::ZERO
         }
     }
 
@@ -168,7 +169,7 @@ impl Bdpt<'_> {
         &self,
         path: &mut [Vertex],
         mut ray: crate::accel::Ray,
-        mut beta: Vec3A,
+        mut beta: Spectrum,
         mut pdf_solid_angle: f32,
         max_vertices: usize,
         mode: TransportMode,
@@ -222,7 +223,7 @@ impl Bdpt<'_> {
                 reverse_solid_angle = bsdf::pdf(material, vertex.normal, sample.wi, vertex.wo);
             }
             beta *= sample.weight;
-            if beta.max_element() <= 0.0 {
+            if beta.is_black() {
                 break;
             }
             let reverse = to_area(reverse_solid_angle, &path[index], &path[index - 1]);
@@ -249,7 +250,7 @@ impl Bdpt<'_> {
             kind: VertexKind::Camera,
             p: origin,
             normal: camera.forward,
-            beta: Vec3A::ONE,
+            beta: Spectrum::ONE,
             ..Vertex::EMPTY
         };
         let pdf_direction = camera.direction_pdf(origin, direction);
@@ -257,7 +258,7 @@ impl Bdpt<'_> {
         self.random_walk(
             path,
             ray,
-            Vec3A::ONE,
+            Spectrum::ONE,
             pdf_direction,
             max_vertices,
             TransportMode::Radiance,
@@ -398,11 +399,11 @@ impl Bdpt<'_> {
 
     /// Throughput factor of a surface vertex scattering from its predecessor towards `to`.
     #[inline]
-    fn f(&self, v: &Vertex, to: Vec3A) -> Vec3A {
+    fn f(&self, v: &Vertex, to: Vec3A) -> Spectrum {
         let w = to - v.p;
         let length = w.length();
         if length == 0.0 {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         }
         bsdf::eval(self.material(v), v.normal, v.wo, w / length)
     }
@@ -443,7 +444,7 @@ pub(crate) const STREAMS: usize = 3;
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Contribution {
     /// The MIS-weighted contribution.
-    pub value: Vec3A,
+    pub value: Spectrum,
     pub splat_pixel: Option<u32>,
     /// Its MIS weight: what divides `value` back into the strategy's own estimate (the
     /// path-space tests compare that with their evaluation of the path).
@@ -564,7 +565,7 @@ impl Bdpt<'_> {
                 return None;
             }
             let le = self.emitted(&pt, pt.wo);
-            if le.max_element() <= 0.0 {
+            if le.is_black() {
                 return None;
             }
             let weight = self.mis_weight(camera_model, camera, light, 0, t);
@@ -594,13 +595,13 @@ impl Bdpt<'_> {
                 kind: VertexKind::Camera,
                 p: lens,
                 normal: camera_model.forward,
-                beta: Vec3A::splat(importance.importance / pdf),
+                beta: Spectrum::splat(importance.importance / pdf),
                 ..Vertex::EMPTY
             };
             // s >= 2 here, so qs is a surface vertex.
             let contribution =
                 qs.beta * sampled.beta * self.f(&qs, lens) * direction.dot(qs.normal).abs();
-            if contribution.max_element() <= 0.0 || !self.visible(&qs, &sampled, counters) {
+            if contribution.is_black() || !self.visible(&qs, &sampled, counters) {
                 return None;
             }
             let saved = camera[0];
@@ -646,7 +647,7 @@ impl Bdpt<'_> {
             }
             let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
             let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
-            if contribution.max_element() <= 0.0 || !self.visible(&pt, &sampled, counters) {
+            if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
                 return None;
             }
             let saved = light[0];
@@ -674,7 +675,7 @@ impl Bdpt<'_> {
             let w = d / distance2.sqrt();
             let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
             let contribution = qs.beta * self.f(&qs, pt.p) * self.f(&pt, qs.p) * pt.beta * geometry;
-            if contribution.max_element() <= 0.0 || !self.visible(&qs, &pt, counters) {
+            if contribution.is_black() || !self.visible(&qs, &pt, counters) {
                 return None;
             }
             let weight = self.mis_weight(camera_model, camera, light, s, t);
@@ -748,8 +749,8 @@ impl PixelEstimator for Bdpt<'_> {
         counters: &mut SampleCounters,
         scratch: &mut BdptScratch,
         splats: &mut Vec<Splat>,
-    ) -> Vec3A {
-        let mut radiance = Vec3A::ZERO;
+    ) -> Spectrum {
+        let mut radiance = Spectrum::ZERO;
         self.sample_all_strategies(
             camera_model,
             x,
@@ -759,10 +760,7 @@ impl PixelEstimator for Bdpt<'_> {
             counters,
             |_, _, c| match c.splat_pixel {
                 None => radiance += c.value,
-                Some(pixel) => splats.push(Splat {
-                    pixel,
-                    value: c.value.into(),
-                }),
+                Some(pixel) => splats.push(Splat::new(pixel, c.value)),
             },
         );
         radiance

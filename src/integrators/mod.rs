@@ -8,6 +8,7 @@ use crate::accel::Ray;
 use crate::film::Splat;
 use crate::sampling::Rng;
 use crate::scene::{CameraModel, Scene};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// A vertex of a light path: a point on a light (the first), on a surface, or on the lens
@@ -47,7 +48,7 @@ pub trait PixelEstimator: Sync {
         counters: &mut SampleCounters,
         scratch: &mut Self::Scratch,
         splats: &mut Vec<Splat>,
-    ) -> Vec3A;
+    ) -> Spectrum;
 }
 
 /// A ray leaving surface point `p` (geometric normal `normal`) in `direction`, with its origin

@@ -6,6 +6,7 @@ use crate::bsdf::{self, TransportMode};
 use crate::film::Splat;
 use crate::sampling::{Rng, Sampler, power_heuristic, uniform_triangle};
 use crate::scene::{CameraModel, MaterialKind, Scene};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Bounces after which Russian roulette may end a path.
@@ -30,10 +31,10 @@ impl PathTracer<'_> {
         direction: Vec3A,
         rng: &mut S,
         rays: &mut u64,
-    ) -> Vec3A {
+    ) -> Spectrum {
         let scene = self.scene;
-        let mut radiance = Vec3A::ZERO;
-        let mut throughput = Vec3A::ONE;
+        let mut radiance = Spectrum::ZERO;
+        let mut throughput = Spectrum::ONE;
         let mut ray = crate::accel::Ray::new(origin, direction, 0.0, f32::INFINITY);
         // The previous vertex's scattering density, for MIS against light sampling.
         let mut previous_pdf = 0.0f32;
@@ -55,7 +56,7 @@ impl PathTracer<'_> {
 
             // Emission from the front side.
             if shading.light_area_pdf > 0.0 && cos_o > 0.0 && depth >= self.min_depth {
-                let emission = Vec3A::from(material.emission);
+                let emission = Spectrum::from(material.emission);
                 let weight = if previous_specular {
                     1.0
                 } else {
@@ -100,13 +101,13 @@ impl PathTracer<'_> {
             depth += 1;
 
             if depth >= ROULETTE_START_DEPTH {
-                let survival = throughput.max_element().min(ROULETTE_MAX_SURVIVAL);
+                let survival = throughput.max_component().min(ROULETTE_MAX_SURVIVAL);
                 if u_roulette >= survival {
                     break;
                 }
                 throughput /= survival;
             }
-            if throughput.max_element() <= 0.0 {
+            if throughput.is_black() {
                 break;
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
@@ -125,10 +126,10 @@ impl PathTracer<'_> {
         material: &crate::scene::Material,
         [u_select, u_point @ ..]: [f32; 3],
         rays: &mut u64,
-    ) -> Vec3A {
+    ) -> Spectrum {
         let scene = self.scene;
         if scene.lights.is_empty() {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         }
         let (index, _, _) = scene.light_distribution.sample_discrete(u_select);
         let light = &scene.lights[index];
@@ -137,23 +138,23 @@ impl PathTracer<'_> {
         let to_light = y - p;
         let distance2 = to_light.length_squared();
         if distance2 <= 0.0 {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         }
         let wi = to_light / distance2.sqrt();
         let cos_light = -wi.dot(light.normal);
         if cos_light <= 0.0 {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         }
         let f = bsdf::eval(material, normal, wo, wi);
-        if f.max_element() <= 0.0 {
-            return Vec3A::ZERO;
+        if f.is_black() {
+            return Spectrum::ZERO;
         }
         let Some(ray) = shadow_ray(scene, p, normal, y, light.normal) else {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         };
         *rays += 1;
         if scene.accel.occluded(&ray) {
-            return Vec3A::ZERO;
+            return Spectrum::ZERO;
         }
         let light_pdf = light.area_pdf * distance2 / cos_light;
         let weight = power_heuristic(light_pdf, bsdf::pdf(material, normal, wo, wi));
@@ -180,7 +181,7 @@ impl PixelEstimator for PathTracer<'_> {
         counters: &mut SampleCounters,
         _scratch: &mut (),
         _splats: &mut Vec<Splat>,
-    ) -> Vec3A {
+    ) -> Spectrum {
         let lens = rng.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
         self.radiance(origin, direction, rng, &mut counters.rays)

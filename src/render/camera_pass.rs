@@ -8,7 +8,7 @@ use crate::film::{Film, Splat};
 use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::CameraModel;
-use glam::Vec3A;
+use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 /// Stream offset of the per-pixel shifts of the camera samples' positions (apart from the
@@ -120,7 +120,7 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                         let x = i as u32 % width;
                         let y = band.first_row + i as u32 / width;
                         let pixel = y as u64 * width as u64 + x as u64;
-                        let mut pixel_sum = Vec3A::ZERO;
+                        let mut pixel_sum = Spectrum::ZERO;
                         // The pixel's samples spread over it as a (0, 2)-sequence.
                         let mut shift = Rng::new(self.seed, PIXEL_SHIFT_STREAM + pixel);
                         let shift = [shift.next_u32(), shift.next_u32()];

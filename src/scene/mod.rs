@@ -9,6 +9,7 @@ pub use material::{Material, MaterialKind};
 use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::sampling::Distribution1D;
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
@@ -55,7 +56,7 @@ pub struct AreaLight {
     pub edge1: Vec3A,
     pub edge2: Vec3A,
     pub normal: Vec3A,
-    pub emission: Vec3A,
+    pub emission: Spectrum,
     /// Selection probability / area: the area density of light sampling on this light.
     pub area_pdf: f32,
     /// Internal index of the light's triangle.
@@ -130,8 +131,8 @@ impl Scene {
             let material = material_of(id);
             let cross = (v1 - v0).cross(v2 - v0);
             let normal = cross.normalize();
-            let emission = Vec3A::from(desc.materials[material as usize].emission);
-            if emission.max_element() > 0.0 {
+            let emission = Spectrum::from(desc.materials[material as usize].emission);
+            if emission.max_component() > 0.0 {
                 lights.push(AreaLight {
                     v0,
                     edge1: v1 - v0,
@@ -156,7 +157,7 @@ impl Scene {
         let area = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
         let light_power: Vec<f32> = lights
             .iter()
-            .map(|light| luminance(light.emission) * area(light))
+            .map(|light| light.emission.luminance() * area(light))
             .collect();
         let light_distribution = Distribution1D::new(&light_power);
         for (index, light) in lights.iter_mut().enumerate() {
@@ -203,13 +204,6 @@ impl Scene {
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel.occluded(ray)
     }
-}
-
-/// Rec. 709 luminance of linear RGB: the scalar used for light selection and (later) for
-/// Metropolis acceptance.
-#[inline]
-pub fn luminance(rgb: Vec3A) -> f32 {
-    rgb.dot(Vec3A::new(0.2126, 0.7152, 0.0722))
 }
 
 fn validate_arrays(desc: &SceneDesc) -> Result<()> {

@@ -158,7 +158,7 @@ pub fn mean_and_standard_error(rgb: &[f32]) -> ([f64; 3], [f64; 3]) {
     (mean, error)
 }
 
-/// Luminance of a linear RGB mean (Rec. 709 weights, as `mlt::scene::luminance`).
+/// Luminance of a linear RGB mean (Rec. 709 weights, as `mlt::spectrum::Spectrum::luminance`).
 pub fn luminance(rgb: [f64; 3]) -> f64 {
     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }

@@ -6,7 +6,7 @@
 use super::pss::PssSampler;
 use crate::film::Splat;
 use crate::scene::CameraModel;
-use glam::Vec3A;
+use crate::spectrum::Spectrum;
 
 /// The settings every Metropolis render's chains share (`RenderSettings` documents each).
 #[derive(Clone, Copy, Debug)]
@@ -44,8 +44,8 @@ impl PathSample {
     /// The luminance of a contribution, or 0 for one that is not finite or not positive
     /// (dropped: a chain must not be drawn to a NaN).
     #[inline]
-    pub fn usable_luminance(value: Vec3A) -> f32 {
-        let luminance = crate::scene::luminance(value);
+    pub fn usable_luminance(value: Spectrum) -> f32 {
+        let luminance = value.luminance();
         if luminance > 0.0 && luminance.is_finite() && value.is_finite() {
             luminance
         } else {
@@ -55,13 +55,10 @@ impl PathSample {
 
     /// Adds a contribution; non-finite or black ones are dropped.
     #[inline]
-    pub fn push(&mut self, pixel: u32, value: Vec3A) {
+    pub fn push(&mut self, pixel: u32, value: Spectrum) {
         let luminance = Self::usable_luminance(value);
         if luminance > 0.0 {
-            self.entries.push(Splat {
-                pixel,
-                value: value.into(),
-            });
+            self.entries.push(Splat::new(pixel, value));
             self.target += luminance;
         }
     }

@@ -13,7 +13,7 @@ use crate::integrators::path::PathTracer;
 use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::sampling::Sampler;
 use crate::scene::CameraModel;
-use glam::Vec3A;
+use crate::spectrum::Spectrum;
 
 /// PSSMLT over the path tracer: one stream, read in the path tracer's order.
 impl PrimarySpaceTarget for PathTracer<'_> {
@@ -170,7 +170,7 @@ fn evaluate_all_strategies(
     out: &mut PathSample,
     rays: &mut u64,
 ) {
-    let mut radiance = Vec3A::ZERO;
+    let mut radiance = Spectrum::ZERO;
     let pixel = trace_all_strategies(bdpt, camera, sampler, paths, rays, |_, _, c| {
         match c.splat_pixel {
             None => radiance += c.value,
@@ -515,7 +515,7 @@ impl PrimarySpaceTarget for BdptMultiplexed<'_> {
 #[cfg(all(test, feature = "cli"))]
 mod tests {
     use super::*;
-    use crate::scene::{Scene, luminance};
+    use crate::scene::Scene;
 
     #[test]
     fn strategies_cover_each_depth_once() {
@@ -591,7 +591,7 @@ mod tests {
                     let entries: f32 = point
                         .entries
                         .iter()
-                        .map(|e| luminance(e.value.into()))
+                        .map(|e| Spectrum::from(e.value.to_array()).luminance())
                         .sum();
                     assert!((entries - point.target).abs() <= 1e-5 * point.target);
                     split[group] += point.target / target.points_per_sample(group) as f32;

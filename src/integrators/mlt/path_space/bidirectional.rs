@@ -42,6 +42,7 @@ use crate::accel::Ray;
 use crate::bsdf::{self, TransportMode};
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// Probabilities of δ = n_a − n_d = −2, −1, 0, 1, 2: mostly the same length, as Veach
@@ -108,7 +109,7 @@ pub(crate) fn split_density_sum(
         .filter_map(|i| {
             let s = (a + 1) as usize + i;
             let (c, _) = space.unweighted_contribution(path, s, true)?;
-            let luminance = crate::scene::luminance(c);
+            let luminance = c.luminance();
             (luminance > 0.0).then(|| 1.0 / luminance)
         })
         .sum()
@@ -118,7 +119,7 @@ pub(crate) fn split_density_sum(
 /// ratio's factor f(y)T(y→x) / (f(x)T(x→y)).
 pub(crate) struct Proposal {
     pub ratio: f32,
-    pub value: Vec3A,
+    pub value: Spectrum,
     pub pixel: u32,
 }
 
@@ -493,7 +494,7 @@ mod tests {
     }
 
     fn luminance(rgb: DVec3) -> f64 {
-        rgb.dot(DVec3::new(0.2126, 0.7152, 0.0722))
+        rgb.dot(DVec3::from_array(crate::spectrum::LUMINANCE_WEIGHTS))
     }
 
     /// |cos| at both ends over the squared distance.

@@ -58,7 +58,7 @@ use crate::integrators::mlt::primary_space::PathSample;
 use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::CameraModel;
-use glam::Vec3A;
+use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -131,7 +131,7 @@ struct Redistributor<'a> {
 
 /// The colour of a contribution scaled to unit luminance.
 #[inline]
-fn unit_colour(value: Vec3A) -> Option<Vec3A> {
+fn unit_colour(value: Spectrum) -> Option<Spectrum> {
     let luminance = PathSample::usable_luminance(value);
     (luminance > 0.0).then(|| value / luminance)
 }
@@ -152,7 +152,7 @@ impl Redistributor<'_> {
     }
 
     #[inline]
-    fn deposit(&self, pending: &mut Pending, pixel: u32, value: Vec3A) {
+    fn deposit(&self, pending: &mut Pending, pixel: u32, value: Spectrum) {
         if pixel != pending.pixel {
             self.flush(pending);
             pending.pixel = pixel;
@@ -171,7 +171,7 @@ impl Redistributor<'_> {
         chains: u64,
         pixel: u32,
         buffer: usize,
-        colour: Vec3A,
+        colour: Spectrum,
         rng: &mut Rng,
         scratch: &mut UnitScratch,
         rays: &mut u64,

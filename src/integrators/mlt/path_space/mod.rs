@@ -41,6 +41,7 @@ pub(crate) use perturbation::PerturbationSizes;
 use crate::bsdf::{self, TransportMode};
 use crate::integrators::PathVertex;
 use crate::scene::{CameraModel, MaterialKind, Scene};
+use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::PI;
 
@@ -119,7 +120,7 @@ impl PathSpace<'_> {
         to: &PathVertex,
         mode: TransportMode,
         lobes_sampled: bool,
-    ) -> Option<Vec3A> {
+    ) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
         let s = bsdf::scatter(self.material(at), at.normal, wo, wi, mode)?;
@@ -132,7 +133,7 @@ impl PathSpace<'_> {
 
     /// The BSDF of non-specular vertex `at` between its neighbors (zero for specular ones).
     #[inline]
-    fn bsdf(&self, from: &PathVertex, at: &PathVertex, to: &PathVertex) -> Option<Vec3A> {
+    fn bsdf(&self, from: &PathVertex, at: &PathVertex, to: &PathVertex) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
         Some(bsdf::eval(self.material(at), at.normal, wo, wi))
@@ -148,7 +149,7 @@ impl PathSpace<'_> {
         path: &[PathVertex],
         s: usize,
         lobes_sampled: bool,
-    ) -> Option<(Vec3A, u32)> {
+    ) -> Option<(Spectrum, u32)> {
         let n = path.len();
         if n < 2 || s >= n || (s == 1 && n == 2) {
             return None;
@@ -161,7 +162,8 @@ impl PathSpace<'_> {
         if area_pdf <= 0.0 {
             return None;
         }
-        let emission = Vec3A::from(self.scene.materials[light_shading.material as usize].emission);
+        let emission =
+            Spectrum::from(self.scene.materials[light_shading.material as usize].emission);
         // The light leaves its front side only.
         let (w_light, _) = direction(&path[0], &path[1])?;
         if w_light.dot(light.normal) <= 0.0 {
@@ -169,7 +171,7 @@ impl PathSpace<'_> {
         }
 
         // Light side: x_0 .. x_{s-1}.
-        let mut beta_light = Vec3A::ONE;
+        let mut beta_light = Spectrum::ONE;
         if s >= 1 {
             beta_light = emission / area_pdf;
             if s >= 2 {
@@ -188,7 +190,7 @@ impl PathSpace<'_> {
         }
         // Lens side: x_{n-1} .. x_s. The camera's importance is normalized so that the
         // first direction's weight is 1.
-        let mut beta_eye = Vec3A::ONE;
+        let mut beta_eye = Spectrum::ONE;
         for j in (s + 1..n - 1).rev() {
             beta_eye *= self.weight(
                 &path[j + 1],
@@ -225,14 +227,14 @@ impl PathSpace<'_> {
             let (w, distance2) = direction(qs, pt)?;
             let light_side = if s == 1 {
                 // Next-event estimation: the light's own factor is in beta_light.
-                Vec3A::ONE
+                Spectrum::ONE
             } else {
                 self.bsdf(&path[s - 2], qs, pt)?
             };
             let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
             beta_light * light_side * geometry * self.bsdf(&path[s + 1], pt, qs)? * beta_eye
         };
-        (value.max_element() > 0.0 && value.is_finite()).then_some((value, pixel))
+        (value.max_component() > 0.0 && value.is_finite()).then_some((value, pixel))
     }
 }
 
@@ -315,8 +317,8 @@ mod tests {
                             .unweighted_contribution(&path, s, true)
                             .unwrap_or_else(|| panic!("{name} ({s}, {t}): none, BDPT {expected}"));
                         let error = ((value - expected).abs()
-                            / expected.abs().max(Vec3A::splat(1e-6)))
-                        .max_element();
+                            / expected.abs().max(Spectrum::splat(1e-6)))
+                        .max_component();
                         assert!(
                             error < 2e-3,
                             "{name} ({s}, {t}): {value} vs BDPT's {expected}"

@@ -424,8 +424,7 @@ fn proposal(
 ) -> Option<Proposal> {
     let (value, pixel) = space.unweighted_contribution(y, s, false)?;
     let (value_x, _) = space.unweighted_contribution(x, s, false)?;
-    let ratio =
-        crate::scene::luminance(value) * density_y / (crate::scene::luminance(value_x) * density_x);
+    let ratio = value.luminance() * density_y / (value_x.luminance() * density_x);
     Some(Proposal {
         ratio,
         value,
