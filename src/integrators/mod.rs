@@ -1,6 +1,7 @@
 //! Light-transport estimators.
 
 pub mod bdpt;
+pub(crate) mod camera_passes;
 pub mod mlt;
 pub mod path;
 

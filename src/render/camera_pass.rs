@@ -1,25 +1,24 @@
-//! The pass of camera samples: an estimator of pixel values (the path tracer, BDPT, a
-//! Metropolis render's direct pass) run over the film in bands, pass by pass, each sample's
-//! position and random numbers fixed by its pixel and index so the image never depends on
-//! the thread count.
+//! The pass of camera samples of a pixel estimator (the path tracer, BDPT, a Metropolis
+//! render's direct pass) over the film: the shared schedule of
+//! `integrators::camera_passes`, each band's samples added to its pixels and its splats
+//! to the film.
 
 use crate::control::Control;
 use crate::film::{Film, Splat};
+use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
 use crate::integrators::{PixelEstimator, SampleCounters};
-use crate::sampling::{Rng, shifted_sobol_2d};
 use crate::scene::CameraModel;
 use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
-/// Stream offset of the per-pixel shifts of the camera samples' positions (apart from the
-/// per-sample streams, which hash the sample index into the seed).
+
+/// Stream offset of the per-pixel shifts of the camera samples' positions.
 const PIXEL_SHIFT_STREAM: u64 = 0x5eed_0f15_0000_0000;
 
 /// Rows per unit of parallel work.
 const BAND_ROWS: u32 = 4;
 
-/// Target samples per pass over the whole image: passes bound how long a stop takes and how
-/// unevenly a partial image is sampled.
+/// Target samples per pass over the whole image.
 const SAMPLES_PER_PASS: u64 = 1 << 18;
 
 /// Per-work-unit state of a render: the estimator's scratch memory and the splats of the
@@ -35,13 +34,8 @@ struct BandState<S> {
 pub(super) struct CameraSampleJob<'a, E: PixelEstimator> {
     estimator: &'a E,
     camera: CameraModel,
-    seed: u64,
-    /// 0 = until stopped.
-    samples_per_pixel: u32,
-    /// Samples per pixel of a full pass.
-    batch: u32,
-    /// Samples per pixel taken so far.
-    samples_taken: u32,
+    samples: PixelSamples,
+    schedule: PassSchedule,
     states: Vec<BandState<E::Scratch>>,
 }
 
@@ -55,7 +49,8 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
     ) -> Self {
         let width = film.width;
         let pixels = width as u64 * film.height as u64;
-        let batch = SAMPLES_PER_PASS.div_ceil(pixels).clamp(1, 64) as u32;
+        let schedule = PassSchedule::new(samples_per_pixel, pixels, SAMPLES_PER_PASS);
+        let batch = schedule.batch();
         let bands = film.height.div_ceil(BAND_ROWS) as usize;
         let splat_capacity = if estimator.splats() {
             (BAND_ROWS * width * batch * 2) as usize
@@ -72,10 +67,12 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
         CameraSampleJob {
             estimator,
             camera: *camera,
-            seed,
-            samples_per_pixel,
-            batch,
-            samples_taken: 0,
+            samples: PixelSamples {
+                seed,
+                shift_stream: PIXEL_SHIFT_STREAM,
+                width,
+            },
+            schedule,
             states,
         }
     }
@@ -88,27 +85,16 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
     /// stops.
     pub(super) fn run_until(&mut self, film: &mut Film, control: &Control, target: u32) {
         let width = film.width;
-        let batch = self.batch;
-        let total = if self.samples_per_pixel > 0 {
-            self.samples_per_pixel.min(target)
-        } else {
-            target
-        };
         let states = &mut self.states;
-        // The first pass takes one sample per pixel and always completes, so a render
-        // stopped at any moment still has a sample in every pixel.
-        while self.samples_taken < total && (self.samples_taken == 0 || !control.should_stop()) {
-            let first = self.samples_taken;
-            let end = if first == 0 {
-                1
-            } else {
-                first.saturating_add(batch).min(total)
-            };
+        while let Some(indices) = self.schedule.next_pass(target, control) {
+            let (first, end) = (indices.start, indices.end);
             film.par_bands(BAND_ROWS)
                 .zip(states.par_iter_mut())
                 .for_each(|(band, state)| {
                     state.splats.clear();
                     state.light_paths = 0;
+                    // After the first pass a stop skips the bands not yet begun: pixels
+                    // keep their own sample counts.
                     if first > 0 && control.should_stop() {
                         return;
                     }
@@ -119,20 +105,14 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                     {
                         let x = i as u32 % width;
                         let y = band.first_row + i as u32 / width;
-                        let pixel = y as u64 * width as u64 + x as u64;
                         let mut pixel_sum = Spectrum::ZERO;
-                        // The pixel's samples spread over it as a (0, 2)-sequence.
-                        let mut shift = Rng::new(self.seed, PIXEL_SHIFT_STREAM + pixel);
-                        let shift = [shift.next_u32(), shift.next_u32()];
-                        for sample in first..end {
-                            let mut rng = Rng::for_pixel_sample(self.seed, pixel, sample as u64);
-                            let [jx, jy] = shifted_sobol_2d(sample, shift);
+                        for mut sample in self.samples.of_pixel(x, y, first..end) {
                             let splats_before = state.splats.len();
                             let l = self.estimator.sample(
                                 &self.camera,
-                                x as f32 + jx,
-                                y as f32 + jy,
-                                &mut rng,
+                                sample.x,
+                                sample.y,
+                                &mut sample.rng,
                                 &mut counters,
                                 &mut state.scratch,
                                 &mut state.splats,
@@ -165,7 +145,6 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                     film.add_splats(&state.splats, state.light_paths);
                 }
             }
-            self.samples_taken = end;
         }
     }
 }

@@ -51,12 +51,13 @@ use super::{PathSpace, PathVertex};
 use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::{Bdpt, BdptScratch};
+use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
 use crate::integrators::mlt::primary_space::PathSample;
 use crate::integrators::{PixelEstimator, SampleCounters};
-use crate::sampling::{Rng, shifted_sobol_2d};
+use crate::sampling::Rng;
 use crate::scene::CameraModel;
 use crate::spectrum::Spectrum;
 use rayon::prelude::*;
@@ -429,49 +430,41 @@ pub(crate) fn run(
         },
         ..Default::default()
     };
-    // The first pass takes one sample per pixel, later ones up to `batch`. A pass always
-    // completes, so every pixel has the same number of camera samples and the splat
-    // normalization is exact; once the render stops, the rest of the pass only takes the
-    // BDPT samples and leaves their energy where it is (chains of length 0), which bounds
-    // how long a stop takes by one pass of camera samples.
-    let batch = (PASS_SAMPLES.div_ceil(pixels as u64)).clamp(1, 64) as u32;
-    let total = if settings.samples_per_pixel > 0 {
-        settings.samples_per_pixel
-    } else {
-        u32::MAX
+    // The schedule's first pass takes one sample per pixel, later ones up to a batch. A
+    // pass always completes here, so every pixel has the same number of camera samples and
+    // the splat normalization is exact; once the render stops, the rest of the pass only
+    // takes the BDPT samples and leaves their energy where it is (chains of length 0),
+    // which bounds how long a stop takes by one pass of camera samples.
+    let mut schedule = PassSchedule::new(settings.samples_per_pixel, pixels as u64, PASS_SAMPLES);
+    let samples = PixelSamples {
+        seed,
+        shift_stream: PIXEL_SHIFT_STREAM,
+        width,
     };
     let mut samples_taken = 0u64;
-    let mut first = 0u32;
-    while first < total && (first == 0 || !control.should_stop()) {
-        let end = if first == 0 {
-            1
-        } else {
-            first.saturating_add(batch).min(total)
-        };
+    while let Some(indices) = schedule.next_pass(u32::MAX, control) {
         units.par_iter_mut().enumerate().for_each(|(band, unit)| {
             let mut counters = SampleCounters::default();
             let (mut taken, mut mutations, mut accepted, mut invalid) = (0, 0, 0, 0);
             let first_row = band as u32 * BAND_ROWS;
             for y in first_row..(first_row + BAND_ROWS).min(height) {
                 for x in 0..width {
-                    let pixel = y as u64 * width as u64 + x as u64;
-                    let mut shift = Rng::new(seed, PIXEL_SHIFT_STREAM + pixel);
-                    let shift = [shift.next_u32(), shift.next_u32()];
-                    for sample in first..end {
-                        let [jx, jy] = shifted_sobol_2d(sample, shift);
-                        let mut rng = Rng::for_pixel_sample(seed, pixel, sample as u64);
+                    for mut sample in samples.of_pixel(x, y, indices.clone()) {
                         let buffer = if buffers > 1 {
-                            let mut hash =
-                                Rng::for_pixel_sample(seed ^ BUFFER_SALT, pixel, sample as u64);
+                            let mut hash = Rng::for_pixel_sample(
+                                seed ^ BUFFER_SALT,
+                                sample.pixel,
+                                sample.index as u64,
+                            );
                             hash.next_u32() as usize % buffers
                         } else {
                             0
                         };
                         let (m, a, valid) = redistributor.sample(
-                            x as f32 + jx,
-                            y as f32 + jy,
+                            sample.x,
+                            sample.y,
                             buffer,
-                            &mut rng,
+                            &mut sample.rng,
                             unit,
                             &mut counters,
                             control,
@@ -498,7 +491,6 @@ pub(crate) fn run(
             outcome.mutations += unit.mutations;
             outcome.accepted += unit.accepted;
         }
-        first = end;
     }
     for unit in &units {
         outcome.mutation_counts.add(&unit.counts);
