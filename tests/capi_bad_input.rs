@@ -1516,6 +1516,8 @@ fn bad_cameras() {
         c.up = [0.0, 0.0, 1.0] => ["camera.up", "parallel"],
         c.up = [0.0, 0.0, -3.0] => ["camera.up", "parallel"],
         c.up = [0.0; 3] => ["camera.up", "zero"],
+        c.up = [0.0, 1e-30, 0.0] => ["camera.up", "too short or too long"],
+        c.up = [0.0, 3e38, 3e38] => ["camera.up", "too short or too long"],
         c.fov_y_deg = 0.0 => ["camera.fov_y_deg is 0", "(0, 180)"],
         c.fov_y_deg = -0.0 => ["camera.fov_y_deg is -0"],
         c.fov_y_deg = 180.0 => ["camera.fov_y_deg is 180"],

@@ -72,8 +72,17 @@ impl Camera {
             )));
         }
         let up = Vec3A::from(self.up);
-        if up.length() == 0.0 {
+        if up == Vec3A::ZERO {
             return Err(Error::invalid("camera.up is the zero vector"));
+        }
+        // The camera frame is built in single precision: an up whose squared length
+        // underflows or overflows has no direction there.
+        let length_squared = up.length_squared();
+        if !(length_squared.is_finite() && length_squared >= f32::MIN_POSITIVE) {
+            return Err(Error::invalid(format!(
+                "camera.up {:?} is too short or too long to normalize in single precision; scale it towards unit length",
+                self.up
+            )));
         }
         let sin_angle = view.normalize().cross(up.normalize()).length();
         if sin_angle < 1e-4 {
@@ -81,6 +90,13 @@ impl Camera {
                 "camera.up {:?} is parallel to the view direction {:?}; the image orientation is undefined",
                 self.up,
                 view.normalize().to_array()
+            )));
+        }
+        // `model` crosses the unnormalized up with the view direction.
+        if !view.normalize().cross(up).normalize().is_finite() {
+            return Err(Error::invalid(format!(
+                "camera.up {:?} is too short for single precision at its angle to the view direction; scale it towards unit length",
+                self.up
             )));
         }
         if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
