@@ -15,17 +15,21 @@
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
 
+mod huge_pages;
+mod stack;
+
 use super::ray::{Hit, Ray};
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, Result};
 use glam::{BVec4A, Vec3A, Vec4};
+use huge_pages::in_huge_pages;
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
     bvh2::{Bvh2, builder::build_bvh2_from_tris},
     triangle::Triangle,
 };
+use stack::{STACK_SIZE, TraversalStack};
 use std::cell::Cell;
-use std::mem::MaybeUninit;
 use std::time::Duration;
 
 /// Triangles of a leaf block, and children of a 4-wide node.
@@ -36,11 +40,6 @@ const LEAF_BIT: u32 = 1 << 31;
 const TWO_BLOCKS_BIT: u32 = 1 << 30;
 /// The reference of an empty child slot (its box is empty, so it is never entered).
 const EMPTY: u32 = u32::MAX;
-/// Entries of the traversal stack. A query holds at most, summed over the nodes on one path
-/// from the root, each node's child count minus one (plus one for the root in occlusion
-/// queries); the build checks that its tree fits. The bench's scenes need 40-50 (4-wide) and
-/// 60-70 (8-wide).
-const STACK_SIZE: usize = 256;
 
 /// Children per node of the BVH.
 #[doc(hidden)]
@@ -232,45 +231,6 @@ fn intersect_block(
 const _: () = assert!(align_of::<Node4>() == 64 && size_of::<Node4>().is_multiple_of(64));
 const _: () =
     assert!(align_of::<TriangleBlock>() == 64 && size_of::<TriangleBlock>().is_multiple_of(64));
-
-/// Arrays from this size on are worth 2 MiB pages: the terrain of the traversal bench has
-/// 89 MB of them, and with 4 KiB pages its random rays miss the TLB on most nodes.
-const HUGE_PAGE_MIN_BYTES: usize = 4 << 20;
-const HUGE_PAGE_BYTES: usize = 2 << 20;
-
-/// `items` in an allocation of their own: for large arrays on Linux, one the kernel is asked
-/// to back with 2 MiB pages (transparent huge pages, which Debian and Ubuntu enable on
-/// request by default), as Embree does for its BVH. Random rays on the bench's terrain gained
-/// about 10% from it. Elsewhere, or if the kernel declines, the pages stay 4 KiB.
-fn in_huge_pages<T: Copy>(mut items: Vec<T>) -> Vec<T> {
-    let bytes = size_of_val(items.as_slice());
-    if !cfg!(target_os = "linux") || bytes < HUGE_PAGE_MIN_BYTES {
-        items.shrink_to_fit();
-        return items;
-    }
-    // Huge pages cover the copy but for its unaligned ends.
-    let mut copy = Vec::with_capacity(items.len());
-    #[cfg(target_os = "linux")]
-    {
-        let start = copy.as_ptr() as usize;
-        let first_page = start.next_multiple_of(HUGE_PAGE_BYTES);
-        let end_of_pages = (start + copy.capacity() * size_of::<T>()) & !(HUGE_PAGE_BYTES - 1);
-        if end_of_pages > first_page {
-            // SAFETY: advice about whole pages inside `copy`'s own allocation, which nothing
-            // else refers to; it changes how the kernel backs them, never their contents, and
-            // its failure (ignored) leaves them as they were.
-            unsafe {
-                libc::madvise(
-                    first_page as *mut libc::c_void,
-                    end_of_pages - first_page,
-                    libc::MADV_HUGEPAGE,
-                )
-            };
-        }
-    }
-    copy.extend_from_slice(&items);
-    copy
-}
 
 /// The first block of leaf `reference` and how many it has.
 #[inline(always)]
@@ -937,90 +897,6 @@ mod avx2 {
             }
             false
         }
-    }
-}
-
-/// The traversal stack. Its storage is left uninitialized: zeroing all `STACK_SIZE` entries
-/// for every ray cost about a tenth of a render's time on small scenes.
-struct TraversalStack<T: Copy> {
-    entries: [MaybeUninit<T>; STACK_SIZE],
-    len: usize,
-}
-
-impl<T: Copy> TraversalStack<T> {
-    #[inline(always)]
-    fn new() -> Self {
-        TraversalStack {
-            entries: [const { MaybeUninit::uninit() }; STACK_SIZE],
-            len: 0,
-        }
-    }
-
-    /// Panics (bounds check) past `STACK_SIZE`, which the build's depth limit rules out.
-    #[inline(always)]
-    fn push(&mut self, value: T) {
-        self.entries[self.len].write(value);
-        self.len += 1;
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<T> {
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        // SAFETY: every entry below the old `len` was written by `push`, and entries are
-        // only ever read below `len`.
-        Some(unsafe { self.entries[self.len].assume_init() })
-    }
-}
-
-impl TraversalStack<(u32, f32)> {
-    /// The children of a node that `mask` says the ray enters (at least one): returns the
-    /// nearest to go on with and pushes the others, farthest first, with their entry
-    /// distances. `prefetch` is called on each of them when there are several.
-    #[inline(always)]
-    fn descend<const N: usize>(
-        &mut self,
-        mut mask: u32,
-        children: &[u32; N],
-        t_near: &[f32; N],
-        prefetch: impl Fn(u32),
-    ) -> u32 {
-        if mask & (mask - 1) == 0 {
-            return children[mask.trailing_zeros() as usize];
-        }
-        let mut hits = [(0u32, 0f32); N];
-        let mut count = 0;
-        while mask != 0 {
-            let slot = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            let entry = (children[slot], t_near[slot]);
-            prefetch(entry.0);
-            // Insertion sort, nearest last.
-            let mut at = count;
-            while at > 0 && hits[at - 1].1 < entry.1 {
-                hits[at] = hits[at - 1];
-                at -= 1;
-            }
-            hits[at] = entry;
-            count += 1;
-        }
-        for &entry in &hits[..count - 1] {
-            self.push(entry);
-        }
-        hits[count - 1].0
-    }
-
-    /// The nearest pushed reference whose entry distance the ray can still reach.
-    #[inline(always)]
-    fn pop_within(&mut self, tmax: f32) -> Option<u32> {
-        while let Some((reference, t_near)) = self.pop() {
-            if t_near <= tmax {
-                return Some(reference);
-            }
-        }
-        None
     }
 }
 
