@@ -6,29 +6,40 @@
 //! ourselves, nearest child first. A leaf is one block, or two consecutive ones in the 8-wide tree.
 //!
 //! The width is picked at build time from the CPU: on x86-64 with AVX2 and FMA, eight children
-//! per node, whose boxes are tested with one AVX instruction per slab (`mod avx2`); elsewhere
-//! four, tested with SSE (or NEON) through glam's `Vec4`. Leaf blocks are tested with `Vec4`
-//! in both. Tests and benches can force the 4-wide tree with [`with_bvh_width`]. On the
-//! traversal bench (1 thread, closest hit) the 8-wide tree traces 1.3-1.6x the 4-wide's rays,
-//! 0.78-0.99x Embree 3's; its build takes the same time.
+//! per node, whose boxes are tested with one AVX instruction per slab; elsewhere four, tested
+//! with SSE (or NEON) through glam's `Vec4`. Leaf blocks are tested with `Vec4` in both. Tests
+//! and benches can force the 4-wide tree with [`with_bvh_width`]. On the traversal bench
+//! (1 thread, closest hit) the 8-wide tree traces 1.3-1.6x the 4-wide's rays, 0.78-0.99x
+//! Embree 3's; its build takes the same time.
 //!
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
+//!
+//! The files, each depending only on those listed after it:
+//! - `mod.rs`: [`BvhAccel`], the choice of width and the dispatch of each query to the tree's;
+//! - `build.rs`: obvhs's binary tree collapsed to a wide one, generic over the width;
+//! - `traversal.rs`: the closest-hit and occlusion traversals, one body each for both widths,
+//!   and their entry points per width (the 8-wide ones compiled with AVX2 and FMA);
+//! - `simd4.rs`, `avx2.rs`: the box tests of a 4-wide node (`Vec4`) and an 8-wide node (AVX2);
+//! - `layout.rs`: nodes, leaf blocks, the references between them and the tree's arrays;
+//! - `stack.rs`: the traversal stack;
+//! - `huge_pages.rs`: large arrays in 2 MiB pages.
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 mod build;
 mod huge_pages;
 mod layout;
+mod simd4;
 mod stack;
+mod traversal;
 
 use super::ray::{Hit, Ray};
 use crate::error::Result;
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::Vec3A;
 #[cfg(target_arch = "x86_64")]
 use layout::Node8;
-use layout::{
-    EMPTY, LEAF_BIT, Node4, TriangleBlock, WideNode, WideTree, leaf_span, near_and_far_bounds,
-};
-use stack::TraversalStack;
+use layout::{EMPTY, Node4, WideTree};
 use std::cell::Cell;
 
 /// Children per node of the BVH.
@@ -78,85 +89,6 @@ pub fn with_bvh_width<R>(width: BvhWidth, f: impl FnOnce() -> R) -> R {
     }
     let _restore = Restore(FORCED_WIDTH.replace(Some(width)));
     f()
-}
-
-/// A ray prepared for the box test: which bound is near on each axis, the origin and the
-/// reciprocal direction.
-///
-/// A zero direction component gives an infinite reciprocal, and the slab (bound − o) · inv is
-/// then ±inf (the ray is inside or outside the slab forever) or, for an origin exactly on the
-/// bound, NaN. The slabs are combined with the running value as the *second* operand of
-/// `max`/`min`, which SSE's maxps/minps (and `f32::max`) return when the first is NaN: a NaN
-/// slab then leaves the interval unconstrained, as a ray lying in the slab's plane should.
-struct BoxRay {
-    near: [usize; 3],
-    far: [usize; 3],
-    origin: [Vec4; 3],
-    inv_direction: [Vec4; 3],
-}
-
-impl BoxRay {
-    #[inline(always)]
-    fn new(ray: &Ray) -> Self {
-        let inv = Vec3A::ONE / ray.direction;
-        let (near, far) = near_and_far_bounds(inv);
-        BoxRay {
-            near,
-            far,
-            origin: splat3(ray.origin),
-            inv_direction: splat3(inv),
-        }
-    }
-
-    /// Entry distances of the four children and which of them the ray enters in [tmin, tmax].
-    #[inline(always)]
-    fn intersect(&self, node: &Node4, tmin: f32, tmax: f32) -> (Vec4, u32) {
-        let slab = |bound: usize, axis: usize| {
-            (node.bounds[bound] - self.origin[axis]) * self.inv_direction[axis]
-        };
-        let t_near = slab(self.near[2], 2)
-            .max(slab(self.near[1], 1).max(slab(self.near[0], 0).max(Vec4::splat(tmin))));
-        let t_far = slab(self.far[2], 2)
-            .min(slab(self.far[1], 1).min(slab(self.far[0], 0).min(Vec4::splat(tmax))));
-        (t_near, t_near.cmple(t_far).bitmask())
-    }
-}
-
-/// The ray against four triangles: (t, u, v) per lane and the lanes hit within [tmin, tmax].
-#[inline(always)]
-fn intersect_block(
-    block: &TriangleBlock,
-    origin: &[Vec4; 3],
-    direction: &[Vec4; 3],
-    tmin: f32,
-    tmax: f32,
-) -> (Vec4, Vec4, Vec4, BVec4A) {
-    let dot = |a: &[Vec4; 3], b: &[Vec4; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let c = [
-        block.v0[0] - origin[0],
-        block.v0[1] - origin[1],
-        block.v0[2] - origin[2],
-    ];
-    let r = [
-        direction[1] * c[2] - direction[2] * c[1],
-        direction[2] * c[0] - direction[0] * c[2],
-        direction[0] * c[1] - direction[1] * c[0],
-    ];
-    let inv_det = Vec4::ONE / dot(&block.ng, direction);
-    let u = dot(&r, &block.e2) * inv_det;
-    let v = dot(&r, &block.e1) * inv_det;
-    let t = dot(&block.ng, &c) * inv_det;
-    // Comparisons written so NaN (a zero lane, or det = 0) fails them all.
-    let hit = u.cmpge(Vec4::ZERO)
-        & v.cmpge(Vec4::ZERO)
-        & (u + v).cmple(Vec4::ONE)
-        & t.cmpge(Vec4::splat(tmin))
-        & t.cmple(Vec4::splat(tmax));
-    (t, u, v, hit)
-}
-
-fn splat3(v: Vec3A) -> [Vec4; 3] {
-    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
 }
 
 /// The tree, at the width it was built.
@@ -249,316 +181,22 @@ impl BvhAccel {
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         match &self.tree {
-            Tree::Four(tree) => intersect4(tree, ray),
+            Tree::Four(tree) => traversal::intersect4(tree, ray),
             // SAFETY: `Tree::Eight` is only built on CPUs with AVX2 and FMA
             // (`build_with_width`), which `intersect8` needs.
             #[cfg(target_arch = "x86_64")]
-            Tree::Eight(tree) => unsafe { avx2::intersect8(tree, ray) },
+            Tree::Eight(tree) => unsafe { traversal::intersect8(tree, ray) },
         }
     }
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         match &self.tree {
-            Tree::Four(tree) => occluded4(tree, ray),
+            Tree::Four(tree) => traversal::occluded4(tree, ray),
             // SAFETY: as in `intersect`.
             #[cfg(target_arch = "x86_64")]
-            Tree::Eight(tree) => unsafe { avx2::occluded8(tree, ray) },
+            Tree::Eight(tree) => unsafe { traversal::occluded8(tree, ray) },
         }
-    }
-}
-
-impl<N> WideTree<N> {
-    /// Tests leaf block `reference` and narrows `tmax` to its closest hit in [tmin, tmax].
-    #[inline(always)]
-    fn intersect_leaf(
-        &self,
-        reference: u32,
-        origin: &[Vec4; 3],
-        direction: &[Vec4; 3],
-        tmin: f32,
-        tmax: &mut f32,
-        best: &mut Option<Hit>,
-    ) {
-        let (index, blocks) = self.leaf_blocks(reference);
-        for (block, &first) in blocks.iter().zip(&self.block_first[index..]) {
-            let (t, u, v, hit) = intersect_block(block, origin, direction, tmin, *tmax);
-            let mut mask = hit.bitmask();
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if t[lane] <= *tmax {
-                    *tmax = t[lane];
-                    *best = Some(Hit {
-                        triangle: first + lane as u32,
-                        t: t[lane],
-                        u: u[lane],
-                        v: v[lane],
-                    });
-                }
-            }
-        }
-    }
-
-    /// The blocks of leaf `reference`, and the index of the first.
-    #[inline(always)]
-    fn leaf_blocks(&self, reference: u32) -> (usize, &[TriangleBlock]) {
-        let (first, count) = leaf_span(reference);
-        (first, &self.blocks[first..first + count])
-    }
-
-    /// Starts loading child `reference` of a node (a node or a leaf's blocks) from memory.
-    ///
-    /// Traversals call it for every child a ray enters, as they sort or push them: the ray
-    /// goes on with one, and the siblings it visits afterwards are then already on their way
-    /// instead of each waiting for memory in turn. On the 1.2M-triangle terrain of the
-    /// traversal bench (87 MB, beyond the caches) random rays spent about half their time
-    /// stalled on the first load of a node or block; this bought +15% on closest-hit and
-    /// +20% on occlusion rays there. Scenes that fit in cache lose nothing measurable.
-    #[inline(always)]
-    fn prefetch(&self, reference: u32) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            // Pointer arithmetic that cannot fault: a prefetch of any address is harmless,
-            // and the build only stores references inside the arrays.
-            let (start, bytes) = if reference & LEAF_BIT == 0 {
-                let node = self.nodes.as_ptr().wrapping_add(reference as usize);
-                (node.cast::<i8>(), size_of::<N>())
-            } else {
-                let (first, count) = leaf_span(reference);
-                let block = self.blocks.as_ptr().wrapping_add(first);
-                (block.cast::<i8>(), count * size_of::<TriangleBlock>())
-            };
-            // Nodes and blocks are 64-byte aligned and sized (asserted at compile time), so these are
-            // their lines.
-            for offset in (0..bytes).step_by(64) {
-                // SAFETY: a prefetch is a hint that never faults or changes memory; SSE,
-                // which it needs, is part of x86-64.
-                unsafe { _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset)) };
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = reference;
-    }
-
-    /// Whether leaf block `reference` has a hit in [tmin, tmax].
-    #[inline(always)]
-    fn leaf_blocked(
-        &self,
-        reference: u32,
-        origin: &[Vec4; 3],
-        direction: &[Vec4; 3],
-        tmin: f32,
-        tmax: f32,
-    ) -> bool {
-        self.leaf_blocks(reference).1.iter().any(|block| {
-            intersect_block(block, origin, direction, tmin, tmax)
-                .3
-                .any()
-        })
-    }
-}
-
-#[inline(always)]
-fn intersect4(tree: &WideTree<Node4>, ray: &Ray) -> Option<Hit> {
-    if tree.root == EMPTY {
-        return None;
-    }
-    let box_ray = BoxRay::new(ray);
-    let origin = splat3(ray.origin);
-    let direction = splat3(ray.direction);
-    let mut tmax = ray.tmax;
-    let mut best: Option<Hit> = None;
-    let mut stack = TraversalStack::<(u32, f32)>::new();
-    let mut current = tree.root;
-    loop {
-        if current & LEAF_BIT == 0 {
-            let node = &tree.nodes[current as usize];
-            let (t_near, mask) = box_ray.intersect(node, ray.tmin, tmax);
-            if mask != 0 {
-                current = stack.descend(mask, node.children(), &t_near.to_array(), |child| {
-                    tree.prefetch(child)
-                });
-                continue;
-            }
-        } else {
-            tree.intersect_leaf(current, &origin, &direction, ray.tmin, &mut tmax, &mut best);
-        }
-        match stack.pop_within(tmax) {
-            Some(next) => current = next,
-            None => return best,
-        }
-    }
-}
-
-#[inline(always)]
-fn occluded4(tree: &WideTree<Node4>, ray: &Ray) -> bool {
-    if tree.root == EMPTY {
-        return false;
-    }
-    let box_ray = BoxRay::new(ray);
-    let origin = splat3(ray.origin);
-    let direction = splat3(ray.direction);
-    let mut stack = TraversalStack::<u32>::new();
-    stack.push(tree.root);
-    while let Some(current) = stack.pop() {
-        if current & LEAF_BIT == 0 {
-            let node = &tree.nodes[current as usize];
-            let (_, mut mask) = box_ray.intersect(node, ray.tmin, ray.tmax);
-            while mask != 0 {
-                let slot = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                tree.prefetch(node.children()[slot]);
-                stack.push(node.children()[slot]);
-            }
-        } else if tree.leaf_blocked(current, &origin, &direction, ray.tmin, ray.tmax) {
-            return true;
-        }
-    }
-    false
-}
-
-/// The 8-wide tree, tested with AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::*;
-    use std::arch::x86_64::*;
-
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn load(row: &[f32; 8]) -> __m256 {
-        // SAFETY: reads the eight floats `row` refers to (unaligned load, no alignment needed).
-        unsafe { _mm256_loadu_ps(row.as_ptr()) }
-    }
-
-    #[inline]
-    #[target_feature(enable = "avx2,fma")]
-    fn lanes(v: __m256) -> [f32; 8] {
-        // SAFETY: both are 32 bytes of eight f32, and every bit pattern is a valid f32.
-        unsafe { std::mem::transmute::<__m256, [f32; 8]>(v) }
-    }
-
-    /// `BoxRay` for eight boxes, with each slab computed as one fused bound · inv − origin · inv.
-    ///
-    /// For a zero direction component (inv = ±inf) the fused form gives the slab's ±inf only
-    /// when the bound and the origin have opposite signs, and NaN otherwise (inf − inf, or
-    /// 0 · inf). NaN slabs leave the interval unconstrained, as in `BoxRay`: such a ray is
-    /// culled by the other two axes only, never wrongly. A direction of all zeros would leave
-    /// empty slots unculled, so such rays are answered before the traversal.
-    struct BoxRay8 {
-        near: [usize; 3],
-        far: [usize; 3],
-        inv_direction: [__m256; 3],
-        origin_inv: [__m256; 3],
-    }
-
-    impl BoxRay8 {
-        #[inline]
-        #[target_feature(enable = "avx2,fma")]
-        fn new(ray: &Ray) -> Self {
-            let inv = Vec3A::ONE / ray.direction;
-            let origin_inv = ray.origin * inv;
-            let (near, far) = near_and_far_bounds(inv);
-            BoxRay8 {
-                near,
-                far,
-                inv_direction: inv.to_array().map(|v| _mm256_set1_ps(v)),
-                origin_inv: origin_inv.to_array().map(|v| _mm256_set1_ps(v)),
-            }
-        }
-
-        /// Entry distances of the eight children and which of them the ray enters in
-        /// [tmin, tmax]. The running value is the second operand of max/min, which vmaxps and
-        /// vminps return when the first is NaN.
-        #[inline]
-        #[target_feature(enable = "avx2,fma")]
-        fn intersect(&self, node: &Node8, tmin: __m256, tmax: __m256) -> (__m256, u32) {
-            let slab = |bound: usize, axis: usize| {
-                _mm256_fmsub_ps(
-                    load(&node.bounds[bound]),
-                    self.inv_direction[axis],
-                    self.origin_inv[axis],
-                )
-            };
-            let t_near = _mm256_max_ps(
-                slab(self.near[2], 2),
-                _mm256_max_ps(
-                    slab(self.near[1], 1),
-                    _mm256_max_ps(slab(self.near[0], 0), tmin),
-                ),
-            );
-            let t_far = _mm256_min_ps(
-                slab(self.far[2], 2),
-                _mm256_min_ps(
-                    slab(self.far[1], 1),
-                    _mm256_min_ps(slab(self.far[0], 0), tmax),
-                ),
-            );
-            let entered = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far);
-            (t_near, _mm256_movemask_ps(entered) as u32)
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub(super) fn intersect8(tree: &WideTree<Node8>, ray: &Ray) -> Option<Hit> {
-        if tree.root == EMPTY || ray.direction == Vec3A::ZERO {
-            return None;
-        }
-        let box_ray = BoxRay8::new(ray);
-        let tmin = _mm256_set1_ps(ray.tmin);
-        let origin = splat3(ray.origin);
-        let direction = splat3(ray.direction);
-        let mut tmax = ray.tmax;
-        let mut best: Option<Hit> = None;
-        let mut stack = TraversalStack::<(u32, f32)>::new();
-        let mut current = tree.root;
-        loop {
-            if current & LEAF_BIT == 0 {
-                let node = &tree.nodes[current as usize];
-                let (t_near, mask) = box_ray.intersect(node, tmin, _mm256_set1_ps(tmax));
-                if mask != 0 {
-                    current = stack.descend(mask, node.children(), &lanes(t_near), |child| {
-                        tree.prefetch(child)
-                    });
-                    continue;
-                }
-            } else {
-                tree.intersect_leaf(current, &origin, &direction, ray.tmin, &mut tmax, &mut best);
-            }
-            match stack.pop_within(tmax) {
-                Some(next) => current = next,
-                None => return best,
-            }
-        }
-    }
-
-    #[target_feature(enable = "avx2,fma")]
-    pub(super) fn occluded8(tree: &WideTree<Node8>, ray: &Ray) -> bool {
-        if tree.root == EMPTY || ray.direction == Vec3A::ZERO {
-            return false;
-        }
-        let box_ray = BoxRay8::new(ray);
-        let (tmin, tmax) = (_mm256_set1_ps(ray.tmin), _mm256_set1_ps(ray.tmax));
-        let origin = splat3(ray.origin);
-        let direction = splat3(ray.direction);
-        let mut stack = TraversalStack::<u32>::new();
-        stack.push(tree.root);
-        while let Some(current) = stack.pop() {
-            if current & LEAF_BIT == 0 {
-                let node = &tree.nodes[current as usize];
-                let (_, mut mask) = box_ray.intersect(node, tmin, tmax);
-                while mask != 0 {
-                    let slot = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    tree.prefetch(node.children()[slot]);
-                    stack.push(node.children()[slot]);
-                }
-            } else if tree.leaf_blocked(current, &origin, &direction, ray.tmin, ray.tmax) {
-                return true;
-            }
-        }
-        false
     }
 }
 
@@ -566,7 +204,7 @@ mod avx2 {
 mod tests {
     use super::*;
     use crate::sampling::Rng;
-    use layout::TWO_BLOCKS_BIT;
+    use layout::{LEAF_BIT, TWO_BLOCKS_BIT, WideNode};
 
     fn random_point(rng: &mut Rng) -> Vec3A {
         Vec3A::new(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0 - 5.0

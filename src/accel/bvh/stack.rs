@@ -1,8 +1,16 @@
 //! The traversal stack: references still to visit, kept in a fixed array on the query's own
 //! stack frame, with the closest-hit query's ordering of a node's children (`descend`) and its
-//! skipping of those beyond the closest hit so far (`pop_within`).
+//! skipping of those beyond the closest hit so far (`pop_within`); and `Lanes`, the entry
+//! distances `descend` orders by, as each width's box test gives them.
 
 use std::mem::MaybeUninit;
+
+/// A node's entry distances as its box test leaves them, in a vector register. `descend`
+/// stores them as an array only for nodes where the ray enters several children, not for
+/// every node tested.
+pub(super) trait Lanes<const N: usize>: Copy {
+    fn lanes(self) -> [f32; N];
+}
 
 /// Entries of the traversal stack. A query holds at most, summed over the nodes on one path
 /// from the root, each node's child count minus one (plus one for the root in occlusion
@@ -54,12 +62,13 @@ impl TraversalStack<(u32, f32)> {
         &mut self,
         mut mask: u32,
         children: &[u32; N],
-        t_near: &[f32; N],
+        t_near: impl Lanes<N>,
         prefetch: impl Fn(u32),
     ) -> u32 {
         if mask & (mask - 1) == 0 {
             return children[mask.trailing_zeros() as usize];
         }
+        let t_near = t_near.lanes();
         let mut hits = [(0u32, 0f32); N];
         let mut count = 0;
         while mask != 0 {
