@@ -111,7 +111,9 @@ impl PathTracer<'_> {
 
     /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
     /// against BSDF sampling. Returns the contribution before the path throughput.
-    #[inline]
+    // Always inlined: called once per vertex, and as a call it costs ~1.5% more
+    // instructions (the compiler stopped inlining it once it took a `Bsdf`).
+    #[inline(always)]
     fn sample_light(
         &self,
         p: Vec3A,
