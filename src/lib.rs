@@ -33,6 +33,7 @@ pub mod error;
 pub mod film;
 pub mod filter;
 pub mod integrators;
+mod interaction;
 pub mod render;
 pub mod sampling;
 pub mod scene;

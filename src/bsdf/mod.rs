@@ -1,7 +1,12 @@
 //! Scattering at a surface: sampling and evaluating each material's BSDF.
 //!
 //! Directions point away from the surface: `wo` towards where the path came from, `wi` the
-//! new direction. `normal` is the triangle's front (counter-clockwise) geometric normal.
+//! new direction. `normal` is the normal of the shading frame, which today is the triangle's
+//! front (counter-clockwise) geometric normal.
+//!
+//! Integrators use [`Bsdf`], a material evaluated at a surface point (built by
+//! `interaction.rs`), and ask it for its [`BsdfLobes`] instead of matching on the material's
+//! kind; the free functions below are its arithmetic, one `match` per operation.
 
 mod dielectric;
 mod scattering;
@@ -14,6 +19,120 @@ use crate::scene::{Material, MaterialKind};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
+
+/// The classes of lobes a BSDF has: what integrators decide by, so a new material only has
+/// to report its lobes here.
+///
+/// - Diffuse and glossy lobes have a density over directions: a connection (next-event
+///   estimation, a BDPT or bidirectional-mutation connection) can end at them, and in Veach's
+///   path classification (`D`/`S`) both are `D`. No material has a glossy lobe yet.
+/// - A specular lobe is a Dirac delta: only sampling the BSDF can follow it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct BsdfLobes(u8);
+
+// The constants are `pub(crate)`, not `pub`: cbindgen exports `pub` associated constants
+// to include/mlt.h whatever the type's visibility.
+impl BsdfLobes {
+    pub(crate) const DIFFUSE: BsdfLobes = BsdfLobes(1);
+    pub(crate) const GLOSSY: BsdfLobes = BsdfLobes(2);
+    pub(crate) const SPECULAR: BsdfLobes = BsdfLobes(4);
+
+    /// The lobes of `material`.
+    #[inline]
+    pub fn of(material: &Material) -> BsdfLobes {
+        match material.kind {
+            MaterialKind::Diffuse => BsdfLobes::DIFFUSE,
+            MaterialKind::Mirror | MaterialKind::Dielectric => BsdfLobes::SPECULAR,
+        }
+    }
+
+    /// Whether all of `other`'s lobes are among these.
+    #[inline]
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub fn contains(self, other: BsdfLobes) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Whether some lobe has a density over directions (diffuse or glossy): then a
+    /// connection can end here, and Veach's classification calls the vertex `D`.
+    #[inline]
+    pub fn has_non_specular(self) -> bool {
+        self.0 & (BsdfLobes::DIFFUSE.0 | BsdfLobes::GLOSSY.0) != 0
+    }
+
+    /// Whether every lobe is a Dirac delta: no connection can end here (Veach's `S`).
+    #[inline]
+    pub fn is_specular(self) -> bool {
+        !self.has_non_specular()
+    }
+}
+
+impl std::ops::BitOr for BsdfLobes {
+    type Output = BsdfLobes;
+    #[inline]
+    fn bitor(self, other: BsdfLobes) -> BsdfLobes {
+        BsdfLobes(self.0 | other.0)
+    }
+}
+
+/// A material's BSDF at a surface point: the material and the shading frame's normal.
+/// Small and `Copy`; its methods are the free functions of this module, so the arithmetic
+/// is theirs.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bsdf<'a> {
+    material: &'a Material,
+    /// Normal of the shading frame (today the geometric normal).
+    normal: Vec3A,
+}
+
+impl<'a> Bsdf<'a> {
+    #[inline]
+    pub fn new(material: &'a Material, normal: Vec3A) -> Self {
+        Bsdf { material, normal }
+    }
+
+    /// The classes of its lobes.
+    #[inline]
+    pub fn lobes(&self) -> BsdfLobes {
+        BsdfLobes::of(self.material)
+    }
+
+    /// See [`sample`].
+    #[inline]
+    pub fn sample(
+        &self,
+        wo: Vec3A,
+        u: [f32; 2],
+        u_lobe: f32,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        sample(self.material, self.normal, wo, u, u_lobe, mode)
+    }
+
+    /// See [`eval`].
+    #[inline]
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> Spectrum {
+        eval(self.material, self.normal, wo, wi)
+    }
+
+    /// See [`pdf`].
+    #[inline]
+    pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        pdf(self.material, self.normal, wo, wi)
+    }
+
+    /// See [`scatter`].
+    #[inline]
+    pub fn scatter(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Option<ScatterSample> {
+        scatter(self.material, self.normal, wo, wi, mode)
+    }
+
+    /// See [`specular_direction`].
+    #[inline]
+    pub fn specular_direction(&self, wo: Vec3A, lobe: SpecularLobe) -> Option<Vec3A> {
+        specular_direction(self.material, self.normal, wo, lobe)
+    }
+}
 
 /// Samples a direction `wi` given `wo`. `u` picks the direction, `u_lobe` the lobe.
 #[inline]
@@ -162,6 +281,23 @@ pub fn specular_direction(
 mod tests {
     use super::*;
     use crate::sampling::Rng;
+
+    /// Today's materials: diffuse is connectible (D), mirror and glass are Dirac (S); a
+    /// glossy lobe counts as non-specular, alone or next to a specular one.
+    #[test]
+    fn lobes_classify_materials() {
+        let diffuse = BsdfLobes::of(&Material::diffuse([0.5; 3]));
+        assert!(diffuse.has_non_specular() && !diffuse.is_specular());
+        assert!(diffuse.contains(BsdfLobes::DIFFUSE));
+        for m in [Material::mirror([1.0; 3]), Material::dielectric(1.5)] {
+            let lobes = BsdfLobes::of(&m);
+            assert!(lobes.is_specular() && !lobes.has_non_specular());
+            assert!(lobes.contains(BsdfLobes::SPECULAR));
+        }
+        assert!(BsdfLobes::GLOSSY.has_non_specular());
+        let coated = BsdfLobes::GLOSSY | BsdfLobes::SPECULAR;
+        assert!(coated.has_non_specular() && coated.contains(BsdfLobes::SPECULAR));
+    }
 
     /// Energy conservation and reciprocity-style check: the albedo estimated by sampling
     /// equals the material's color for diffuse, and the pdf matches eval/cos for diffuse.

@@ -14,10 +14,11 @@
 //! of both directions exact for MIS.
 
 use super::{PathVertex, PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
-use crate::bsdf::{self, TransportMode};
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
-use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere, uniform_triangle};
-use crate::scene::{CameraModel, MaterialKind, Scene};
+use crate::interaction::{SurfaceInteraction, vertex_bsdf};
+use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere};
+use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
@@ -55,7 +56,8 @@ struct Vertex {
     pdf_reverse: f32,
     /// Internal triangle index (surfaces and lights).
     triangle: u32,
-    /// Scattering here is a Dirac delta (mirror, glass).
+    /// Scattering here is a Dirac delta (mirror, glass): no connection can end here. A
+    /// surface's BSDF with a diffuse or glossy lobe is connectible.
     specular: bool,
 }
 
@@ -104,18 +106,17 @@ fn to_area(pdf_solid_angle: f32, from: &Vertex, to: &Vertex) -> f32 {
 }
 
 impl Bdpt<'_> {
+    /// The BSDF of a surface vertex.
     #[inline]
-    fn material(&self, v: &Vertex) -> &crate::scene::Material {
-        let shading = &self.scene.shading[v.triangle as usize];
-        &self.scene.materials[shading.material as usize]
+    fn bsdf(&self, v: &Vertex) -> Bsdf<'_> {
+        vertex_bsdf(self.scene, v.triangle, v.normal)
     }
 
     /// Radiance a surface vertex emits towards direction `w` (front side only).
     #[inline]
     fn emitted(&self, v: &Vertex, w: Vec3A) -> Spectrum {
-        let shading = &self.scene.shading[v.triangle as usize];
-        if shading.light_area_pdf > 0.0 && w.dot(v.normal) > 0.0 {
-            Spectrum::from(self.scene.materials[shading.material as usize].emission)
+        if self.scene.light_area_pdf(v.triangle) > 0.0 && w.dot(v.normal) > 0.0 {
+            self.scene.emission(v.triangle)
         } else {
             Spectrum::ZERO
         }
@@ -138,7 +139,7 @@ impl Bdpt<'_> {
                     Some(prev) => (prev.p - v.p).normalize(),
                     None => v.wo,
                 };
-                bsdf::pdf(self.material(v), v.normal, wp, wn)
+                self.bsdf(v).pdf(wp, wn)
             }
         };
         to_area(pdf_solid_angle, v, next)
@@ -159,7 +160,7 @@ impl Bdpt<'_> {
     /// Area density of sampling `v` (on an emitter) as a light subpath's first vertex.
     #[inline]
     fn pdf_light_origin(&self, v: &Vertex) -> f32 {
-        self.scene.shading[v.triangle as usize].light_area_pdf
+        self.scene.light_area_pdf(v.triangle)
     }
 
     /// Extends `path` (whose last vertex is the subpath's start) by a random walk; returns
@@ -182,19 +183,19 @@ impl Bdpt<'_> {
             let Some(hit) = self.scene.accel.intersect(&ray) else {
                 break;
             };
-            let shading = &self.scene.shading[hit.triangle as usize];
-            let material = &self.scene.materials[shading.material as usize];
+            let si = SurfaceInteraction::new(self.scene, &ray, &hit);
+            let bsdf = si.bsdf(self.scene);
             let mut vertex = Vertex {
                 kind: VertexKind::Surface,
-                p: ray.origin + ray.direction * hit.t,
-                normal: shading.normal,
+                p: si.p,
+                normal: si.geometric_normal,
                 wo: -ray.direction,
                 beta,
                 pdf_forward: 0.0,
                 pdf_reverse: 0.0,
-                triangle: hit.triangle,
-                // Known from the material, so a subpath cut short here is marked too.
-                specular: material.kind != MaterialKind::Diffuse,
+                triangle: si.triangle,
+                // Known from the BSDF's lobes, so a subpath cut short here is marked too.
+                specular: bsdf.lobes().is_specular(),
             };
             vertex.pdf_forward = to_area(pdf_solid_angle, &path[count - 1], &vertex);
             path[count] = vertex;
@@ -202,14 +203,8 @@ impl Bdpt<'_> {
             if count >= max_vertices {
                 break;
             }
-            let Some(sample) = bsdf::sample(
-                material,
-                vertex.normal,
-                vertex.wo,
-                sampler.uniform2(),
-                sampler.uniform(),
-                mode,
-            ) else {
+            let Some(sample) = bsdf.sample(vertex.wo, sampler.uniform2(), sampler.uniform(), mode)
+            else {
                 break;
             };
             let index = count - 1;
@@ -220,7 +215,7 @@ impl Bdpt<'_> {
                 reverse_solid_angle = 0.0;
             } else {
                 pdf_solid_angle = sample.pdf;
-                reverse_solid_angle = bsdf::pdf(material, vertex.normal, sample.wi, vertex.wo);
+                reverse_solid_angle = bsdf.pdf(sample.wi, vertex.wo);
             }
             beta *= sample.weight;
             if beta.is_black() {
@@ -277,13 +272,13 @@ impl Bdpt<'_> {
         let u_select = sampler.uniform();
         let u_point = sampler.uniform2();
         let u_direction = sampler.uniform2();
-        if self.scene.lights.is_empty() || max_vertices == 0 {
+        if max_vertices == 0 {
             return 0;
         }
-        let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
-        let light = &self.scene.lights[index];
-        let [b1, b2] = uniform_triangle(u_point);
-        let p = light.v0 + light.edge1 * b1 + light.edge2 * b2;
+        let Some(light) = self.scene.sample_light(u_select, u_point) else {
+            return 0;
+        };
+        let p = light.point;
         let local = cosine_hemisphere(u_direction);
         let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
         let pdf_direction = local.z * FRAC_1_PI;
@@ -405,7 +400,7 @@ impl Bdpt<'_> {
         if length == 0.0 {
             return Spectrum::ZERO;
         }
-        bsdf::eval(self.material(v), v.normal, v.wo, w / length)
+        self.bsdf(v).eval(v.wo, w / length)
     }
 
     /// Whether nothing blocks the segment between two vertices.
@@ -623,12 +618,10 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let (index, _, _) = self.scene.light_distribution.sample_discrete(u_select);
-            let l = &self.scene.lights[index];
-            let [b1, b2] = uniform_triangle(u_point);
+            let l = self.scene.sample_light(u_select, u_point)?;
             let sampled = Vertex {
                 kind: VertexKind::Light,
-                p: l.v0 + l.edge1 * b1 + l.edge2 * b2,
+                p: l.point,
                 normal: l.normal,
                 beta: l.emission / l.area_pdf,
                 pdf_forward: l.area_pdf,

@@ -7,6 +7,7 @@ pub mod path;
 
 use crate::accel::Ray;
 use crate::film::Splat;
+use crate::interaction::SurfaceInteraction;
 use crate::sampling::Rng;
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
@@ -21,6 +22,19 @@ pub(crate) struct PathVertex {
     pub normal: Vec3A,
     /// Internal triangle index (unused for the lens).
     pub triangle: u32,
+}
+
+impl PathVertex {
+    /// The vertex at a surface interaction. It keeps the geometric normal, which is also
+    /// the shading normal today (see `interaction::vertex_bsdf`).
+    #[inline]
+    pub fn surface(si: &SurfaceInteraction) -> PathVertex {
+        PathVertex {
+            p: si.p,
+            normal: si.geometric_normal,
+            triangle: si.triangle,
+        }
+    }
 }
 
 /// Counters a sample updates; summed per work unit.

@@ -1,9 +1,11 @@
 //! The validated, immutable scene: geometry in the backend's order, materials, area lights.
 
 mod camera;
+mod lights;
 mod material;
 
 pub use camera::{Camera, CameraModel};
+pub use lights::AreaLight;
 pub use material::{Material, MaterialKind};
 
 use crate::accel::{Accel, Backend, Hit, Ray};
@@ -47,20 +49,6 @@ pub struct TriangleShading {
     /// Probability density per unit area of picking a point on this triangle by light
     /// sampling (selection probability / area); 0 for non-emitters.
     pub light_area_pdf: f32,
-}
-
-/// What light sampling needs about one area light.
-#[derive(Clone, Copy, Debug)]
-pub struct AreaLight {
-    pub v0: Vec3A,
-    pub edge1: Vec3A,
-    pub edge2: Vec3A,
-    pub normal: Vec3A,
-    pub emission: Spectrum,
-    /// Selection probability / area: the area density of light sampling on this light.
-    pub area_pdf: f32,
-    /// Internal index of the light's triangle.
-    pub triangle: u32,
 }
 
 pub struct Scene {

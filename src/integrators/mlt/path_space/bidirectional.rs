@@ -39,9 +39,9 @@
 
 use super::{PathSpace, PathVertex};
 use crate::accel::Ray;
-use crate::bsdf::{self, TransportMode};
+use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
-use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_triangle};
+use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
@@ -212,14 +212,13 @@ impl Bidirectional {
         let scene = space.scene;
         match path {
             [] => {
-                if scene.lights.is_empty() {
+                // No numbers are drawn without a light (the chain's random sequence stays).
+                if !scene.has_lights() {
                     return None;
                 }
-                let (index, _, _) = scene.light_distribution.sample_discrete(rng.uniform());
-                let light = &scene.lights[index];
-                let [b1, b2] = uniform_triangle(rng.uniform2());
+                let light = scene.sample_light(rng.uniform(), rng.uniform2())?;
                 Some(PathVertex {
-                    p: light.v0 + light.edge1 * b1 + light.edge2 * b2,
+                    p: light.point,
                     normal: light.normal,
                     triangle: light.triangle,
                 })
@@ -291,9 +290,9 @@ fn sample_direction(
     rng: &mut Rng,
 ) -> Option<Vec3A> {
     let wo = (from.p - at.p).normalize();
-    let shading = &space.scene.shading[at.triangle as usize];
-    let material = &space.scene.materials[shading.material as usize];
-    let s = bsdf::sample(material, at.normal, wo, rng.uniform2(), rng.uniform(), mode)?;
+    let s = space
+        .surface_bsdf(at)
+        .sample(wo, rng.uniform2(), rng.uniform(), mode)?;
     Some(s.wi)
 }
 

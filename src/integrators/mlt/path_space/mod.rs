@@ -38,9 +38,10 @@ pub(crate) use chain::{PathSpaceTarget, run};
 pub(crate) use erpt::{ErptSettings, run as run_erpt};
 pub(crate) use perturbation::PerturbationSizes;
 
-use crate::bsdf::{self, TransportMode};
+use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrators::PathVertex;
-use crate::scene::{CameraModel, MaterialKind, Scene};
+use crate::interaction::{SurfaceInteraction, vertex_bsdf};
+use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -61,15 +62,19 @@ fn direction(from: &PathVertex, to: &PathVertex) -> Option<(Vec3A, f32)> {
 }
 
 impl PathSpace<'_> {
+    /// The BSDF of surface vertex `v`.
     #[inline]
-    fn material(&self, v: &PathVertex) -> &crate::scene::Material {
-        let shading = &self.scene.shading[v.triangle as usize];
-        &self.scene.materials[shading.material as usize]
+    fn surface_bsdf(&self, v: &PathVertex) -> Bsdf<'_> {
+        vertex_bsdf(self.scene, v.triangle, v.normal)
     }
 
+    /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
+    /// specular, else `D`. A glossy lobe counts as `D`, like a diffuse one: it has a density,
+    /// so connections and the perturbations' direction densities work there as at a diffuse
+    /// vertex (a sharp glossy lobe is then explored poorly by them, not wrongly).
     #[inline]
     fn is_specular(&self, v: &PathVertex) -> bool {
-        self.material(v).kind != MaterialKind::Diffuse
+        self.surface_bsdf(v).lobes().is_specular()
     }
 
     /// The vertex `ray` hits first, or `None` if it escapes.
@@ -77,11 +82,9 @@ impl PathSpace<'_> {
     fn trace(&self, ray: &crate::accel::Ray, rays: &mut u64) -> Option<PathVertex> {
         *rays += 1;
         let hit = self.scene.accel.intersect(ray)?;
-        Some(PathVertex {
-            p: ray.origin + ray.direction * hit.t,
-            normal: self.scene.shading[hit.triangle as usize].normal,
-            triangle: hit.triangle,
-        })
+        Some(PathVertex::surface(&SurfaceInteraction::new(
+            self.scene, ray, &hit,
+        )))
     }
 
     /// Whether nothing blocks the segment between two vertices (`b_is_lens`: b is the lens,
@@ -123,7 +126,7 @@ impl PathSpace<'_> {
     ) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
-        let s = bsdf::scatter(self.material(at), at.normal, wo, wi, mode)?;
+        let s = self.surface_bsdf(at).scatter(wo, wi, mode)?;
         Some(if s.specular && !lobes_sampled {
             s.weight * s.pdf
         } else {
@@ -136,7 +139,7 @@ impl PathSpace<'_> {
     fn bsdf(&self, from: &PathVertex, at: &PathVertex, to: &PathVertex) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
-        Some(bsdf::eval(self.material(at), at.normal, wo, wi))
+        Some(self.surface_bsdf(at).eval(wo, wi))
     }
 
     /// f(x) / p_s(x): the measurement contribution of `path` (a light vertex first, the
@@ -157,13 +160,11 @@ impl PathSpace<'_> {
         let pixel = self.pixel(path)?;
         let t = n - s;
         let light = &path[0];
-        let light_shading = &self.scene.shading[light.triangle as usize];
-        let area_pdf = light_shading.light_area_pdf;
+        let area_pdf = self.scene.light_area_pdf(light.triangle);
         if area_pdf <= 0.0 {
             return None;
         }
-        let emission =
-            Spectrum::from(self.scene.materials[light_shading.material as usize].emission);
+        let emission = self.scene.emission(light.triangle);
         // The light leaves its front side only.
         let (w_light, _) = direction(&path[0], &path[1])?;
         if w_light.dot(light.normal) <= 0.0 {
@@ -326,10 +327,7 @@ mod tests {
                         if let Some(splat) = c.splat_pixel {
                             assert_eq!(pixel, splat, "{name} ({s}, {t})");
                         }
-                        let specular = path.iter().any(|v| {
-                            let shading = &scene.shading[v.triangle as usize];
-                            scene.materials[shading.material as usize].kind != MaterialKind::Diffuse
-                        });
+                        let specular = path.iter().any(|v| space.is_specular(v));
                         let entry = compared.entry((s, t)).or_default();
                         entry.0 += 1;
                         entry.1 += specular as u32;

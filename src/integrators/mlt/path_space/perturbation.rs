@@ -49,7 +49,7 @@
 use super::bidirectional::Proposal;
 use super::{PathSpace, PathVertex, direction};
 use crate::accel::Ray;
-use crate::bsdf::{self, SpecularLobe};
+use crate::bsdf::SpecularLobe;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
 use glam::Vec3A;
@@ -252,7 +252,7 @@ fn direction_density(
     match from {
         None => (wi.dot(at.normal) * FRAC_1_PI).max(0.0),
         Some(from) => match direction(at, from) {
-            Some((wo, _)) => bsdf::pdf(space.material(at), at.normal, wo, wi),
+            Some((wo, _)) => space.surface_bsdf(at).pdf(wo, wi),
             None => 0.0,
         },
     }
@@ -308,8 +308,9 @@ pub(crate) fn lens(
         y[k] = v;
         if specular {
             let (wo, _) = direction(&y[k], &y[k + 1])?;
-            let next =
-                bsdf::specular_direction(space.material(&y[k]), v.normal, wo, lobe_at(x, k)?)?;
+            let next = space
+                .surface_bsdf(&v)
+                .specular_direction(wo, lobe_at(x, k)?)?;
             ray = spawn_ray(space.scene, v.p, v.normal, next);
             k -= 1;
             continue;
@@ -394,7 +395,7 @@ pub(crate) fn caustic(
             let (wo_x, _) = direction(&x[k], &x[k - 1])?;
             let (wi_x, _) = direction(&x[k], &x[k + 1])?;
             let lobe = SpecularLobe::of(x[k].normal, wo_x, wi_x);
-            let next = bsdf::specular_direction(space.material(&y[k]), v.normal, wo, lobe)?;
+            let next = space.surface_bsdf(&v).specular_direction(wo, lobe)?;
             ray = spawn_ray(space.scene, v.p, v.normal, next);
         }
     }
@@ -436,6 +437,7 @@ fn proposal(
 mod tests {
     use super::*;
     use crate::accel::Backend;
+    use crate::bsdf;
     use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
 
     /// Fixed moves, to set up a given proposal: a film offset, and directions turned by a
