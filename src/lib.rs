@@ -1,7 +1,7 @@
 //! # mlt — an embeddable Metropolis Light Transport kernel
 //!
 //! Hand it triangles, materials and a camera; get back a linear HDR image. The Rust API is
-//! [`Scene::new`] and [`render`]; C and C++ hosts use the same kernel through `include/mlt.h`
+//! [`Scene::new`] and [`render()`]; C and C++ hosts use the same kernel through `include/mlt.h`
 //! (see [`capi`]).
 //!
 //! ```

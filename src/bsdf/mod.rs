@@ -4,8 +4,8 @@
 //! new direction. `normal` is the normal of the shading frame, which today is the triangle's
 //! front (counter-clockwise) geometric normal.
 //!
-//! Integrators use [`Bsdf`], a material evaluated at a surface point (built by
-//! `interaction.rs`), and ask it for its [`BsdfLobes`] instead of matching on the material's
+//! Integrators use `Bsdf`, a material evaluated at a surface point (built by
+//! `interaction.rs`), and ask it for its `BsdfLobes` instead of matching on the material's
 //! kind; the free functions below are its arithmetic, one `match` per operation.
 
 mod dielectric;
