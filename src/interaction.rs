@@ -97,6 +97,7 @@ mod tests {
             indices: &[0, 2, 1],
             material_ids: &[],
             materials: &materials,
+            lights: Default::default(),
             backend: Backend::Bvh,
         })
         .unwrap();
@@ -112,8 +113,16 @@ mod tests {
         assert_eq!(si.light_area_pdf, 0.5);
         assert_eq!(si.emission(&scene), Spectrum::splat(2.0));
         assert!(si.bsdf(&scene).lobes().contains(BsdfLobes::SPECULAR));
-        let light = scene.sample_light(0.3, [0.2, 0.7]).unwrap();
-        assert_eq!((light.triangle, light.area_pdf), (si.triangle, 0.5));
-        assert_eq!(light.normal, si.geometric_normal);
+        let Some(crate::scene::lights::LightSample::Area {
+            triangle,
+            area_pdf,
+            normal,
+            ..
+        }) = scene.sample_light(0.3, [0.2, 0.7])
+        else {
+            panic!("the only light is an area light")
+        };
+        assert_eq!((triangle, area_pdf), (si.triangle, 0.5));
+        assert_eq!(normal, si.geometric_normal);
     }
 }

@@ -15,6 +15,7 @@
 //!     indices: &indices,
 //!     material_ids: &[],
 //!     materials: &materials,
+//!     lights: Default::default(),
 //!     backend: Default::default(),
 //! })
 //! .unwrap();
@@ -50,7 +51,10 @@ pub use integrators::mlt::normalization::NormalizationStats;
 pub use render::{
     Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
 };
-pub use scene::{Camera, Material, MaterialKind, Scene, SceneDesc, SceneInfo};
+pub use scene::{
+    Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight, PunctualLightKind,
+    Scene, SceneDesc, SceneInfo, SunDesc,
+};
 
 // One scene serves renders and queries from many threads at once.
 const _: () = {

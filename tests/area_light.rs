@@ -61,6 +61,7 @@ fn scene(split_light: bool) -> Scene {
         indices: &indices,
         material_ids: &material_ids,
         materials: &materials,
+        lights: Default::default(),
         backend: Backend::Bvh,
     })
     .unwrap()

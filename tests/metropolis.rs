@@ -214,6 +214,7 @@ fn glass_caustic() -> (Scene, Camera) {
             mlt::Material::diffuse([0.0; 3]).with_emission([150.0, 140.0, 120.0]),
             mlt::Material::dielectric(1.5),
         ],
+        lights: Default::default(),
         backend: mlt::Backend::Bvh,
     })
     .unwrap();

@@ -199,6 +199,7 @@ pub unsafe extern "C" fn mlt_scene_create(
             indices,
             material_ids,
             materials: &materials,
+            lights: Default::default(),
             backend: backend(desc.backend)?,
         })?;
         let handle = Box::into_raw(Box::new(MltScene {

@@ -12,12 +12,21 @@
 //!
 //! Russian roulette is not used: subpaths end at the depth limit, which keeps the densities
 //! of both directions exact for MIS.
+//!
+//! Every kind of light takes part. A light at infinity (the environment, the sun) is a
+//! vertex that is a direction (`normal`, pointing from the scene to the light): densities
+//! towards it stay in solid angle, and light subpaths leave it from a disc covering the
+//! scene, so the next vertex's area density is the disc's times its |cos| (pbrt's
+//! construction). A camera subpath that leaves the scene ends on such a vertex. Delta
+//! lights (point, spot, directional) can be reached by connections only: the strategy that
+//! would need to hit one (s = 0) gets no weight.
 
 use super::{PathVertex, PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
-use crate::sampling::{OrthonormalBasis, Rng, Sampler, cosine_hemisphere};
+use crate::sampling::{Rng, Sampler};
+use crate::scene::lights::{Emitter, LightSample};
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
@@ -35,8 +44,11 @@ pub struct Bdpt<'a> {
 enum VertexKind {
     /// The lens point; `normal` is the view direction.
     Camera,
-    /// A point sampled on an area light; `normal` is the light's front normal.
-    Light,
+    /// The start of a light subpath, or the light a camera subpath ended on: a point on an
+    /// area light (`normal` is its front normal), a point light, or a light at infinity
+    /// (`normal` points from the scene to it; `p` is where a light subpath started, on the
+    /// disc, and meaningless for a camera subpath).
+    Light(Emitter),
     /// A surface hit by a subpath.
     Surface,
 }
@@ -79,6 +91,36 @@ impl Vertex {
     fn connectible(&self) -> bool {
         !self.specular
     }
+
+    /// Whether the vertex is a direction at infinity.
+    #[inline]
+    fn at_infinity(&self) -> bool {
+        matches!(self.kind, VertexKind::Light(e) if e.at_infinity())
+    }
+
+    /// The normal to offset shadow rays by (none for the lens and point lights).
+    #[inline]
+    fn offset_normal(&self) -> Vec3A {
+        match self.kind {
+            VertexKind::Camera | VertexKind::Light(Emitter::Point(_)) => Vec3A::ZERO,
+            _ => self.normal,
+        }
+    }
+}
+
+/// The unit direction from `from` to `to` and the squared distance (infinite towards a
+/// light at infinity), or `None` for coincident points.
+#[inline]
+fn direction(from: &Vertex, to: &Vertex) -> Option<(Vec3A, f32)> {
+    if to.at_infinity() {
+        return Some((to.normal, f32::INFINITY));
+    }
+    if from.at_infinity() {
+        return Some((-from.normal, f32::INFINITY));
+    }
+    let d = to.p - from.p;
+    let distance2 = d.length_squared();
+    (distance2 > 0.0).then(|| (d / distance2.sqrt(), distance2))
 }
 
 /// The two subpaths of one sample, reused by every sample of a work unit.
@@ -90,9 +132,16 @@ pub struct BdptScratch {
 }
 
 /// Converts a solid-angle density at `from` of the direction towards `to` into an area
-/// density at `to`.
+/// density at `to`. Towards a light at infinity the density stays in solid angle; from
+/// one, `pdf_solid_angle` is the disc's area density, projected onto `to`.
 #[inline]
 fn to_area(pdf_solid_angle: f32, from: &Vertex, to: &Vertex) -> f32 {
+    if to.at_infinity() {
+        return pdf_solid_angle;
+    }
+    if from.at_infinity() {
+        return pdf_solid_angle * from.normal.dot(to.normal).abs();
+    }
     let d = to.p - from.p;
     let distance2 = d.length_squared();
     if distance2 == 0.0 {
@@ -112,30 +161,33 @@ impl Bdpt<'_> {
         vertex_bsdf(self.scene, v.triangle, v.normal)
     }
 
-    /// Radiance a surface vertex emits towards direction `w` (front side only).
+    /// Radiance the light a camera subpath ended on sends back along it: an emitting
+    /// surface towards `w` (front side only), or the lights at infinity.
     #[inline]
     fn emitted(&self, v: &Vertex, w: Vec3A) -> Spectrum {
-        if self.scene.light_area_pdf(v.triangle) > 0.0 && w.dot(v.normal) > 0.0 {
-            self.scene.emission(v.triangle)
-        } else {
-            Spectrum::ZERO
+        match v.kind {
+            VertexKind::Surface
+                if self.scene.light_area_pdf(v.triangle) > 0.0 && w.dot(v.normal) > 0.0 =>
+            {
+                self.scene.emission(v.triangle)
+            }
+            VertexKind::Light(Emitter::Infinite) => self.scene.infinite_radiance(v.normal),
+            _ => Spectrum::ZERO,
         }
     }
 
     /// Area density at `next` of sampling it from `v`, which was reached from `prev`.
     #[inline]
     fn pdf(&self, camera: &CameraModel, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -> f32 {
-        let to_next = next.p - v.p;
-        let distance = to_next.length();
-        if distance == 0.0 {
+        let Some((wn, _)) = direction(v, next) else {
             return 0.0;
-        }
-        let wn = to_next / distance;
+        };
         let pdf_solid_angle = match v.kind {
             VertexKind::Camera => camera.direction_pdf(v.p, wn),
-            VertexKind::Light => return self.pdf_light_direction(v, next),
+            VertexKind::Light(_) => return self.pdf_light_direction(v, next),
             VertexKind::Surface => {
                 let wp = match prev {
+                    Some(prev) if prev.at_infinity() => prev.normal,
                     Some(prev) => (prev.p - v.p).normalize(),
                     None => v.wo,
                 };
@@ -145,22 +197,43 @@ impl Bdpt<'_> {
         to_area(pdf_solid_angle, v, next)
     }
 
-    /// Area density at `next` of an emission direction from light point `v` (cosine-weighted
-    /// about the light's normal, as light subpaths sample it).
+    /// Area density at `next` of an emission direction from light vertex `v` (an emitting
+    /// surface or a light vertex), as light subpaths sample it.
     #[inline]
     fn pdf_light_direction(&self, v: &Vertex, next: &Vertex) -> f32 {
-        let w = (next.p - v.p).normalize();
-        let cos = w.dot(v.normal);
-        if cos <= 0.0 {
-            return 0.0;
+        match v.kind {
+            VertexKind::Light(
+                emitter @ (Emitter::Point(_) | Emitter::Directional(_) | Emitter::Infinite),
+            ) => {
+                let Some((w, _)) = direction(v, next) else {
+                    return 0.0;
+                };
+                let pdf = self.scene.emission_direction_pdf(emitter, v.normal, w);
+                if pdf <= 0.0 {
+                    return 0.0;
+                }
+                to_area(pdf, v, next)
+            }
+            _ => {
+                // A point on an area light: cosine-weighted about its normal.
+                let w = (next.p - v.p).normalize();
+                let cos = w.dot(v.normal);
+                if cos <= 0.0 {
+                    return 0.0;
+                }
+                to_area(cos * FRAC_1_PI, v, next)
+            }
         }
-        to_area(cos * FRAC_1_PI, v, next)
     }
 
-    /// Area density of sampling `v` (on an emitter) as a light subpath's first vertex.
+    /// Density of sampling `v` (an emitting surface or a light vertex) as a light
+    /// subpath's first vertex: per unit area on area lights, in solid angle at infinity.
     #[inline]
     fn pdf_light_origin(&self, v: &Vertex) -> f32 {
-        self.scene.light_area_pdf(v.triangle)
+        match v.kind {
+            VertexKind::Light(emitter) => self.scene.emission_origin_pdf(emitter, v.normal),
+            _ => self.scene.light_area_pdf(v.triangle),
+        }
     }
 
     /// Extends `path` (whose last vertex is the subpath's start) by a random walk; returns
@@ -181,6 +254,20 @@ impl Bdpt<'_> {
         while count < max_vertices {
             counters.rays += 1;
             let Some(hit) = self.scene.accel.intersect(&ray) else {
+                // A camera subpath that leaves the scene ends on the lights at infinity.
+                if mode == TransportMode::Radiance && self.scene.has_infinite_light() {
+                    path[count] = Vertex {
+                        kind: VertexKind::Light(Emitter::Infinite),
+                        p: ray.origin,
+                        normal: ray.direction,
+                        wo: -ray.direction,
+                        beta,
+                        // In solid angle, as every density towards infinity.
+                        pdf_forward: pdf_solid_angle,
+                        ..Vertex::EMPTY
+                    };
+                    count += 1;
+                }
                 break;
             };
             let si = SurfaceInteraction::new(self.scene, &ray, &hit);
@@ -275,34 +362,35 @@ impl Bdpt<'_> {
         if max_vertices == 0 {
             return 0;
         }
-        let Some(light) = self.scene.sample_light(u_select, u_point) else {
+        let Some(light) = self.scene.sample_emission(u_select, u_point, u_direction) else {
             return 0;
         };
-        let p = light.point;
-        let local = cosine_hemisphere(u_direction);
-        let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
-        let pdf_direction = local.z * FRAC_1_PI;
+        let triangle = match light.emitter {
+            Emitter::Area(triangle) => triangle,
+            _ => 0,
+        };
         path[0] = Vertex {
-            kind: VertexKind::Light,
-            p,
+            kind: VertexKind::Light(light.emitter),
+            p: light.point,
             normal: light.normal,
-            // Le / p_position: what a connection to this vertex carries.
-            beta: light.emission / light.area_pdf,
-            pdf_forward: light.area_pdf,
-            triangle: light.triangle,
+            // Le / p_origin: what a connection to this vertex carries.
+            beta: light.emission / light.pdf_origin,
+            pdf_forward: light.pdf_origin,
+            triangle,
             ..Vertex::EMPTY
         };
-        if local.z <= 0.0 {
+        if light.pdf_direction <= 0.0 || light.beta.is_black() {
             return 1;
         }
-        // Le·cos / (p_position · p_direction) = Le·π / p_position.
-        let beta = light.emission * (local.z / (light.area_pdf * pdf_direction));
-        let ray = spawn_ray(self.scene, p, light.normal, direction);
+        let ray = match light.emitter {
+            Emitter::Area(_) => spawn_ray(self.scene, light.point, light.normal, light.direction),
+            _ => crate::accel::Ray::new(light.point, light.direction, 0.0, f32::INFINITY),
+        };
         self.random_walk(
             path,
             ray,
-            beta,
-            pdf_direction,
+            light.beta,
+            light.pdf_direction,
             max_vertices,
             TransportMode::Importance,
             sampler,
@@ -372,9 +460,14 @@ impl Bdpt<'_> {
         for i in (0..s).rev() {
             let r = remap(light[i].pdf_reverse) / remap(light[i].pdf_forward);
             ratio *= r * r;
-            // Area lights are never Dirac, so light[0] can always be connected.
-            let previous_specular = i > 0 && light[i - 1].specular;
-            if !light[i].specular && !previous_specular {
+            // s' = i connects light[i - 1] with light[i]; s' = 0 needs the camera subpath to
+            // hit light[0], impossible for a delta light.
+            let blocked = if i > 0 {
+                light[i - 1].specular
+            } else {
+                matches!(light[0].kind, VertexKind::Light(e) if e.is_delta())
+            };
+            if !light[i].specular && !blocked {
                 sum += ratio;
             }
         }
@@ -403,20 +496,21 @@ impl Bdpt<'_> {
         self.bsdf(v).eval(v.wo, w / length)
     }
 
+    /// Whether nothing blocks the way from surface vertex `a` to infinity along `w`.
+    #[inline]
+    fn unoccluded_towards(&self, a: &Vertex, w: Vec3A, counters: &mut SampleCounters) -> bool {
+        counters.rays += 1;
+        !self
+            .scene
+            .accel
+            .occluded(&spawn_ray(self.scene, a.p, a.normal, w))
+    }
+
     /// Whether nothing blocks the segment between two vertices.
     #[inline]
     fn visible(&self, a: &Vertex, b: &Vertex, counters: &mut SampleCounters) -> bool {
-        let normal_a = if a.kind == VertexKind::Camera {
-            Vec3A::ZERO
-        } else {
-            a.normal
-        };
-        let normal_b = if b.kind == VertexKind::Camera {
-            Vec3A::ZERO
-        } else {
-            b.normal
-        };
-        let Some(ray) = shadow_ray(self.scene, a.p, normal_a, b.p, normal_b) else {
+        let Some(ray) = shadow_ray(self.scene, a.p, a.offset_normal(), b.p, b.offset_normal())
+        else {
             return false;
         };
         counters.rays += 1;
@@ -554,9 +648,9 @@ impl Bdpt<'_> {
         let camera = &mut scratch.camera;
         let light = &mut scratch.light;
         if s == 0 {
-            // The camera subpath reached an emitter.
+            // The camera subpath reached an emitter, or left the scene.
             let pt = camera[t - 1];
-            if pt.kind != VertexKind::Surface {
+            if pt.kind == VertexKind::Camera {
                 return None;
             }
             let le = self.emitted(&pt, pt.wo);
@@ -618,31 +712,91 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let l = self.scene.sample_light(u_select, u_point)?;
-            let sampled = Vertex {
-                kind: VertexKind::Light,
-                p: l.point,
-                normal: l.normal,
-                beta: l.emission / l.area_pdf,
-                pdf_forward: l.area_pdf,
-                triangle: l.triangle,
-                ..Vertex::EMPTY
+            let (sampled, contribution) = match self.scene.sample_light(u_select, u_point)? {
+                LightSample::Area {
+                    point,
+                    normal,
+                    emission,
+                    area_pdf,
+                    triangle,
+                } => {
+                    let sampled = Vertex {
+                        kind: VertexKind::Light(Emitter::Area(triangle)),
+                        p: point,
+                        normal,
+                        beta: emission / area_pdf,
+                        pdf_forward: area_pdf,
+                        triangle,
+                        ..Vertex::EMPTY
+                    };
+                    let d = sampled.p - pt.p;
+                    let distance2 = d.length_squared();
+                    if distance2 == 0.0 {
+                        return None;
+                    }
+                    let w = d / distance2.sqrt();
+                    let cos_light = -w.dot(normal);
+                    if cos_light <= 0.0 {
+                        return None;
+                    }
+                    let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
+                    let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
+                    if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
+                        return None;
+                    }
+                    (sampled, contribution)
+                }
+                LightSample::Point {
+                    light,
+                    position,
+                    pdf,
+                } => {
+                    let d = position - pt.p;
+                    let distance2 = d.length_squared();
+                    if distance2 == 0.0 {
+                        return None;
+                    }
+                    let w = d / distance2.sqrt();
+                    let sampled = Vertex {
+                        kind: VertexKind::Light(Emitter::Point(light)),
+                        p: position,
+                        normal: -w,
+                        beta: self.scene.point_light(light).intensity(-w) / pdf,
+                        pdf_forward: pdf,
+                        ..Vertex::EMPTY
+                    };
+                    let geometry = w.dot(pt.normal).abs() / distance2;
+                    let contribution = pt.beta * self.f(&pt, position) * sampled.beta * geometry;
+                    if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
+                        return None;
+                    }
+                    (sampled, contribution)
+                }
+                LightSample::Direction {
+                    emitter,
+                    toward,
+                    radiance,
+                    pdf,
+                } => {
+                    if pdf <= 0.0 {
+                        return None;
+                    }
+                    let sampled = Vertex {
+                        kind: VertexKind::Light(emitter),
+                        p: pt.p,
+                        normal: toward,
+                        beta: radiance / pdf,
+                        pdf_forward: pdf,
+                        ..Vertex::EMPTY
+                    };
+                    let f = self.bsdf(&pt).eval(pt.wo, toward);
+                    let contribution = pt.beta * f * sampled.beta * toward.dot(pt.normal).abs();
+                    if contribution.is_black() || !self.unoccluded_towards(&pt, toward, counters) {
+                        return None;
+                    }
+                    (sampled, contribution)
+                }
             };
-            let d = sampled.p - pt.p;
-            let distance2 = d.length_squared();
-            if distance2 == 0.0 {
-                return None;
-            }
-            let w = d / distance2.sqrt();
-            let cos_light = -w.dot(l.normal);
-            if cos_light <= 0.0 {
-                return None;
-            }
-            let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
-            let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
-            if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
-                return None;
-            }
             let saved = light[0];
             light[0] = sampled;
             let weight = self.mis_weight(camera_model, camera, light, 1, t);

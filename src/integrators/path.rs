@@ -1,11 +1,14 @@
-//! Unidirectional path tracing: BSDF importance sampling, next-event estimation to area
-//! lights, multiple importance sampling (power heuristic) and Russian roulette.
+//! Unidirectional path tracing: BSDF importance sampling, next-event estimation to every
+//! kind of light, multiple importance sampling (power heuristic) against BSDF sampling for
+//! the lights rays can hit (area lights, the environment, the sun's disc), and Russian
+//! roulette.
 
 use super::{PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
 use crate::sampling::{Rng, Sampler, power_heuristic};
+use crate::scene::lights::LightSample;
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
@@ -46,6 +49,16 @@ impl PathTracer<'_> {
         loop {
             *rays += 1;
             let Some(hit) = scene.accel.intersect(&ray) else {
+                // The ray left the scene: the environment and the sun's disc.
+                if depth >= self.min_depth && scene.has_infinite_light() {
+                    let emission = scene.infinite_radiance(ray.direction);
+                    let weight = if previous_specular {
+                        1.0
+                    } else {
+                        power_heuristic(previous_pdf, scene.infinite_pdf(ray.direction))
+                    };
+                    radiance += throughput * emission * weight;
+                }
                 break;
             };
             let si = SurfaceInteraction::new(scene, &ray, &hit);
@@ -109,8 +122,9 @@ impl PathTracer<'_> {
         radiance
     }
 
-    /// Next-event estimation: one point on one light (chosen by power), weighted by MIS
-    /// against BSDF sampling. Returns the contribution before the path throughput.
+    /// Next-event estimation: one light (chosen by power) and a point or direction on it,
+    /// weighted by MIS against BSDF sampling where BSDF sampling could find it too. Returns
+    /// the contribution before the path throughput.
     // Always inlined: called once per vertex, and as a call it costs ~1.5% more
     // instructions (the compiler stopped inlining it once it took a `Bsdf`).
     #[inline(always)]
@@ -124,34 +138,88 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
-        let Some(light) = scene.sample_light(u_select, u_point) else {
-            return Spectrum::ZERO;
-        };
-        let y = light.point;
-        let to_light = y - p;
-        let distance2 = to_light.length_squared();
-        if distance2 <= 0.0 {
-            return Spectrum::ZERO;
+        match scene.sample_light(u_select, u_point) {
+            None => Spectrum::ZERO,
+            Some(LightSample::Area {
+                point: y,
+                normal: light_normal,
+                emission,
+                area_pdf,
+                ..
+            }) => {
+                let to_light = y - p;
+                let distance2 = to_light.length_squared();
+                if distance2 <= 0.0 {
+                    return Spectrum::ZERO;
+                }
+                let wi = to_light / distance2.sqrt();
+                let cos_light = -wi.dot(light_normal);
+                if cos_light <= 0.0 {
+                    return Spectrum::ZERO;
+                }
+                let f = bsdf.eval(wo, wi);
+                if f.is_black() {
+                    return Spectrum::ZERO;
+                }
+                let Some(ray) = shadow_ray(scene, p, normal, y, light_normal) else {
+                    return Spectrum::ZERO;
+                };
+                *rays += 1;
+                if scene.accel.occluded(&ray) {
+                    return Spectrum::ZERO;
+                }
+                let light_pdf = area_pdf * distance2 / cos_light;
+                let weight = power_heuristic(light_pdf, bsdf.pdf(wo, wi));
+                f * emission * (wi.dot(normal).abs() * weight / light_pdf)
+            }
+            Some(LightSample::Point {
+                light,
+                position,
+                pdf,
+            }) => {
+                let to_light = position - p;
+                let distance2 = to_light.length_squared();
+                if distance2 <= 0.0 {
+                    return Spectrum::ZERO;
+                }
+                let wi = to_light / distance2.sqrt();
+                let intensity = scene.point_light(light).intensity(-wi);
+                let f = bsdf.eval(wo, wi);
+                if f.is_black() || intensity.is_black() {
+                    return Spectrum::ZERO;
+                }
+                let Some(ray) = shadow_ray(scene, p, normal, position, Vec3A::ZERO) else {
+                    return Spectrum::ZERO;
+                };
+                *rays += 1;
+                if scene.accel.occluded(&ray) {
+                    return Spectrum::ZERO;
+                }
+                // A delta position: no other strategy finds it, so no MIS.
+                f * intensity * (wi.dot(normal).abs() / (distance2 * pdf))
+            }
+            Some(LightSample::Direction {
+                emitter,
+                toward: wi,
+                radiance,
+                pdf,
+            }) => {
+                let f = bsdf.eval(wo, wi);
+                if f.is_black() || radiance.is_black() || pdf <= 0.0 {
+                    return Spectrum::ZERO;
+                }
+                *rays += 1;
+                if scene.accel.occluded(&spawn_ray(scene, p, normal, wi)) {
+                    return Spectrum::ZERO;
+                }
+                let weight = if emitter.is_delta() {
+                    1.0
+                } else {
+                    power_heuristic(pdf, bsdf.pdf(wo, wi))
+                };
+                f * radiance * (wi.dot(normal).abs() * weight / pdf)
+            }
         }
-        let wi = to_light / distance2.sqrt();
-        let cos_light = -wi.dot(light.normal);
-        if cos_light <= 0.0 {
-            return Spectrum::ZERO;
-        }
-        let f = bsdf.eval(wo, wi);
-        if f.is_black() {
-            return Spectrum::ZERO;
-        }
-        let Some(ray) = shadow_ray(scene, p, normal, y, light.normal) else {
-            return Spectrum::ZERO;
-        };
-        *rays += 1;
-        if scene.accel.occluded(&ray) {
-            return Spectrum::ZERO;
-        }
-        let light_pdf = light.area_pdf * distance2 / cos_light;
-        let weight = power_heuristic(light_pdf, bsdf.pdf(wo, wi));
-        f * light.emission * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
 

@@ -58,6 +58,8 @@ pub struct SceneData {
     pub material_names: Vec<String>,
     /// The OBJ's `NAME.camera.json` sidecar or the glTF's first camera.
     pub camera: Option<CameraFile>,
+    /// The glTF's `KHR_lights_punctual` lights, placed by its node hierarchy.
+    pub punctual_lights: Vec<crate::scene::PunctualLight>,
 }
 
 impl SceneData {
@@ -68,6 +70,10 @@ impl SceneData {
             indices: &self.indices,
             material_ids: &self.material_ids,
             materials: &self.materials,
+            lights: crate::scene::LightsDesc {
+                punctual: &self.punctual_lights,
+                ..Default::default()
+            },
             backend,
         }
     }

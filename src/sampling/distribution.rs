@@ -127,15 +127,11 @@ impl Distribution2D {
             .chunks_exact(width)
             .map(Distribution1D::new)
             .collect();
-        let row_totals: Vec<f32> = rows
-            .iter()
-            .map(|r| {
-                if r.total() > 0.0 {
-                    r.total_weight()
-                } else {
-                    0.0
-                }
-            })
+        // From the values themselves: a row of zeros gets a uniform conditional (so its
+        // Distribution1D reports a non-zero total) but must never be chosen.
+        let row_totals: Vec<f32> = values
+            .chunks_exact(width)
+            .map(|row| row.iter().map(|&v| v as f64).sum::<f64>() as f32)
             .collect();
         Distribution2D {
             marginal: Distribution1D::new(&row_totals),
@@ -156,13 +152,6 @@ impl Distribution2D {
         let height = self.rows.len();
         let row = ((p[1] * height as f32) as usize).min(height - 1);
         self.marginal.continuous_pdf(p[1]) * self.rows[row].continuous_pdf(p[0])
-    }
-}
-
-impl Distribution1D {
-    /// Sum of the original weights (zero for an all-zero row).
-    fn total_weight(&self) -> f32 {
-        self.weights.iter().sum()
     }
 }
 
@@ -201,7 +190,8 @@ mod tests {
 
     #[test]
     fn two_d_density_integrates_to_one_and_matches_samples() {
-        let values = [0.0, 1.0, 2.0, 3.0, 0.0, 0.0, 5.0, 1.0, 2.0];
+        // The middle row is all zeros: never chosen.
+        let values = [0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 5.0, 1.0, 2.0];
         let d = Distribution2D::new(&values, 3, 3);
         let mut rng = Rng::new(4, 4);
         let mut counts = [0usize; 9];

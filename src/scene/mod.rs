@@ -1,10 +1,12 @@
 //! The validated, immutable scene: geometry in the backend's order, materials, area lights.
 
 mod camera;
-mod lights;
+mod light_desc;
+pub(crate) mod lights;
 mod material;
 
 pub use camera::{Camera, CameraModel};
+pub use light_desc::{EnvironmentDesc, LightsDesc, PunctualLight, PunctualLightKind, SunDesc};
 pub use lights::AreaLight;
 pub use material::{Material, MaterialKind};
 
@@ -24,6 +26,8 @@ pub struct SceneDesc<'a> {
     /// One material index per triangle; empty means material 0 for every triangle.
     pub material_ids: &'a [u32],
     pub materials: &'a [Material],
+    /// Lights besides the emissive triangles: environment, sun, punctual lights.
+    pub lights: LightsDesc<'a>,
     pub backend: Backend,
 }
 
@@ -55,8 +59,17 @@ pub struct Scene {
     pub(crate) accel: Accel,
     pub(crate) shading: Vec<TriangleShading>,
     pub(crate) materials: Vec<Material>,
-    pub(crate) lights: Vec<AreaLight>,
+    /// Every light, in selection order: area lights (in the host's triangle order), punctual
+    /// lights, a delta sun, the lights at infinity.
+    pub(crate) lights: Vec<lights::Light>,
     pub(crate) light_distribution: Distribution1D,
+    /// The environment and sun disc, if any.
+    pub(crate) infinite: Option<lights::InfiniteLight>,
+    /// Selection probability of the lights at infinity (0: none, or black).
+    pub(crate) infinite_select_pdf: f32,
+    /// Centre and radius of a sphere around the geometry: light subpaths from infinity
+    /// start on a disc of this radius.
+    pub(crate) bounding_sphere: (Vec3A, f32),
     /// Internal triangle index → the host's triangle id.
     internal_to_input: Vec<u32>,
     /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
@@ -68,6 +81,7 @@ impl Scene {
     /// Validates the description and builds the acceleration structure.
     pub fn new(desc: &SceneDesc) -> Result<Scene> {
         validate_arrays(desc)?;
+        desc.lights.validate()?;
         let vertex = |i: u32| {
             let i = i as usize * 3;
             Vec3A::new(
@@ -141,16 +155,20 @@ impl Scene {
         // Lights in the host's triangle order, not the backend's: the same seed then picks
         // the same lights with either backend.
         lights.sort_by_key(|light| internal_to_input[light.triangle as usize]);
+        let emitter_count = lights.len();
+        let center = (bounds_min + bounds_max) * 0.5;
+        // A little larger than the box's sphere: rays from its disc start outside the geometry.
+        let radius = ((bounds_max - bounds_min).length() * 0.5 * 1.01).max(1e-3);
         // Lights are picked in proportion to their emitted power.
+        let scene_lights = lights::SceneLights::new(lights, &desc.lights, radius);
+        let light_distribution = scene_lights.distribution;
+        let mut all_lights = scene_lights.lights;
         let area = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
-        let light_power: Vec<f32> = lights
-            .iter()
-            .map(|light| light.emission.luminance() * area(light))
-            .collect();
-        let light_distribution = Distribution1D::new(&light_power);
-        for (index, light) in lights.iter_mut().enumerate() {
-            light.area_pdf = light_distribution.discrete_pdf(index) / area(light);
-            shading[light.triangle as usize].light_area_pdf = light.area_pdf;
+        for (index, light) in all_lights.iter_mut().enumerate() {
+            if let lights::Light::Area(light) = light {
+                light.area_pdf = light_distribution.discrete_pdf(index) / area(light);
+                shading[light.triangle as usize].light_area_pdf = light.area_pdf;
+            }
         }
         let magnitude = bounds_min
             .abs()
@@ -160,7 +178,7 @@ impl Scene {
         let info = SceneInfo {
             triangle_count,
             degenerate_triangle_count: triangle_count - order.len(),
-            emitter_count: lights.len(),
+            emitter_count,
             bounds_min: bounds_min.to_array(),
             bounds_max: bounds_max.to_array(),
         };
@@ -168,8 +186,11 @@ impl Scene {
             accel,
             shading,
             materials: desc.materials.to_vec(),
-            lights,
+            lights: all_lights,
             light_distribution,
+            infinite: scene_lights.infinite,
+            infinite_select_pdf: scene_lights.infinite_select_pdf,
+            bounding_sphere: (center, radius),
             internal_to_input,
             ray_epsilon: magnitude * 2e-5,
             info,

@@ -91,6 +91,7 @@ pub fn furnace_scene(albedo: [f32; 3], emission: [f32; 3]) -> Scene {
         indices: &indices,
         material_ids: &[],
         materials: &materials,
+        lights: Default::default(),
         backend: Backend::Bvh,
     })
     .unwrap()
@@ -508,6 +509,7 @@ impl Mesh {
             indices: &self.indices,
             material_ids: &self.material_ids,
             materials: &self.materials,
+            lights: Default::default(),
             backend,
         })
         .expect("a valid scene")

@@ -216,12 +216,20 @@ impl Bidirectional {
                 if !scene.has_lights() {
                     return None;
                 }
-                let light = scene.sample_light(rng.uniform(), rng.uniform2())?;
-                Some(PathVertex {
-                    p: light.point,
-                    normal: light.normal,
-                    triangle: light.triangle,
-                })
+                match scene.sample_light(rng.uniform(), rng.uniform2())? {
+                    crate::scene::lights::LightSample::Area {
+                        point,
+                        normal,
+                        triangle,
+                        ..
+                    } => Some(PathVertex {
+                        p: point,
+                        normal,
+                        triangle,
+                    }),
+                    // Path-space MLT refuses scenes with other lights (see `render`).
+                    _ => None,
+                }
             }
             [light] => {
                 let local = cosine_hemisphere(rng.uniform2());
@@ -428,6 +436,7 @@ mod tests {
                 Material::diffuse(albedo(Surface::Wall)),
                 Material::diffuse([0.0; 3]).with_emission([EMISSION; 3]),
             ],
+            lights: Default::default(),
             backend: Backend::Bvh,
         })
         .unwrap()

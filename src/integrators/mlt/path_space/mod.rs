@@ -257,6 +257,7 @@ mod tests {
             indices: &data.indices,
             material_ids: &data.material_ids,
             materials: &data.materials,
+            lights: Default::default(),
             backend: Backend::Bvh,
         })
         .unwrap();

@@ -489,6 +489,7 @@ mod tests {
                 Material::mirror([0.9, 0.9, 0.9]),
                 Material::diffuse([0.0; 3]).with_emission([5.0, 5.0, 5.0]),
             ],
+            lights: Default::default(),
             backend: Backend::Bvh,
         })
         .unwrap()
@@ -808,6 +809,7 @@ mod tests {
                 Material::mirror([0.9, 0.8, 0.7]),
                 Material::diffuse([0.0; 3]).with_emission([4.0, 4.0, 4.0]),
             ],
+            lights: Default::default(),
             backend: Backend::Bvh,
         })
         .unwrap()
