@@ -504,12 +504,17 @@ impl Mesh {
     }
 
     pub fn scene_with(&self, backend: Backend) -> Scene {
+        self.scene_lit(backend, Default::default())
+    }
+
+    /// The scene with lights besides its emissive triangles.
+    pub fn scene_lit(&self, backend: Backend, lights: mlt::LightsDesc) -> Scene {
         Scene::new(&SceneDesc {
             positions: &self.positions,
             indices: &self.indices,
             material_ids: &self.material_ids,
             materials: &self.materials,
-            lights: Default::default(),
+            lights,
             backend,
         })
         .expect("a valid scene")
