@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{door_ajar, lamp_behind_glass};
+use common::{door_ajar, lamp_behind_glass, window_room};
 use mlt::io::{self, IoError, SceneData};
 use mlt::{Material, MaterialKind, Scene};
 use std::path::{Path, PathBuf};
@@ -166,6 +166,28 @@ fn lamp_behind_glass_scene_files_are_what_the_generator_writes() {
     assert_eq!((m.kind, m.ior), (MaterialKind::Dielectric, 1.5));
     let glass_faces = data.material_ids.iter().filter(|&&id| id == glass).count();
     assert_eq!(glass_faces, 12);
+}
+
+/// The same for `tests/common/window_room.rs`: no emitter (the sky and sun light it) and
+/// a window opening in the wall z = 5000.
+#[test]
+fn window_room_scene_files_are_what_the_generator_writes() {
+    check_generated_scene(window_room::files());
+    let data = io::load_scene(&scenes().join("window-room.obj")).unwrap();
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    assert_eq!(scene.info().emitter_count, 0);
+    assert!(data.camera.is_some());
+    // A ray out through the window's centre escapes; one through the wall beside it does not.
+    let out = |x: f32| {
+        mlt::accel::Ray::new(
+            glam::Vec3A::new(x, 1400.0, 4000.0),
+            glam::Vec3A::Z,
+            0.0,
+            f32::INFINITY,
+        )
+    };
+    assert!(scene.intersect(&out(2000.0)).is_none());
+    assert!(scene.intersect(&out(1000.0)).is_some());
 }
 
 #[test]

@@ -1,16 +1,21 @@
 //! Lights beyond emissive triangles (environment, sun, point, spot and directional lights)
 //! against closed forms, for every algorithm that supports them: a convex diffuse sphere
 //! under a constant environment, and a diffuse plane under a constant sky, a sun at several
-//! elevations (delta and disc), a point and a spot light. Tolerances come from the spread of
-//! independent renders (Student's t with their degrees of freedom), and each check also
-//! asserts that a 2% brightness error would fail it.
+//! elevations (delta and disc), a point and a spot light. Then the algorithms against each
+//! other on two scenes: the window room (tests/common/window_room.rs: sky and sun through a
+//! small window) and the Cornell box lit by a spot light and the sun through its open
+//! front. Tolerances come from the spread of independent renders (Student's t with their
+//! degrees of freedom), and each check also asserts that a 2% brightness error would fail.
 
 mod common;
 
-use common::{Estimate, Mesh, inward_icosphere, render_image};
+use common::{
+    Estimate, Mesh, assert_estimates_agree, cached_estimate, canonical_camera, canonical_mesh,
+    inward_icosphere, render_image, window_room,
+};
 use mlt::{
     Algorithm, Backend, Camera, EnvironmentDesc, LightsDesc, Material, PunctualLight,
-    RenderSettings, SunDesc,
+    RenderSettings, Scene, SunDesc,
 };
 use std::f64::consts::PI;
 
@@ -314,4 +319,191 @@ fn plane_under_a_directional_and_a_point_light() {
         2,
         truth,
     );
+}
+
+/// The window room under its sky map and sun.
+fn window_room_scene() -> (Scene, Camera) {
+    let mesh = canonical_mesh("window-room");
+    let sky = window_room::sky_pixels();
+    let (width, height) = window_room::SKY_SIZE;
+    let lights = LightsDesc {
+        environment: Some(EnvironmentDesc {
+            pixels: &sky,
+            width,
+            height,
+            rotation_degrees: 0.0,
+            scale: 1.0,
+        }),
+        sun: Some(window_room::sun()),
+        ..Default::default()
+    };
+    (
+        mesh.scene_lit(Backend::Bvh, lights),
+        canonical_camera("window-room"),
+    )
+}
+
+/// The Cornell box with its ceiling lamp off, lit by a spot under the ceiling aimed at the
+/// tall block and by a sun disc shining in through the open front.
+fn spot_and_sun_box() -> (Scene, Camera) {
+    let mut mesh = canonical_mesh("cornell-box");
+    for material in &mut mesh.materials {
+        material.emission = [0.0; 3];
+    }
+    let spot = [PunctualLight::spot(
+        [278.0, 530.0, 280.0],
+        [0.2, -1.0, 0.25],
+        [2.0e5, 1.8e5, 1.5e5],
+        20.0,
+        40.0,
+    )];
+    let lights = LightsDesc {
+        sun: Some(SunDesc {
+            direction: [-0.25, 0.6, -1.0],
+            angular_radius_degrees: 1.0,
+            irradiance: [1.0, 0.95, 0.85],
+        }),
+        punctual: &spot,
+        ..Default::default()
+    };
+    (
+        mesh.scene_lit(Backend::Bvh, lights),
+        canonical_camera("cornell-box"),
+    )
+}
+
+const AGREEMENT_SIZE: u32 = 32;
+
+fn lit_scene(name: &str) -> (Scene, Camera) {
+    match name {
+        "window-room" => window_room_scene(),
+        "spot-and-sun" => spot_and_sun_box(),
+        _ => unreachable!(),
+    }
+}
+
+/// `renders` independent renders of a lit scene with `settings` (size and seed set here).
+fn lit_estimate(name: &str, settings: RenderSettings, renders: u64) -> Estimate {
+    let (scene, camera) = lit_scene(name);
+    let images: Vec<Vec<f32>> = (0..renders)
+        .map(|seed| {
+            let settings = RenderSettings {
+                width: AGREEMENT_SIZE,
+                height: AGREEMENT_SIZE,
+                seed: 500 + seed,
+                ..settings
+            };
+            render_image(&scene, &camera, &settings)
+        })
+        .collect();
+    let size = AGREEMENT_SIZE as usize;
+    Estimate::from_correlated_renders(size, size, &images)
+}
+
+/// Work per pixel for a lit scene: the window room's image is mostly light after bounces,
+/// and needs more for a 2% error to be resolvable.
+fn effort(name: &str) -> u32 {
+    if name == "window-room" { 2 } else { 1 }
+}
+
+/// BDPT's estimate of a lit scene (16 renders at max depth 5), once per test binary: the
+/// reference of the Metropolis algorithms, itself checked against the path tracer.
+fn bdpt_reference(name: &str) -> &'static Estimate {
+    cached_estimate(&format!("bdpt {name}"), || {
+        let settings = RenderSettings {
+            algorithm: Algorithm::Bdpt,
+            samples_per_pixel: 64 * effort(name),
+            max_depth: 5,
+            ..Default::default()
+        };
+        lit_estimate(name, settings, 16)
+    })
+}
+
+fn bdpt_agrees_with_the_path_tracer(name: &str) {
+    let settings = RenderSettings {
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 256 * effort(name),
+        max_depth: 5,
+        ..Default::default()
+    };
+    let path = lit_estimate(name, settings, 16);
+    assert_estimates_agree(
+        &format!("{name} BDPT against the path tracer"),
+        bdpt_reference(name),
+        &path,
+        4,
+        5.0,
+        6.0,
+    );
+}
+
+fn metropolis_agrees_with_bdpt(name: &str, algorithm: Algorithm) {
+    let settings = RenderSettings {
+        algorithm,
+        mutations_per_pixel: 128 * effort(name),
+        bootstrap_samples: 1 << 16,
+        chains: 256,
+        max_depth: 5,
+        ..Default::default()
+    };
+    let test = lit_estimate(name, settings, 16);
+    assert_estimates_agree(
+        &format!("{name} {algorithm:?} against BDPT"),
+        &test,
+        bdpt_reference(name),
+        4,
+        5.0,
+        6.0,
+    );
+}
+
+#[test]
+fn window_room_bdpt_agrees_with_the_path_tracer() {
+    bdpt_agrees_with_the_path_tracer("window-room");
+}
+
+#[test]
+fn spot_and_sun_bdpt_agrees_with_the_path_tracer() {
+    bdpt_agrees_with_the_path_tracer("spot-and-sun");
+}
+
+#[test]
+fn window_room_metropolis_agrees_with_bdpt() {
+    for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt, Algorithm::Mmlt] {
+        metropolis_agrees_with_bdpt("window-room", algorithm);
+    }
+}
+
+#[test]
+fn spot_and_sun_metropolis_agrees_with_bdpt() {
+    for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt, Algorithm::Mmlt] {
+        metropolis_agrees_with_bdpt("spot-and-sun", algorithm);
+    }
+}
+
+/// Writes the lit scenes' BDPT references as images, for looking at (`MLT_WRITE_LIT=DIR`).
+#[test]
+fn write_lit_scene_images() {
+    let Some(dir) = std::env::var_os("MLT_WRITE_LIT") else {
+        return;
+    };
+    for name in ["window-room", "spot-and-sun"] {
+        let (scene, camera) = lit_scene(name);
+        let settings = RenderSettings {
+            width: 256,
+            height: 256,
+            algorithm: Algorithm::Bdpt,
+            samples_per_pixel: 64,
+            ..Default::default()
+        };
+        let image = render_image(&scene, &camera, &settings);
+        mlt::io::write_png(
+            &std::path::Path::new(&dir).join(format!("{name}.png")),
+            256,
+            256,
+            &image,
+        )
+        .unwrap();
+    }
 }
