@@ -1,8 +1,9 @@
 //! Equal-time quality: how close each algorithm gets to a converged reference in the same
 //! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings:
 //! cornell-box, cornell-glass (caustics through a glass sphere), door-ajar (a room lit
-//! through the crack of a door) and lamp-behind-glass (a room lit only through the glass
-//! cover of a recessed lamp).
+//! through the crack of a door), lamp-behind-glass (a room lit only through the glass
+//! cover of a recessed lamp) and window-room (a room lit only by the sky and the sun
+//! through a small window: an environment map and a sun disc).
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
 //! actual seconds, camera samples and chain mutations per second, the share of mutations
@@ -37,7 +38,7 @@
 //! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
 //! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 2048).
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
-//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass`).
+//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass,window-room`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
 //! - `MLT_BENCH_REPEATS`: renders at the longest budget per thread count (default 1).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
@@ -149,6 +150,7 @@ const DEFAULT_SCENES: &[&str] = &[
     "cornell-glass",
     "door-ajar",
     "lamp-behind-glass",
+    "window-room",
 ];
 const DEFAULT_MAX_SECONDS: f64 = 10.0;
 /// One time-limited render compared with the reference.

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{door_ajar, lamp_behind_glass, window_room};
+use common::{door_ajar, lamp_behind_glass, sky_spheres, window_room};
 use mlt::io::{self, IoError, SceneData};
 use mlt::{Material, MaterialKind, Scene};
 use std::path::{Path, PathBuf};
@@ -188,6 +188,60 @@ fn window_room_scene_files_are_what_the_generator_writes() {
     };
     assert!(scene.intersect(&out(2000.0)).is_none());
     assert!(scene.intersect(&out(1000.0)).is_some());
+    // Its sky, for the command line's --env: the generator's map, exactly (EXR keeps f32).
+    let sky_path = scenes().join("sky.exr");
+    let (width, height) = window_room::SKY_SIZE;
+    let pixels = window_room::sky_pixels();
+    if std::env::var_os("MLT_WRITE_SCENES").is_some() {
+        io::write_exr(&sky_path, width, height, &pixels).unwrap();
+    }
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &sky_path,
+        |resolution, _| vec![[0.0f32; 3]; resolution.width() * resolution.height()],
+        move |texels: &mut Vec<[f32; 3]>, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+            texels[position.y() * width as usize + position.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    let read: Vec<f32> = image.layer_data.channel_data.pixels.concat();
+    assert!(
+        read == pixels,
+        "sky.exr differs from its generator: rewrite it with MLT_WRITE_SCENES=1 cargo test --test io"
+    );
+}
+
+/// The committed sky-spheres glTF files are what `tests/common/sky_spheres.rs` writes (with
+/// `MLT_WRITE_SCENES=1`, this test writes them instead), and the scene loads with its
+/// camera, a diffuse ground and clay sphere, a mirror and a glass sphere.
+#[test]
+fn sky_spheres_scene_files_are_what_the_generator_writes() {
+    let (bin, gltf) = sky_spheres::files();
+    let (bin_path, gltf_path) = (
+        scenes().join("sky-spheres.bin"),
+        scenes().join("sky-spheres.gltf"),
+    );
+    if std::env::var_os("MLT_WRITE_SCENES").is_some() {
+        std::fs::write(&bin_path, &bin).unwrap();
+        std::fs::write(&gltf_path, &gltf).unwrap();
+    }
+    assert!(
+        std::fs::read(&bin_path).unwrap() == bin
+            && std::fs::read_to_string(&gltf_path).unwrap() == gltf,
+        "sky-spheres differs from its generator: rewrite it with MLT_WRITE_SCENES=1 cargo test --test io"
+    );
+    let data = io::load_scene(&gltf_path).unwrap();
+    assert!(data.camera.is_some());
+    let kinds: Vec<MaterialKind> = data.materials.iter().map(|m| m.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            MaterialKind::Diffuse,
+            MaterialKind::Diffuse,
+            MaterialKind::Mirror,
+            MaterialKind::Dielectric
+        ]
+    );
+    assert_eq!(data.triangle_count(), 2 + 3 * (24 * 48 * 2 - 2 * 48));
 }
 
 #[test]

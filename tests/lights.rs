@@ -372,12 +372,33 @@ fn spot_and_sun_box() -> (Scene, Camera) {
     )
 }
 
+/// The glTF spheres under the window room's sky and sun.
+fn sky_spheres_scene() -> (Scene, Camera) {
+    let data = mlt::io::load_scene(&common::scenes_dir().join("sky-spheres.gltf")).unwrap();
+    let sky = window_room::sky_pixels();
+    let (width, height) = window_room::SKY_SIZE;
+    let mut desc = data.desc(Backend::Bvh);
+    desc.lights = LightsDesc {
+        environment: Some(EnvironmentDesc {
+            pixels: &sky,
+            width,
+            height,
+            rotation_degrees: 0.0,
+            scale: 1.0,
+        }),
+        sun: Some(window_room::sun()),
+        ..Default::default()
+    };
+    (Scene::new(&desc).unwrap(), data.camera.unwrap().camera)
+}
+
 const AGREEMENT_SIZE: u32 = 32;
 
 fn lit_scene(name: &str) -> (Scene, Camera) {
     match name {
         "window-room" => window_room_scene(),
         "spot-and-sun" => spot_and_sun_box(),
+        "sky-spheres" => sky_spheres_scene(),
         _ => unreachable!(),
     }
 }
@@ -488,7 +509,7 @@ fn write_lit_scene_images() {
     let Some(dir) = std::env::var_os("MLT_WRITE_LIT") else {
         return;
     };
-    for name in ["window-room", "spot-and-sun"] {
+    for name in ["window-room", "spot-and-sun", "sky-spheres"] {
         let (scene, camera) = lit_scene(name);
         let settings = RenderSettings {
             width: 256,

@@ -3,6 +3,11 @@
 #![allow(dead_code)]
 
 pub mod reference;
+// The window room's generator (its sky and sun), shared with the tests.
+#[path = "../../tests/common/obj_text.rs"]
+pub mod obj_text;
+#[path = "../../tests/common/window_room.rs"]
+pub mod window_room;
 
 use plotters::coord::CoordTranslate;
 use plotters::prelude::*;

@@ -53,14 +53,31 @@ pub fn luminance(rgb: [f64; 3]) -> f64 {
     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
-/// A scene of tests/scenes with its camera sidecar, on the BVH backend.
+/// A scene of tests/scenes with its camera sidecar, on the BVH backend; the window room
+/// with its sky and sun (tests/common/window_room.rs).
 pub fn load_scene(name: &str) -> (Scene, Camera) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/scenes")
         .join(format!("{name}.obj"));
     let data = mlt::io::load_scene(&path)
         .unwrap_or_else(|e| panic!("scene {name} (MLT_BENCH_SCENES) does not load: {e}"));
-    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).expect("scene builds");
+    let sky = super::window_room::sky_pixels();
+    let (sky_width, sky_height) = super::window_room::SKY_SIZE;
+    let mut desc = data.desc(mlt::Backend::Bvh);
+    if name == "window-room" {
+        desc.lights = mlt::LightsDesc {
+            environment: Some(mlt::EnvironmentDesc {
+                pixels: &sky,
+                width: sky_width,
+                height: sky_height,
+                rotation_degrees: 0.0,
+                scale: 1.0,
+            }),
+            sun: Some(super::window_room::sun()),
+            ..Default::default()
+        };
+    }
+    let scene = Scene::new(&desc).expect("scene builds");
     let camera = data.camera.expect("camera sidecar").camera;
     (scene, camera)
 }

@@ -5,6 +5,7 @@ pub mod door_ajar;
 pub mod generate;
 pub mod lamp_behind_glass;
 pub mod obj_text;
+pub mod sky_spheres;
 pub mod window_room;
 
 use mlt::{Backend, Camera, Material, Scene, SceneDesc};

@@ -4,7 +4,8 @@
 //!
 //! Written as tests/scenes/window-room.{obj,mtl,camera.json} by this generator; the sky is
 //! built in code (`sky_pixels`, an equirectangular map: a blue gradient above the horizon,
-//! brighter around the sun, dark ground below) and the sun is `sun()`. The camera stands by
+//! brighter around the sun, dark ground below; also written as tests/scenes/sky.exr for the
+//! command line's `--env`) and the sun is `sun()`. The camera stands by
 //! the window wall and looks into the room, at the sun's patch on the floor, so nothing it
 //! sees directly is lit except through the window.
 //!

@@ -429,6 +429,25 @@ mod tests {
         }
     }
 
+    /// The rotation turns the map about +Y as documented: what the unrotated map shows
+    /// along d arrives from R_y(α) d (R_y the right-handed rotation), and the density turns
+    /// with it. The map's centre looks along +Z.
+    #[test]
+    fn rotation_turns_the_map_about_y() {
+        let (unrotated, rotated) = (map(0.0), map(67.5));
+        let (sin, cos) = 67.5f32.to_radians().sin_cos();
+        let r_y = |d: Vec3A| Vec3A::new(cos * d.x + sin * d.z, d.y, -sin * d.x + cos * d.z);
+        let mut rng = Rng::new(8, 8);
+        for _ in 0..1000 {
+            let d = uniform_sphere(rng.uniform2());
+            assert_eq!(rotated.radiance(r_y(d)), unrotated.radiance(d));
+            let (a, b) = (rotated.pdf(r_y(d)), unrotated.pdf(d));
+            assert!((a - b).abs() <= 1e-4 * a.max(b), "{a} vs {b}");
+        }
+        // Column u = 0.5 (φ = π) is the direction +Z.
+        assert_eq!(EnvironmentMap::uv(Vec3A::Z).0, [0.5, 0.5]);
+    }
+
     /// A deliberate error the χ² test must catch: forgetting the sin θ factor.
     #[test]
     fn the_histogram_test_catches_a_missing_sin_theta() {
