@@ -118,7 +118,7 @@ mod tests {
             area_pdf,
             normal,
             ..
-        }) = scene.sample_light(0.3, [0.2, 0.7])
+        }) = scene.lights.sample_light(0.3, [0.2, 0.7])
         else {
             panic!("the only light is an area light")
         };

@@ -565,3 +565,50 @@ fn rendered_images_agree() {
         4.0,
     );
 }
+
+/// The window room (tests/common/window_room.rs) lit by its sky map and sun through each
+/// backend: rays that leave the scene, shadow rays towards infinity and light subpaths from
+/// the disc around the scene agree within the statistical error (BDPT, which uses them all).
+#[test]
+fn window_room_images_agree() {
+    let mesh = canonical_mesh("window-room");
+    let camera = canonical_camera("window-room");
+    let sky = window_room::sky_pixels();
+    let (width, height) = window_room::SKY_SIZE;
+    let lights = mlt::LightsDesc {
+        environment: Some(mlt::EnvironmentDesc {
+            pixels: &sky,
+            width,
+            height,
+            rotation_degrees: 0.0,
+            scale: 1.0,
+        }),
+        sun: Some(window_room::sun()),
+        ..Default::default()
+    };
+    let estimate = |backend, seeds: std::ops::Range<u64>| {
+        let scene = mesh.scene_lit(backend, lights);
+        let renders: Vec<Vec<f32>> = seeds
+            .map(|seed| {
+                let settings = mlt::RenderSettings {
+                    width: 32,
+                    height: 32,
+                    algorithm: mlt::Algorithm::Bdpt,
+                    samples_per_pixel: 160,
+                    seed,
+                    ..Default::default()
+                };
+                render_image(&scene, &camera, &settings)
+            })
+            .collect();
+        Estimate::from_correlated_renders(32, 32, &renders)
+    };
+    assert_estimates_agree(
+        "window room, embree vs bvh",
+        &estimate(Backend::Embree, 100..112),
+        &estimate(Backend::Bvh, 0..12),
+        2,
+        5.0,
+        6.0,
+    );
+}

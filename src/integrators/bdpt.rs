@@ -171,7 +171,7 @@ impl Bdpt<'_> {
             {
                 self.scene.emission(v.triangle)
             }
-            VertexKind::Light(Emitter::Infinite) => self.scene.infinite_radiance(v.normal),
+            VertexKind::Light(Emitter::Infinite) => self.scene.lights.infinite_radiance(v.normal),
             _ => Spectrum::ZERO,
         }
     }
@@ -208,7 +208,10 @@ impl Bdpt<'_> {
                 let Some((w, _)) = direction(v, next) else {
                     return 0.0;
                 };
-                let pdf = self.scene.emission_direction_pdf(emitter, v.normal, w);
+                let pdf = self
+                    .scene
+                    .lights
+                    .emission_direction_pdf(emitter, v.normal, w);
                 if pdf <= 0.0 {
                     return 0.0;
                 }
@@ -255,7 +258,7 @@ impl Bdpt<'_> {
             counters.rays += 1;
             let Some(hit) = self.scene.accel.intersect(&ray) else {
                 // A camera subpath that leaves the scene ends on the lights at infinity.
-                if mode == TransportMode::Radiance && self.scene.has_infinite_light() {
+                if mode == TransportMode::Radiance && self.scene.lights.has_infinite_light() {
                     path[count] = Vertex {
                         kind: VertexKind::Light(Emitter::Infinite),
                         p: ray.origin,
@@ -362,7 +365,11 @@ impl Bdpt<'_> {
         if max_vertices == 0 {
             return 0;
         }
-        let Some(light) = self.scene.sample_emission(u_select, u_point, u_direction) else {
+        let Some(light) = self
+            .scene
+            .lights
+            .sample_emission(u_select, u_point, u_direction)
+        else {
             return 0;
         };
         let triangle = match light.emitter {
@@ -712,7 +719,7 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let (sampled, contribution) = match self.scene.sample_light(u_select, u_point)? {
+            let (sampled, contribution) = match self.scene.lights.sample_light(u_select, u_point)? {
                 LightSample::Area {
                     point,
                     normal,
@@ -761,7 +768,7 @@ impl Bdpt<'_> {
                         kind: VertexKind::Light(Emitter::Point(light)),
                         p: position,
                         normal: -w,
-                        beta: self.scene.point_light(light).intensity(-w) / pdf,
+                        beta: self.scene.lights.point_light(light).intensity(-w) / pdf,
                         pdf_forward: pdf,
                         ..Vertex::EMPTY
                     };

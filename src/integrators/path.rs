@@ -50,12 +50,12 @@ impl PathTracer<'_> {
             *rays += 1;
             let Some(hit) = scene.accel.intersect(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
-                if depth >= self.min_depth && scene.has_infinite_light() {
-                    let emission = scene.infinite_radiance(ray.direction);
+                if depth >= self.min_depth && scene.lights.has_infinite_light() {
+                    let emission = scene.lights.infinite_radiance(ray.direction);
                     let weight = if previous_specular {
                         1.0
                     } else {
-                        power_heuristic(previous_pdf, scene.infinite_pdf(ray.direction))
+                        power_heuristic(previous_pdf, scene.lights.infinite_pdf(ray.direction))
                     };
                     radiance += throughput * emission * weight;
                 }
@@ -138,7 +138,7 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
-        match scene.sample_light(u_select, u_point) {
+        match scene.lights.sample_light(u_select, u_point) {
             None => Spectrum::ZERO,
             Some(LightSample::Area {
                 point: y,
@@ -183,7 +183,7 @@ impl PathTracer<'_> {
                     return Spectrum::ZERO;
                 }
                 let wi = to_light / distance2.sqrt();
-                let intensity = scene.point_light(light).intensity(-wi);
+                let intensity = scene.lights.point_light(light).intensity(-wi);
                 let f = bsdf.eval(wo, wi);
                 if f.is_black() || intensity.is_black() {
                     return Spectrum::ZERO;

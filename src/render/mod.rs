@@ -199,7 +199,7 @@ fn render_into(
     if matches!(
         settings.algorithm,
         Algorithm::PathSpaceMlt | Algorithm::Erpt
-    ) && scene.has_non_area_lights()
+    ) && scene.lights.has_non_area_lights()
     {
         return Err(Error::new(
             crate::error::MltStatus::MLT_STATUS_UNSUPPORTED,

@@ -12,7 +12,6 @@ pub use material::{Material, MaterialKind};
 
 use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
-use crate::sampling::Distribution1D;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
@@ -60,16 +59,8 @@ pub struct Scene {
     pub(crate) shading: Vec<TriangleShading>,
     pub(crate) materials: Vec<Material>,
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
-    /// lights, a delta sun, the lights at infinity.
-    pub(crate) lights: Vec<lights::Light>,
-    pub(crate) light_distribution: Distribution1D,
-    /// The environment and sun disc, if any.
-    pub(crate) infinite: Option<lights::InfiniteLight>,
-    /// Selection probability of the lights at infinity (0: none, or black).
-    pub(crate) infinite_select_pdf: f32,
-    /// Centre and radius of a sphere around the geometry: light subpaths from infinity
-    /// start on a disc of this radius.
-    pub(crate) bounding_sphere: (Vec3A, f32),
+    /// lights, a delta sun, the lights at infinity; with their selection distribution.
+    pub(crate) lights: lights::SceneLights,
     /// Internal triangle index → the host's triangle id.
     internal_to_input: Vec<u32>,
     /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
@@ -160,13 +151,9 @@ impl Scene {
         // A little larger than the box's sphere: rays from its disc start outside the geometry.
         let radius = ((bounds_max - bounds_min).length() * 0.5 * 1.01).max(1e-3);
         // Lights are picked in proportion to their emitted power.
-        let scene_lights = lights::SceneLights::new(lights, &desc.lights, radius);
-        let light_distribution = scene_lights.distribution;
-        let mut all_lights = scene_lights.lights;
-        let area = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
-        for (index, light) in all_lights.iter_mut().enumerate() {
+        let scene_lights = lights::SceneLights::new(lights, &desc.lights, (center, radius));
+        for light in &scene_lights.lights {
             if let lights::Light::Area(light) = light {
-                light.area_pdf = light_distribution.discrete_pdf(index) / area(light);
                 shading[light.triangle as usize].light_area_pdf = light.area_pdf;
             }
         }
@@ -186,15 +173,39 @@ impl Scene {
             accel,
             shading,
             materials: desc.materials.to_vec(),
-            lights: all_lights,
-            light_distribution,
-            infinite: scene_lights.infinite,
-            infinite_select_pdf: scene_lights.infinite_select_pdf,
-            bounding_sphere: (center, radius),
+            lights: scene_lights,
             internal_to_input,
             ray_epsilon: magnitude * 2e-5,
             info,
         })
+    }
+
+    /// The area density with which `sample_light` picks a point on internal triangle
+    /// `triangle` (0 for triangles that do not emit).
+    #[inline]
+    pub(crate) fn light_area_pdf(&self, triangle: u32) -> f32 {
+        self.shading[triangle as usize].light_area_pdf
+    }
+
+    /// Radiance the front side of internal triangle `triangle` emits, if it is a light
+    /// (`light_area_pdf` > 0: the integrators ask that first).
+    #[inline]
+    pub(crate) fn emission(&self, triangle: u32) -> Spectrum {
+        let material = self.shading[triangle as usize].material;
+        Spectrum::from(self.materials[material as usize].emission)
+    }
+
+    /// Density of light vertex `emitter` as the start of a light subpath (see
+    /// `EmissionSample::pdf_origin`); `toward` is the direction of a light at infinity.
+    #[inline]
+    pub(crate) fn emission_origin_pdf(&self, emitter: lights::Emitter, toward: Vec3A) -> f32 {
+        match emitter {
+            lights::Emitter::Area(triangle) => self.light_area_pdf(triangle),
+            lights::Emitter::Point(index) | lights::Emitter::Directional(index) => {
+                self.lights.light_select_pdf(index)
+            }
+            lights::Emitter::Infinite => self.lights.infinite_pdf(toward),
+        }
     }
 
     pub fn info(&self) -> SceneInfo {

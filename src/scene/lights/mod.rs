@@ -3,9 +3,9 @@
 //! sun disc, one light), picked in proportion to their power.
 //!
 //! Every integrator that samples a light (next-event estimation, light subpaths, the
-//! bidirectional mutation's new light vertex) calls [`Scene::sample_light`] or
-//! [`Scene::sample_emission`], and every ray that leaves the scene asks
-//! [`Scene::infinite_radiance`], so another kind of light changes this module, not theirs.
+//! bidirectional mutation's new light vertex) calls `sample_light` or `sample_emission`,
+//! and every ray that leaves the scene asks `infinite_radiance` (the `Scene` forwards them
+//! to its [`SceneLights`]), so another kind of light changes this module, not theirs.
 //!
 //! Power is measured as Φ/π (luminance times area for an area light), so that a scene of
 //! area lights picks them exactly as before the other kinds existed.
@@ -14,7 +14,7 @@ mod environment;
 
 pub(crate) use environment::{EnvironmentMap, InfiniteLight, SunDisc, uniform_sphere};
 
-use super::Scene;
+use super::light_desc::{LightsDesc, PunctualLightKind};
 use crate::sampling::{OrthonormalBasis, uniform_disk, uniform_triangle};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
@@ -224,7 +224,7 @@ pub(crate) struct EmissionSample {
     pub beta: Spectrum,
 }
 
-impl Scene {
+impl SceneLights {
     /// Picks a light by power with `u_select` and a point or direction on it with
     /// `u_point`; `None` if the scene has no lights or the sample has zero density. The
     /// caller draws both numbers (always, whether or not there are lights, where its
@@ -234,7 +234,7 @@ impl Scene {
         if self.lights.is_empty() {
             return None;
         }
-        let (index, select_pdf, _) = self.light_distribution.sample_discrete(u_select);
+        let (index, select_pdf, _) = self.distribution.sample_discrete(u_select);
         match &self.lights[index] {
             Light::Area(light) => {
                 let [b1, b2] = uniform_triangle(u_point);
@@ -281,7 +281,7 @@ impl Scene {
         if self.lights.is_empty() {
             return None;
         }
-        let (index, select_pdf, _) = self.light_distribution.sample_discrete(u_select);
+        let (index, select_pdf, _) = self.distribution.sample_discrete(u_select);
         match &self.lights[index] {
             Light::Area(light) => {
                 let [b1, b2] = uniform_triangle(u_point);
@@ -384,21 +384,6 @@ impl Scene {
             .any(|light| !matches!(light, Light::Area(_)))
     }
 
-    /// The area density with which `sample_light` picks a point on internal triangle
-    /// `triangle` (0 for triangles that do not emit).
-    #[inline]
-    pub(crate) fn light_area_pdf(&self, triangle: u32) -> f32 {
-        self.shading[triangle as usize].light_area_pdf
-    }
-
-    /// Radiance the front side of internal triangle `triangle` emits, if it is a light
-    /// (`light_area_pdf` > 0: the integrators ask that first).
-    #[inline]
-    pub(crate) fn emission(&self, triangle: u32) -> Spectrum {
-        let material = self.shading[triangle as usize].material;
-        Spectrum::from(self.materials[material as usize].emission)
-    }
-
     /// Whether rays that leave the scene can find light (an environment or a sun disc).
     #[inline]
     pub(crate) fn has_infinite_light(&self) -> bool {
@@ -436,7 +421,7 @@ impl Scene {
     /// Selection probability of light number `index`.
     #[inline]
     pub(crate) fn light_select_pdf(&self, index: u32) -> f32 {
-        self.light_distribution.discrete_pdf(index as usize)
+        self.distribution.discrete_pdf(index as usize)
     }
 
     /// Density in solid angle with which a light subpath leaves light vertex `emitter`
@@ -453,17 +438,6 @@ impl Scene {
             Emitter::Directional(_) | Emitter::Infinite => self.disc_pdf(),
         }
     }
-
-    /// Density of light vertex `emitter` as the start of a light subpath (see
-    /// `EmissionSample::pdf_origin`); `toward` is the direction of a light at infinity.
-    #[inline]
-    pub(crate) fn emission_origin_pdf(&self, emitter: Emitter, toward: Vec3A) -> f32 {
-        match emitter {
-            Emitter::Area(triangle) => self.light_area_pdf(triangle),
-            Emitter::Point(index) | Emitter::Directional(index) => self.light_select_pdf(index),
-            Emitter::Infinite => self.infinite_pdf(toward),
-        }
-    }
 }
 
 /// The scene's lights in selection order, their selection distribution and the lights at
@@ -471,14 +445,24 @@ impl Scene {
 pub(crate) struct SceneLights {
     pub lights: Vec<Light>,
     pub distribution: crate::sampling::Distribution1D,
+    /// The environment and sun disc, if any.
     pub infinite: Option<InfiniteLight>,
+    /// Selection probability of the lights at infinity (0: none, or black).
     pub infinite_select_pdf: f32,
+    /// Centre and radius of a sphere around the geometry: light subpaths from infinity
+    /// start on a disc of this radius.
+    pub bounding_sphere: (Vec3A, f32),
 }
 
 impl SceneLights {
-    /// `area` in the host's triangle order; `bounds_radius` is the radius of the scene's
-    /// bounding sphere (the environment's power is estimated through it).
-    pub fn new(area: Vec<AreaLight>, desc: &super::LightsDesc, bounds_radius: f32) -> SceneLights {
+    /// `area` in the host's triangle order (their `area_pdf` is filled here);
+    /// `bounding_sphere` is the scene's (the environment's power is estimated through it).
+    pub fn new(
+        area: Vec<AreaLight>,
+        desc: &LightsDesc,
+        bounding_sphere: (Vec3A, f32),
+    ) -> SceneLights {
+        let bounds_radius = bounding_sphere.1;
         let area_of = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
         let mut lights: Vec<Light> = Vec::with_capacity(area.len() + desc.punctual.len() + 2);
         let mut power: Vec<f32> = Vec::with_capacity(lights.capacity());
@@ -488,7 +472,7 @@ impl SceneLights {
         }
         let r2 = bounds_radius * bounds_radius;
         for punctual in desc.punctual {
-            use super::PunctualLightKind as Kind;
+            use PunctualLightKind as Kind;
             let intensity = Spectrum::from(punctual.intensity);
             let light = match punctual.kind {
                 Kind::Point | Kind::Spot => {
@@ -549,11 +533,17 @@ impl SceneLights {
         // Lights that emit nothing are never picked (zero weight) but keep their index.
         let distribution = crate::sampling::Distribution1D::new(&power);
         let infinite_select_pdf = infinite_index.map_or(0.0, |i| distribution.discrete_pdf(i));
+        for (index, light) in lights.iter_mut().enumerate() {
+            if let Light::Area(light) = light {
+                light.area_pdf = distribution.discrete_pdf(index) / area_of(light);
+            }
+        }
         SceneLights {
             lights,
             distribution,
             infinite,
             infinite_select_pdf,
+            bounding_sphere,
         }
     }
 }

@@ -213,10 +213,10 @@ impl Bidirectional {
         match path {
             [] => {
                 // No numbers are drawn without a light (the chain's random sequence stays).
-                if !scene.has_lights() {
+                if !scene.lights.has_lights() {
                     return None;
                 }
-                match scene.sample_light(rng.uniform(), rng.uniform2())? {
+                match scene.lights.sample_light(rng.uniform(), rng.uniform2())? {
                     crate::scene::lights::LightSample::Area {
                         point,
                         normal,
