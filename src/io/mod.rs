@@ -5,6 +5,7 @@
 //! - [`load_scene`] reads Wavefront OBJ (+ MTL, + `NAME.camera.json` beside it) or glTF 2.0
 //!   (`.gltf` / `.glb`) into flat arrays ([`SceneData`]) ready for [`crate::Scene::new`].
 //! - [`load_camera_json`] reads a camera sidecar file.
+//! - [`load_environment`] reads an environment map (`.hdr`, `.exr`) as linear RGB floats.
 //! - [`write_image`] writes the renderer's linear RGB buffer as PFM, OpenEXR or PNG.
 //!
 //! Every failure is an [`IoError`] whose message is one sentence naming the file and what is
@@ -31,6 +32,7 @@
 //! Textures are ignored.
 
 mod camera_file;
+mod environment_file;
 mod gltf_file;
 mod image_file;
 mod obj;
@@ -39,6 +41,7 @@ mod scene_data;
 use std::path::Path;
 
 pub use camera_file::load_camera_json;
+pub use environment_file::load_environment;
 pub use image_file::{ImageFormat, read_pfm, write_exr, write_image, write_pfm, write_png};
 pub use scene_data::{CameraFile, IoError, SceneData};
 
