@@ -176,6 +176,10 @@ pub struct MltPunctualLight {
 ///
 /// Degenerate triangles (zero area, e.g. repeated or collinear vertices) are accepted: they
 /// keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
+///
+/// Light comes from emissive triangles and from an environment, a sun and punctual lights
+/// (the fields after `backend`; a host built against a header from before them, whose
+/// struct ends at `backend`, gets none of those).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltSceneDesc {

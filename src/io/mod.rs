@@ -60,6 +60,11 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   with `KHR_materials_ior` (1.5 if absent); metallic 1 and roughness 0 → mirror with the
 ///   base color; else diffuse with the base color. Primitives without a material get the glTF
 ///   default material (white diffuse). Textures, normals and other attributes are ignored.
+///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into
+///   [`SceneData::punctual_lights`]: at their node's world origin, pointing along its world
+///   −Z, with `color × intensity / 683` (candela and lux over 683 lm/W, Blender's factor:
+///   W/sr for point and spot lights, W/m² for directional ones), spot cone angles in
+///   degrees; `range` is ignored.
 ///
 /// A file without any triangle is an error.
 pub fn load_scene(path: &Path) -> Result<SceneData, IoError> {
