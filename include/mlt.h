@@ -69,6 +69,24 @@
 #define MLT_MATERIAL_DIELECTRIC 2
 
 /**
+ * `MltPunctualLight.kind`: radiates `intensity` equally in every direction from `position`.
+ */
+#define MLT_LIGHT_POINT 0
+
+/**
+ * `MltPunctualLight.kind`: radiates from `position` into a cone about `direction`, full
+ * `intensity` within `inner_cone_degrees` of the axis, none beyond `outer_cone_degrees`,
+ * with glTF's smooth falloff between.
+ */
+#define MLT_LIGHT_SPOT 1
+
+/**
+ * `MltPunctualLight.kind`: light travelling along `direction` from infinitely far away,
+ * with irradiance `intensity` on a plane facing it.
+ */
+#define MLT_LIGHT_DIRECTIONAL 2
+
+/**
  * `MltSceneDesc.backend`: mlt's own SIMD BVH (8-wide with AVX2, else 4-wide; built with
  * obvhs), always available.
  */
@@ -219,6 +237,21 @@
 #define MLT_MAX_NORMALIZATION_WORK_FRACTION 0.9
 
 /**
+ * Largest width or height of an environment map, in texels.
+ */
+#define MLT_MAX_ENVIRONMENT_SIDE (1 << 16)
+
+/**
+ * Most texels of an environment map (width × height): 2^28, 3 GiB of RGB floats.
+ */
+#define MLT_MAX_ENVIRONMENT_TEXELS (1 << 28)
+
+/**
+ * Most punctual lights of a scene.
+ */
+#define MLT_MAX_PUNCTUAL_LIGHTS (1 << 20)
+
+/**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
  */
 typedef enum MltStatus {
@@ -291,12 +324,121 @@ typedef struct MltMaterial {
 } MltMaterial;
 
 /**
+ * An environment: radiance arriving from infinitely far away, seen by every ray that
+ * leaves the scene and sampled as a light by every algorithm. Initialize with
+ * `mlt_environment_default`; for a constant colour, `mlt_environment_constant`.
+ *
+ * The map is equirectangular (latitude-longitude) with +Y up: column u in [0, 1) (left to
+ * right) is the azimuth phi = 2 pi u, row v in [0, 1) (top to bottom) the polar angle
+ * theta = pi v from +Y, and the direction is (sin phi sin theta, cos theta, -cos phi sin
+ * theta): the map's centre looks along +Z, its left and right edges along -Z (Mitsuba 3's
+ * convention).
+ */
+typedef struct MltEnvironment {
+  /**
+   * sizeof(MltEnvironment) of the header the host was built with: set by `mlt_environment_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
+  /**
+   * Linear RGB radiance, 3 floats per texel, rows from the top: width × height × 3
+   * floats, each finite and >= 0. Copied by `mlt_scene_create`.
+   */
+  const float *pixels;
+  /**
+   * Texels per row and rows, each in [1, `MLT_MAX_ENVIRONMENT_SIDE`], at most
+   * `MLT_MAX_ENVIRONMENT_TEXELS` together. A 1 × 1 map is a constant environment.
+   */
+  uint32_t width;
+  uint32_t height;
+  /**
+   * Turns the environment about +Y by this many degrees (counter-clockwise seen from
+   * above); finite.
+   */
+  float rotation_degrees;
+  /**
+   * Multiplies every texel; finite and >= 0. Default 1.
+   */
+  float scale;
+} MltEnvironment;
+
+/**
+ * The sun: a distant disc of uniform radiance (or a delta direction, with an angular
+ * radius of 0). Initialize with `mlt_sun_default`.
+ */
+typedef struct MltSun {
+  /**
+   * sizeof(MltSun) of the header the host was built with: set by `mlt_sun_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
+  /**
+   * From the scene towards the sun; any finite length but zero. Default +Y (noon).
+   */
+  float direction[3];
+  /**
+   * Half the angle the disc subtends, in degrees, in [0, 45]: 0 is a delta direction
+   * (hard shadows); the real sun is about 0.27 (the default).
+   */
+  float angular_radius_degrees;
+  /**
+   * Linear RGB irradiance on a plane facing the sun, each finite and >= 0 (the disc's
+   * radiance is this over pi sin^2 of the angular radius). Default 1.
+   */
+  float irradiance[3];
+} MltSun;
+
+/**
+ * A point, spot or directional light (glTF's `KHR_lights_punctual`): a delta light, hit by
+ * no ray, reached by connections only. Initialize with `mlt_punctual_light_default` (a
+ * white point light at the origin).
+ */
+typedef struct MltPunctualLight {
+  /**
+   * sizeof(MltPunctualLight) of the header the host was built with: set by `mlt_punctual_light_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
+  /**
+   * One of `MLT_LIGHT_*`.
+   */
+  int32_t kind;
+  /**
+   * Point and spot lights: where the light is; finite (ignored for directional lights).
+   */
+  float position[3];
+  /**
+   * Spot: the cone's axis; directional: the direction the light travels. Any finite
+   * length but zero (ignored for point lights).
+   */
+  float direction[3];
+  /**
+   * Linear RGB, each finite and >= 0: radiant intensity (W/sr) of a point light and of a
+   * spot on its axis, irradiance (W/m^2) on a plane facing a directional light.
+   */
+  float intensity[3];
+  /**
+   * Spot: full intensity within this angle from the axis, in degrees (default 0).
+   */
+  float inner_cone_degrees;
+  /**
+   * Spot: no light beyond this angle from the axis, in degrees; 0 <= inner < outer <= 90
+   * (default 45).
+   */
+  float outer_cone_degrees;
+} MltPunctualLight;
+
+/**
  * Everything `mlt_scene_create` needs, as plain arrays the host keeps ownership of (they are
  * copied; the host may free them once the call returns). Initialize with
  * `mlt_scene_desc_default`.
  *
  * Degenerate triangles (zero area, e.g. repeated or collinear vertices) are accepted: they
  * keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
+ *
+ * Light comes from emissive triangles and from an environment, a sun and punctual lights
+ * (the fields after `backend`; a host built against a header from before them, whose
+ * struct ends at `backend`, gets none of those).
  */
 typedef struct MltSceneDesc {
   /**
@@ -335,6 +477,24 @@ typedef struct MltSceneDesc {
    * One of `MLT_BACKEND_*`.
    */
   int32_t backend;
+  /**
+   * An environment lighting the scene from infinitely far away, or NULL (the default)
+   * for none (black).
+   */
+  const struct MltEnvironment *environment;
+  /**
+   * The sun, or NULL (the default) for none.
+   */
+  const struct MltSun *sun;
+  /**
+   * Point, spot and directional lights, each initialized by `mlt_punctual_light_default`;
+   * may be NULL with a length of 0 (the default).
+   */
+  const struct MltPunctualLight *punctual_lights;
+  /**
+   * Number of entries in `punctual_lights`, at most `MLT_MAX_PUNCTUAL_LIGHTS`.
+   */
+  size_t punctual_lights_len;
 } MltSceneDesc;
 
 /**
@@ -713,6 +873,33 @@ MLT_API enum MltStatus mlt_material_init(struct MltMaterial *out, size_t struct_
 MLT_API enum MltStatus mlt_scene_desc_init(struct MltSceneDesc *out, size_t struct_size);
 
 /**
+ * Fills `out` with an empty environment (no pixels, rotation 0, scale 1): set `pixels`,
+ * `width` and `height` before passing it.
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_environment_init(struct MltEnvironment *out, size_t struct_size);
+
+/**
+ * Fills `out` with a white sun of irradiance 1 straight above (+Y), of the real sun's
+ * angular radius (0.27 degrees).
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_sun_init(struct MltSun *out, size_t struct_size);
+
+/**
+ * Fills `out` with a point light of intensity 1 at the origin (for a spot: axis -Z, cone
+ * 0 to 45 degrees).
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_punctual_light_init(struct MltPunctualLight *out, size_t struct_size);
+
+/**
  * Fills `out` with the Cornell box's pinhole camera.
  *
  * # Safety
@@ -846,5 +1033,25 @@ static inline MltStatus mlt_render_stats_default(MltRenderStats *out) {
 }
 static inline MltStatus mlt_scene_info_default(MltSceneInfo *out) {
     return mlt_scene_info_init(out, sizeof(MltSceneInfo));
+}
+static inline MltStatus mlt_environment_default(MltEnvironment *out) {
+    return mlt_environment_init(out, sizeof(MltEnvironment));
+}
+static inline MltStatus mlt_sun_default(MltSun *out) {
+    return mlt_sun_init(out, sizeof(MltSun));
+}
+static inline MltStatus mlt_punctual_light_default(MltPunctualLight *out) {
+    return mlt_punctual_light_init(out, sizeof(MltPunctualLight));
+}
+/* A constant environment of radiance rgb[0..3]: a 1 x 1 map whose pixel is rgb, which must
+ * stay valid until mlt_scene_create returns (it is copied then). */
+static inline MltStatus mlt_environment_constant(MltEnvironment *out, const float *rgb) {
+    MltStatus status = mlt_environment_default(out);
+    if (status == MLT_STATUS_OK) {
+        out->pixels = rgb;
+        out->width = 1;
+        out->height = 1;
+    }
+    return status;
 }
 #endif  /* MLT_H_INITIALIZERS */

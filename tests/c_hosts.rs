@@ -349,3 +349,42 @@ fn minimal_c_reports_a_bad_size_through_the_status_helper() {
         "{stderr}"
     );
 }
+
+/// `c_examples/sky.c` lights a ground square only by a constant environment set through
+/// `mlt_environment_constant`: every pixel converges to 0.5 (albedo 0.5 under radiance 1),
+/// checked against the standard error of the pixels' mean. Built as C99 and as C++.
+#[test]
+fn sky_c_lights_a_scene_with_a_constant_environment() {
+    for (exe_name, as_cpp, flags) in [
+        ("sky_c99", false, &["-std=c99"][..]),
+        ("sky_cpp", true, &["-x", "c++"][..]),
+    ] {
+        let exe = build("sky.c", exe_name, as_cpp, flags);
+        let pfm_path = scratch_dir().join(format!("{exe_name}.pfm"));
+        let _ = std::fs::remove_file(&pfm_path);
+        let output = Command::new(exe)
+            .arg(&pfm_path)
+            .args(["16", "16", "64"])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success(),
+            "{exe_name}: {stdout}{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(stdout.contains("(converges to 0.5)"), "{stdout}");
+        let image = read_pfm(&pfm_path);
+        assert_eq!((image.width, image.height), (16, 16));
+        let (mean, error) = common::mean_and_standard_error(&image.rgb);
+        for c in 0..3 {
+            common::assert_within_and_sharp(
+                &format!("{exe_name} channel {c}"),
+                mean[c],
+                0.5,
+                error[c],
+                4.0,
+            );
+        }
+    }
+}

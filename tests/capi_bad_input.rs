@@ -20,6 +20,7 @@ use mlt::render::{
     MLT_MAX_DEPTH_LIMIT, MLT_MAX_ERPT_CHAIN_LENGTH, MLT_MAX_IMAGE_SIDE, MLT_MAX_SAMPLES_PER_PIXEL,
     MLT_MAX_THREADS, MLT_MAX_TIME_LIMIT_SECONDS,
 };
+use mlt::scene::{MLT_MAX_ENVIRONMENT_SIDE, MLT_MAX_PUNCTUAL_LIGHTS};
 use std::ffi::{CStr, c_void};
 use std::ptr::{null, null_mut};
 
@@ -2066,4 +2067,451 @@ fn extreme_camera_values_are_rejected_or_rendered() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+// ---------------------------------------------------------------------------------------
+// mlt_scene_create: lights besides emissive triangles
+// ---------------------------------------------------------------------------------------
+
+fn default_environment() -> MltEnvironment {
+    let mut e = std::mem::MaybeUninit::<MltEnvironment>::uninit();
+    // SAFETY: writable memory for an MltEnvironment.
+    assert_ok(unsafe { mlt_environment_init(e.as_mut_ptr(), size_of::<MltEnvironment>()) });
+    // SAFETY: initialized on success.
+    unsafe { e.assume_init() }
+}
+
+fn default_sun() -> MltSun {
+    let mut s = std::mem::MaybeUninit::<MltSun>::uninit();
+    // SAFETY: as above.
+    assert_ok(unsafe { mlt_sun_init(s.as_mut_ptr(), size_of::<MltSun>()) });
+    unsafe { s.assume_init() }
+}
+
+fn default_punctual_light() -> MltPunctualLight {
+    let mut l = std::mem::MaybeUninit::<MltPunctualLight>::uninit();
+    // SAFETY: as above.
+    assert_ok(unsafe { mlt_punctual_light_init(l.as_mut_ptr(), size_of::<MltPunctualLight>()) });
+    unsafe { l.assume_init() }
+}
+
+/// A scene with every kind of light: `HostScene::floor_and_light` under a 2 × 1
+/// environment, a sun, and a point, a spot and a directional light (in that order).
+struct HostLights {
+    host: HostScene,
+    /// What `environment.pixels` points to (set at construction: the vector's buffer does
+    /// not move with the struct).
+    pixels: Vec<f32>,
+    environment: MltEnvironment,
+    sun: MltSun,
+    punctual: Vec<MltPunctualLight>,
+}
+
+impl HostLights {
+    fn new() -> Self {
+        let pixels = vec![0.5, 0.6, 0.7, 1.0, 1.0, 1.0];
+        let environment = MltEnvironment {
+            pixels: pixels.as_ptr(),
+            width: 2,
+            height: 1,
+            rotation_degrees: 30.0,
+            scale: 2.0,
+            ..default_environment()
+        };
+        let sun = MltSun {
+            direction: [1.0, 2.0, 0.5],
+            angular_radius_degrees: 1.0,
+            irradiance: [3.0, 2.0, 1.0],
+            ..default_sun()
+        };
+        let point = MltPunctualLight {
+            position: [0.0, 1.0, 0.0],
+            intensity: [1.0, 2.0, 3.0],
+            ..default_punctual_light()
+        };
+        let spot = MltPunctualLight {
+            kind: MLT_LIGHT_SPOT,
+            position: [0.5, 1.5, 0.0],
+            direction: [0.0, -1.0, 0.0],
+            inner_cone_degrees: 10.0,
+            outer_cone_degrees: 20.0,
+            ..default_punctual_light()
+        };
+        let directional = MltPunctualLight {
+            kind: MLT_LIGHT_DIRECTIONAL,
+            direction: [0.3, -1.0, 0.0],
+            ..default_punctual_light()
+        };
+        HostLights {
+            host: HostScene::floor_and_light(),
+            pixels,
+            environment,
+            sun,
+            punctual: vec![point, spot, directional],
+        }
+    }
+
+    fn desc(&self) -> MltSceneDesc {
+        MltSceneDesc {
+            environment: &self.environment,
+            sun: &self.sun,
+            punctual_lights: self.punctual.as_ptr(),
+            punctual_lights_len: self.punctual.len(),
+            ..self.host.desc()
+        }
+    }
+}
+
+#[test]
+fn light_defaults_are_valid_and_documented() {
+    let d = default_desc();
+    assert!(d.environment.is_null() && d.sun.is_null());
+    assert!(d.punctual_lights.is_null() && d.punctual_lights_len == 0);
+    let e = default_environment();
+    assert!(e.pixels.is_null());
+    assert_eq!(
+        (e.width, e.height, e.rotation_degrees, e.scale),
+        (0, 0, 0.0, 1.0)
+    );
+    let s = default_sun();
+    assert_eq!(
+        (s.direction, s.angular_radius_degrees, s.irradiance),
+        ([0.0, 1.0, 0.0], 0.27, [1.0; 3])
+    );
+    let l = default_punctual_light();
+    assert_eq!(
+        (l.kind, l.position, l.intensity),
+        (MLT_LIGHT_POINT, [0.0; 3], [1.0; 3])
+    );
+    assert_eq!(
+        (l.direction, l.inner_cone_degrees, l.outer_cone_degrees),
+        ([0.0, 0.0, -1.0], 0.0, 45.0)
+    );
+    // Every kind of light together, valid.
+    let lights = HostLights::new();
+    let mut out = null_mut();
+    // SAFETY: the desc points into live values.
+    assert_ok(unsafe { mlt_scene_create(&lights.desc(), &mut out) });
+    drop(Handle(out));
+}
+
+#[test]
+fn light_initializers_refuse_null_and_unknown_sizes() {
+    type Init = fn(*mut u8, usize) -> MltStatus;
+    // SAFETY (each closure): forwards the pointer and size to the initializer under test.
+    let initializers: [(&str, usize, Init); 3] = [
+        (
+            "mlt_environment_default",
+            size_of::<MltEnvironment>(),
+            |p, n| unsafe { mlt_environment_init(p.cast(), n) },
+        ),
+        ("mlt_sun_default", size_of::<MltSun>(), |p, n| unsafe {
+            mlt_sun_init(p.cast(), n)
+        }),
+        (
+            "mlt_punctual_light_default",
+            size_of::<MltPunctualLight>(),
+            |p, n| unsafe { mlt_punctual_light_init(p.cast(), n) },
+        ),
+    ];
+    let mut results = Vec::new();
+    for (name, size, init) in initializers {
+        let mut storage = [0xABu8; 256];
+        let aligned = storage
+            .as_mut_ptr()
+            .wrapping_add(storage.as_ptr().align_offset(8));
+        let status = init(null_mut(), size);
+        results.push((
+            format!("{name}: out NULL"),
+            check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
+        ));
+        for bad in [0, 3, size - 4, size + 8] {
+            let status = init(aligned, bad);
+            let needles = ["out.struct_size", &bad.to_string(), name];
+            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
+                .and_then(|()| ensure(storage.iter().all(|&b| b == 0xAB), "out written"));
+            results.push((format!("{name}: struct_size {bad}"), result));
+        }
+        let status = init(aligned, size);
+        // SAFETY: 4 aligned bytes of `storage`, initialized.
+        let written = unsafe { aligned.cast::<u32>().read() };
+        let result =
+            check_ok(status).and_then(|()| ensure(written as usize == size, "struct_size not set"));
+        results.push((format!("{name}: its own size {size}"), result));
+    }
+    assert_all("light initializers", results);
+}
+
+/// Every bad value of the environment, the sun and the punctual lights, and bad pointers
+/// and counts, each refused with a message naming it.
+#[test]
+fn scene_create_bad_lights() {
+    let storage = [0u64; 8];
+    let odd = storage.as_ptr().cast::<u8>().wrapping_add(1);
+    let mut cases = cases![h = HostLights::new();
+        h.environment.pixels = null() => ["desc.environment.pixels", "NULL"],
+        h.environment.pixels = odd.cast() => ["desc.environment.pixels", "aligned"],
+        h.environment.width = 0 => ["desc.environment is 0 x 1", "at least 1 x 1"],
+        h.environment.height = 0 => ["desc.environment is 2 x 0", "at least 1 x 1"],
+        h.environment.width = MLT_MAX_ENVIRONMENT_SIDE + 1
+            => ["desc.environment is 65537 x 1", "at most 65536"],
+        (h.environment.width, h.environment.height) = (1 << 15, 1 << 14)
+            => ["desc.environment is 32768 x 16384", "at most 268435456 texels"],
+        h.environment.struct_size = 0
+            => ["desc.environment.struct_size is 0", "mlt_environment_default"],
+        h.environment.struct_size = size_of::<MltEnvironment>() as u32 + 8
+            => ["desc.environment.struct_size", "newer mlt header"],
+        h.pixels[4] = -1.0
+            => ["desc.environment.pixels[4]", "texel 1", "column 1", "G", "is -1", ">= 0"],
+        h.pixels[5] = f32::NAN => ["desc.environment.pixels[5]", "B", "is NaN"],
+        h.pixels[0] = f32::INFINITY => ["desc.environment.pixels[0]", "R", "is inf"],
+        h.environment.scale = -1.0 => ["desc.environment.scale is -1", ">= 0"],
+        h.sun.struct_size = 0 => ["desc.sun.struct_size is 0", "mlt_sun_default"],
+        h.sun.direction = [0.0; 3] => ["desc.sun.direction", "non-zero"],
+        h.sun.direction = [1e30, 1e30, 0.0] => ["desc.sun.direction", "finite length"],
+        h.sun.angular_radius_degrees = 46.0
+            => ["desc.sun.angular_radius_degrees is 46", "[0, 45]"],
+        h.sun.angular_radius_degrees = -1.0
+            => ["desc.sun.angular_radius_degrees is -1", "[0, 45]"],
+        h.sun.irradiance[0] = -1.0 => ["desc.sun.irradiance (R) is -1", ">= 0"],
+        h.punctual[0].kind = 3
+            => ["desc.punctual_lights[0].kind is 3", "MLT_LIGHT_POINT", "MLT_LIGHT_DIRECTIONAL"],
+        h.punctual[2].kind = -1 => ["desc.punctual_lights[2].kind is -1", "MLT_LIGHT_SPOT"],
+        h.punctual[0].intensity[1] = -2.0
+            => ["desc.punctual_lights[0].intensity (G) is -2", ">= 0"],
+        (h.punctual[1].inner_cone_degrees, h.punctual[1].outer_cone_degrees) = (30.0, 20.0)
+            => ["desc.punctual_lights[1].inner_cone_degrees is 30", "outer_cone_degrees is 20"],
+        h.punctual[1].outer_cone_degrees = 10.0
+            => ["desc.punctual_lights[1].inner_cone_degrees is 10", "inner < outer"],
+        h.punctual[1].outer_cone_degrees = 91.0
+            => ["desc.punctual_lights[1]", "outer_cone_degrees is 91", "<= 90"],
+        h.punctual[1].inner_cone_degrees = -1.0
+            => ["desc.punctual_lights[1].inner_cone_degrees is -1", "0 <= inner"],
+        h.punctual[1].direction = [0.0; 3] => ["desc.punctual_lights[1].direction", "non-zero"],
+        h.punctual[2].direction = [0.0; 3] => ["desc.punctual_lights[2].direction", "non-zero"],
+        h.punctual[1].struct_size = 0
+            => ["desc.punctual_lights[1].struct_size is 0", "desc.punctual_lights[0]'s"],
+        h.punctual[0].struct_size = 0
+            => ["desc.punctual_lights[0].struct_size is 0", "mlt_punctual_light_default"],
+    ];
+    cases.extend(non_finite_cases![h = HostLights::new();
+        h.environment.scale => "desc.environment.scale" + ">= 0",
+        h.environment.rotation_degrees => "desc.environment.rotation_degrees" + "finite",
+        h.sun.direction[1] => "desc.sun.direction.y" + "finite",
+        h.sun.angular_radius_degrees => "desc.sun.angular_radius_degrees" + "[0, 45]",
+        h.sun.irradiance[2] => "desc.sun.irradiance (B)" + ">= 0",
+        h.punctual[0].position[2] => "desc.punctual_lights[0].position.z" + "finite",
+        h.punctual[1].position[0] => "desc.punctual_lights[1].position.x" + "finite",
+        h.punctual[0].intensity[0] => "desc.punctual_lights[0].intensity (R)" + ">= 0",
+        h.punctual[1].direction[2] => "desc.punctual_lights[1].direction.z" + "finite",
+        h.punctual[2].direction[0] => "desc.punctual_lights[2].direction.x" + "finite",
+        h.punctual[1].inner_cone_degrees
+            => "desc.punctual_lights[1].inner_cone_degrees" + "0 <= inner < outer <= 90",
+        h.punctual[1].outer_cone_degrees
+            => "desc.punctual_lights[1].outer_cone_degrees" + "0 <= inner < outer <= 90",
+    ]);
+    assert_create_refuses("lights", &cases, HostLights::desc);
+
+    // Pointers and counts of the description itself.
+    let lights = HostLights::new();
+    let cases = cases![d = lights.desc();
+        d.punctual_lights = null() => ["desc.punctual_lights", "NULL"],
+        d.punctual_lights = odd.cast() => ["desc.punctual_lights[0]", "aligned"],
+        d.environment = odd.cast() => ["desc.environment", "aligned"],
+        d.sun = odd.cast() => ["desc.sun", "aligned"],
+        d.punctual_lights_len = MLT_MAX_PUNCTUAL_LIGHTS + 1
+            => ["desc.punctual_lights_len is 1048577", "at most 1048576"],
+        d.punctual_lights_len = usize::MAX
+            => ["desc.punctual_lights_len", "at most 1048576"],
+    ];
+    assert_create_refuses("light pointers", &cases, |d| *d);
+}
+
+/// Lights that are valid but unused are not checked: a point light's direction and cone,
+/// a directional light's position and cone.
+#[test]
+fn unused_light_fields_are_ignored() {
+    let mut lights = HostLights::new();
+    lights.punctual[0].direction = [0.0; 3];
+    lights.punctual[0].outer_cone_degrees = -5.0;
+    lights.punctual[2].position = [f32::NAN; 3];
+    let mut out = null_mut();
+    // SAFETY: the desc points into live values.
+    assert_ok(unsafe { mlt_scene_create(&lights.desc(), &mut out) });
+    drop(Handle(out));
+}
+
+/// A host built against the header before the lights (its `MltSceneDesc` ends at
+/// `backend`) gets no lights, whatever its memory holds past its struct.
+#[test]
+fn an_older_scene_desc_has_no_lights() {
+    let host = HostScene::floor_and_light();
+    let scene = host.create();
+    let settings = small_settings(4, 4, 4);
+    let (status, expected) = scene.render(&floor_camera(), &settings, 48);
+    assert_ok(status);
+    let older = MltSceneDesc {
+        struct_size: earlier_size::<MltSceneDesc>(std::mem::offset_of!(MltSceneDesc, environment)),
+        // Garbage an older host's memory may hold: mlt must not read it.
+        environment: std::ptr::dangling(),
+        sun: std::ptr::dangling(),
+        punctual_lights: std::ptr::dangling(),
+        punctual_lights_len: usize::MAX,
+        ..host.desc()
+    };
+    assert_eq!(older.struct_size, 80, "mlt 0.2's sizeof(MltSceneDesc)");
+    let mut out = null_mut();
+    // SAFETY: an older layout's struct; mlt reads only its first 80 bytes.
+    assert_ok(unsafe { mlt_scene_create(&older, &mut out) });
+    let older_scene = Handle(out);
+    let (status, image) = older_scene.render(&floor_camera(), &settings, 48);
+    assert_ok(status);
+    assert_eq!(image, expected, "the same scene, without lights");
+}
+
+/// A 2 × 2 quad at y = 0 facing +y, diffuse with albedo `albedo`, no emitters.
+fn lit_quad(albedo: f32) -> HostScene {
+    HostScene {
+        positions: vec![
+            -1.0, 0.0, -1.0, -1.0, 0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, -1.0,
+        ],
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material_ids: vec![0, 0],
+        materials: vec![MltMaterial {
+            color: [albedo; 3],
+            ..default_material()
+        }],
+        backend: MLT_BACKEND_BVH,
+    }
+}
+
+/// Looking straight down at the quad from `height`, so that it fills the image.
+fn quad_camera(height: f32) -> MltCamera {
+    MltCamera {
+        eye: [0.0, height, 0.0],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 0.0, 1.0],
+        fov_y_deg: 2.0 * (0.8 / height).atan().to_degrees(),
+        ..default_camera()
+    }
+}
+
+fn render_lit(desc: &MltSceneDesc, camera: &MltCamera, settings: &MltRenderSettings) -> Vec<f32> {
+    let mut out = null_mut();
+    // SAFETY: the desc points into live values.
+    assert_ok(unsafe { mlt_scene_create(desc, &mut out) });
+    let scene = Handle(out);
+    let len = settings.width as usize * settings.height as usize * 3;
+    let (status, image) = scene.render(camera, settings, len);
+    assert_ok(status);
+    image
+}
+
+/// A diffuse quad of albedo 0.5 under a constant environment of radiance 1, seen from
+/// above: it receives π from the whole upper hemisphere and reflects 0.5 · π / π = 0.5 in
+/// every direction, so every pixel is 0.5 within its noise (path tracing: BSDF sampling and
+/// the environment's light sampling, combined by MIS).
+#[test]
+fn a_quad_under_a_constant_environment_reflects_its_albedo() {
+    let host = lit_quad(0.5);
+    let radiance = [1.0f32; 3];
+    let environment = MltEnvironment {
+        pixels: radiance.as_ptr(),
+        width: 1,
+        height: 1,
+        ..default_environment()
+    };
+    let desc = MltSceneDesc {
+        environment: &environment,
+        ..host.desc()
+    };
+    let image = render_lit(&desc, &quad_camera(2.0), &small_settings(16, 16, 64));
+    assert_valid_image(&image, "environment-lit quad");
+    let (mean, error) = common::mean_and_standard_error(&image);
+    for c in 0..3 {
+        common::assert_within_and_sharp(&format!("channel {c}"), mean[c], 0.5, error[c], 4.0);
+    }
+    // Every pixel, against the spread of the pixels (all have the same expectation).
+    let deviation = error[0] * ((image.len() / 3) as f64).sqrt();
+    let worst = image
+        .iter()
+        .map(|&v| (v as f64 - 0.5).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 5.0 * deviation,
+        "a pixel is {worst} from 0.5, more than 5 standard deviations ({deviation})"
+    );
+}
+
+/// The same quad lit only by a point light of intensity I at height h above its centre:
+/// the irradiance at a point at distance d is I h / d³ and the radiance it reflects
+/// albedo / π times that. Each pixel is compared with that radiance averaged over the
+/// pixel's footprint; what remains is the noise of where in the pixel samples land.
+#[test]
+fn a_quad_under_a_point_light_follows_the_inverse_square_law() {
+    let (albedo, intensity, h) = (0.5f32, 2.0f32, 1.0f32);
+    let host = lit_quad(albedo);
+    let light = MltPunctualLight {
+        position: [0.0, h, 0.0],
+        intensity: [intensity; 3],
+        ..default_punctual_light()
+    };
+    let desc = MltSceneDesc {
+        punctual_lights: &light,
+        punctual_lights_len: 1,
+        ..host.desc()
+    };
+    let camera = quad_camera(3.0);
+    let (width, height) = (16u32, 16u32);
+    let image = render_lit(&desc, &camera, &small_settings(width, height, 16));
+    assert_valid_image(&image, "point-lit quad");
+
+    let model = mlt::scene::Camera {
+        eye: camera.eye,
+        target: camera.target,
+        up: camera.up,
+        fov_y_deg: camera.fov_y_deg,
+        ..mlt::scene::Camera::default()
+    }
+    .model(width, height);
+    let radiance_at = |x: f32, y: f32| -> f64 {
+        let (origin, direction) = model.generate_ray(x, y, [0.0, 0.0]);
+        let t = -origin.y / direction.y;
+        let p = origin + direction * t;
+        let d2 = (p.x * p.x + (p.z * p.z) + h * h) as f64;
+        albedo as f64 / std::f64::consts::PI * intensity as f64 * h as f64 / d2.powf(1.5)
+    };
+    const SUB: usize = 16;
+    let mut residuals = Vec::new();
+    let mut truth_sum = 0.0;
+    for py in 0..height as usize {
+        for px in 0..width as usize {
+            let mut expected = 0.0;
+            for sy in 0..SUB {
+                for sx in 0..SUB {
+                    let x = px as f32 + (sx as f32 + 0.5) / SUB as f32;
+                    let y = py as f32 + (sy as f32 + 0.5) / SUB as f32;
+                    expected += radiance_at(x, y);
+                }
+            }
+            expected /= (SUB * SUB) as f64;
+            truth_sum += expected;
+            let i = (py * width as usize + px) * 3;
+            for c in 0..3 {
+                residuals.push(image[i + c] - expected as f32);
+            }
+        }
+    }
+    let pixels = (width * height) as f64;
+    let truth = truth_sum / pixels;
+    let (residual, error) = common::mean_and_standard_error(&residuals);
+    for c in 0..3 {
+        common::assert_within_and_sharp(
+            &format!("channel {c} (mean {truth})"),
+            truth + residual[c],
+            truth,
+            error[c],
+            4.0,
+        );
+    }
 }

@@ -512,3 +512,247 @@ fn the_filter_is_reported_and_refused_where_it_does_not_apply() {
     assert!(!output.status.success());
     assert!(stderr.contains("Metropolis and ERPT"), "{stderr}");
 }
+
+/// A directory with a 2 × 2 quad at y = 0 facing up (diffuse, albedo 0.5) and a camera
+/// looking straight down at it, filling the image: lit by nothing but what the flags add.
+fn ground_scene() -> PathBuf {
+    let dir = temp_path("ground");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("ground.obj"),
+        "mtllib ground.mtl\nv -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nusemtl grey\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("ground.mtl"), "newmtl grey\nKd 0.5 0.5 0.5\n").unwrap();
+    std::fs::write(
+        dir.join("ground.camera.json"),
+        r#"{"eye":[0,2,0],"target":[0,0,0],"up":[0,0,1],"fov_y_deg":40,"width":16,"height":16}"#,
+    )
+    .unwrap();
+    dir.join("ground.obj")
+}
+
+/// Renders `obj` with path tracing and `extra` flags; the image's mean per channel and the
+/// standard output.
+fn render_ground(obj: &Path, extra: &[&str]) -> ([f32; 3], String) {
+    let out = temp_path("ground.pfm");
+    let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![
+        &obj,
+        &"--algorithm",
+        &"path",
+        &"--spp",
+        &"32",
+        &"--out",
+        &out,
+    ];
+    for a in extra {
+        args.push(a);
+    }
+    let output = mlt_render(&args);
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(
+        output.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_summary_lines_up(&stdout);
+    let (w, h, rgb) = mlt::io::read_pfm(&out).unwrap();
+    std::fs::remove_file(&out).unwrap();
+    let mut mean = [0.0; 3];
+    for (c, m) in mean.iter_mut().enumerate() {
+        *m = rgb.iter().skip(c).step_by(3).sum::<f32>() / (w * h) as f32;
+    }
+    (mean, stdout)
+}
+
+/// Writes a Radiance .hdr of `width` × `height` texels of radiance `rgb` with the image crate.
+fn write_hdr(path: &Path, width: u32, height: u32, rgb: [f32; 3]) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let texels = vec![image::Rgb(rgb); (width * height) as usize];
+    image::codecs::hdr::HdrEncoder::new(file)
+        .encode(&texels, width as usize, height as usize)
+        .unwrap();
+}
+
+/// The quad under a uniform sky of radiance 1 reflects 0.5 (albedo 0.5): from an .hdr file
+/// (--env), as a constant (--background), scaled (--env-scale) and turned (--env-rotate,
+/// which changes nothing for a uniform sky); under a delta sun straight above of
+/// irradiance π it is 0.5 again (no noise but the pixel positions'), and under a sun disc
+/// given by its radiance too. The checks are loose (each image is one render of 8192
+/// samples); `tests/capi_bad_input.rs` checks the same scene to its standard error.
+#[test]
+fn environment_and_sun_flags_light_the_scene() {
+    let obj = ground_scene();
+    let hdr = obj.with_file_name("sky.hdr");
+    write_hdr(&hdr, 8, 4, [1.0, 1.0, 1.0]);
+    let hdr_arg = hdr.to_string_lossy().into_owned();
+    let close = |mean: [f32; 3], expected: f32, tolerance: f32| {
+        mean.iter()
+            .all(|m| (m - expected).abs() <= tolerance * expected)
+    };
+
+    let (mean, stdout) = render_ground(&obj, &["--env", &hdr_arg]);
+    assert!(close(mean, 0.5, 0.05), "--env: {mean:?}");
+    assert!(
+        stdout.contains("lights        8 x 4 environment"),
+        "{stdout}"
+    );
+
+    let (mean, stdout) = render_ground(&obj, &["--background", "1,1,1"]);
+    assert!(close(mean, 0.5, 0.05), "--background: {mean:?}");
+    assert!(stdout.contains("constant environment"), "{stdout}");
+
+    let (mean, _) = render_ground(
+        &obj,
+        &["--env", &hdr_arg, "--env-scale", "2", "--env-rotate", "-30"],
+    );
+    assert!(close(mean, 1.0, 0.05), "--env-scale 2: {mean:?}");
+
+    let pi = std::f32::consts::PI.to_string();
+    let irradiance = format!("{pi},{pi},{pi}");
+    let (mean, stdout) =
+        render_ground(&obj, &["--sun", "0,1,0,0", "--sun-irradiance", &irradiance]);
+    assert!(close(mean, 0.5, 0.01), "delta sun: {mean:?}");
+    assert!(stdout.contains("sun of 0°"), "{stdout}");
+
+    // A disc of radius 5° and radiance L straight above gives irradiance π sin²(5°) L.
+    let radiance = 1.0 / 5f32.to_radians().sin().powi(2);
+    let (mean, _) = render_ground(
+        &obj,
+        &[
+            "--sun",
+            "0,1,0,5",
+            "--sun-radiance",
+            &format!("{radiance},{radiance},{radiance}"),
+        ],
+    );
+    assert!(close(mean, 0.5, 0.05), "sun disc: {mean:?}");
+    std::fs::remove_dir_all(obj.parent().unwrap()).unwrap();
+}
+
+#[test]
+fn bad_light_flags_are_one_line_errors() {
+    let obj = ground_scene();
+    let png = obj.with_file_name("sky.png");
+    std::fs::write(&png, b"not read").unwrap();
+    let missing = obj.with_file_name("missing.hdr");
+    let garbage = obj.with_file_name("garbage.exr");
+    std::fs::write(&garbage, b"not an exr").unwrap();
+    let never = temp_path("never.pfm");
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            vec!["--env".into(), missing.to_string_lossy().into()],
+            vec!["missing.hdr"],
+        ),
+        (
+            vec!["--env".into(), png.to_string_lossy().into()],
+            vec!["sky.png", "expected .hdr or .exr"],
+        ),
+        (
+            vec!["--env".into(), garbage.to_string_lossy().into()],
+            vec!["garbage.exr"],
+        ),
+        (
+            vec![
+                "--env".into(),
+                missing.to_string_lossy().into(),
+                "--background".into(),
+                "1,1,1".into(),
+            ],
+            vec!["--background", "--env"],
+        ),
+        (
+            vec!["--background".into(), "-1,0,0".into()],
+            vec!["--background", "-1 is negative"],
+        ),
+        (
+            vec!["--background".into(), "1,1".into()],
+            vec!["--background", "3 comma-separated numbers"],
+        ),
+        (
+            vec!["--background".into(), "1,x,1".into()],
+            vec!["--background", "\"x\""],
+        ),
+        (
+            vec!["--background".into(), "1,inf,1".into()],
+            vec!["--background", "not a finite number"],
+        ),
+        (
+            vec!["--env-scale".into(), "-2".into()],
+            vec!["--env-scale", "finite number >= 0"],
+        ),
+        (
+            vec!["--env-rotate".into(), "NaN".into()],
+            vec!["--env-rotate", "not a finite number"],
+        ),
+        (
+            vec![
+                "--sun".into(),
+                "0,0,0".into(),
+                "--sun-irradiance".into(),
+                "1,1,1".into(),
+            ],
+            vec!["--sun", "no direction"],
+        ),
+        (
+            vec!["--sun".into(), "0,1".into()],
+            vec!["--sun", "3 or 4 comma-separated numbers"],
+        ),
+        (
+            vec![
+                "--sun".into(),
+                "0,1,0,50".into(),
+                "--sun-irradiance".into(),
+                "1,1,1".into(),
+            ],
+            vec!["--sun", "[0, 45]"],
+        ),
+        (
+            vec!["--sun".into(), "0,1,0".into()],
+            vec!["--sun needs --sun-irradiance"],
+        ),
+        (
+            vec![
+                "--sun".into(),
+                "-1,1,0,0".into(),
+                "--sun-radiance".into(),
+                "1,1,1".into(),
+            ],
+            vec!["--sun-radiance needs a sun of angular radius > 0"],
+        ),
+        (
+            vec!["--sun-irradiance".into(), "1,1,1".into()],
+            vec!["--sun"],
+        ),
+        (
+            vec![
+                "--sun".into(),
+                "0,1,0".into(),
+                "--sun-irradiance".into(),
+                "1,-1,1".into(),
+            ],
+            vec!["--sun-irradiance", "-1 is negative"],
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (flags, needles) in &cases {
+        let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&obj, &"--out", &never];
+        for f in flags {
+            args.push(f);
+        }
+        let output = mlt_render(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        let lines = stderr.lines().count();
+        let ok = output.status.code() == Some(1)
+            && lines == 1
+            && stderr.starts_with("mlt-render: ")
+            && !stderr.contains("panicked")
+            && needles.iter().all(|n| stderr.contains(n));
+        if !ok {
+            failures.push(format!("{flags:?}: {stderr}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(!never.exists());
+    std::fs::remove_dir_all(obj.parent().unwrap()).unwrap();
+}

@@ -719,3 +719,186 @@ fn gltf_errors_name_the_file() {
     );
     std::fs::remove_file(&path).unwrap();
 }
+
+// ---------------------------------------------------------------------------------------
+// glTF KHR_lights_punctual and environment maps
+// ---------------------------------------------------------------------------------------
+
+#[track_caller]
+fn assert_close(got: [f32; 3], expected: [f32; 3], what: &str) {
+    let close = got
+        .iter()
+        .zip(expected)
+        .all(|(g, e)| (g - e).abs() <= 1e-5 * (1.0 + e.abs()));
+    assert!(close, "{what}: {got:?}, expected {expected:?}");
+}
+
+/// tests/scenes/lights-punctual.gltf (hand-written; the extension in `extensionsRequired`):
+/// under a parent node translated by (1, 2, 3) and turned 90° about +Y, a spot light 2
+/// units along the parent's −Z, a point light under a node scaled by 2, a directional light
+/// turned −90° about +X (pointing down); and at the root a spot light with glTF's default
+/// cone angles. Positions are the nodes' world origins, directions their world −Z, and
+/// intensities `color × intensity / 683` (candela and lux to W/sr and W/m²).
+#[test]
+fn gltf_punctual_lights_are_placed_by_the_node_hierarchy() {
+    use mlt::scene::PunctualLightKind;
+    let data = io::load_scene(&scenes().join("lights-punctual.gltf")).unwrap();
+    let lights = &data.punctual_lights;
+    assert_eq!(lights.len(), 4, "{lights:?}");
+    // Depth-first order of the nodes: the parent's children (spot, point, sun), then the
+    // root's default spot.
+    let spot = &lights[0];
+    assert_eq!(spot.kind, PunctualLightKind::Spot);
+    // R_y(90°) maps (0, 0, −2) to (−2, 0, 0) and −Z to −X.
+    assert_close(spot.position, [-1.0, 2.0, 3.0], "spot position");
+    assert_close(spot.direction, [-1.0, 0.0, 0.0], "spot direction");
+    assert_close(spot.intensity, [1.0, 0.5, 0.25], "spot intensity (683 cd)");
+    assert!((spot.inner_cone_degrees - 0.2f32.to_degrees()).abs() < 1e-4);
+    assert!((spot.outer_cone_degrees - 0.5f32.to_degrees()).abs() < 1e-4);
+
+    let point = &lights[1];
+    assert_eq!(point.kind, PunctualLightKind::Point);
+    // (1, 0, 0) scaled by 2 and moved by (0, 1, 0) is (2, 1, 0); turned, (0, 1, −2).
+    assert_close(point.position, [1.0, 3.0, 1.0], "point position");
+    assert_close(
+        point.intensity,
+        [0.1; 3],
+        "point intensity (68.3 cd; range ignored)",
+    );
+
+    let sun = &lights[2];
+    assert_eq!(sun.kind, PunctualLightKind::Directional);
+    assert_close(sun.direction, [0.0, -1.0, 0.0], "directional direction");
+    assert_close(
+        sun.intensity,
+        [1.0, 2.0, 2.0],
+        "directional irradiance (1366 lx)",
+    );
+
+    let default_spot = &lights[3];
+    assert_eq!(default_spot.kind, PunctualLightKind::Spot);
+    assert_close(default_spot.position, [0.0; 3], "default spot position");
+    assert_close(
+        default_spot.direction,
+        [0.0, 0.0, -1.0],
+        "default spot direction",
+    );
+    assert_close(
+        default_spot.intensity,
+        [1.0 / 683.0; 3],
+        "default colour and intensity",
+    );
+    assert_eq!(default_spot.inner_cone_degrees, 0.0);
+    assert!((default_spot.outer_cone_degrees - 45.0).abs() < 1e-4);
+
+    // The lights reach the scene.
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    assert_eq!(scene.info().triangle_count, 1);
+}
+
+/// glTF files whose lights the kernel cannot take are refused naming the light.
+#[test]
+fn gltf_bad_lights_are_errors_naming_the_light() {
+    let text = std::fs::read_to_string(scenes().join("lights-punctual.gltf")).unwrap();
+    for (from, to, needle) in [
+        (
+            "\"outerConeAngle\": 0.5",
+            "\"outerConeAngle\": 1.6",
+            "light 0 (of node 1) has innerConeAngle 0.2 and outerConeAngle 1.6",
+        ),
+        (
+            "\"intensity\": 68.3",
+            "\"intensity\": -1.0",
+            "light 1 (of node 3)",
+        ),
+        (
+            "\"scale\": [\n        2.0,\n        2.0,\n        2.0\n      ]",
+            "\"scale\": [\n        0.0,\n        0.0,\n        0.0\n      ]",
+            "has no direction",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let path = temp_path("bad-light.gltf");
+        std::fs::write(&path, text.replace(from, to)).unwrap();
+        let message = load_error(&path).message;
+        assert!(message.contains(needle), "{message}");
+        assert!(message.contains("bad-light.gltf"), "{message}");
+        std::fs::remove_file(&path).unwrap();
+    }
+}
+
+/// A spot light with equal inner and outer cone angles (a hard edge, as Blender exports a
+/// spot without blend) gets a falloff 0.1% of the cone wide, which the kernel accepts.
+#[test]
+fn gltf_spot_with_equal_cone_angles_has_a_hard_edge() {
+    let text = std::fs::read_to_string(scenes().join("lights-punctual.gltf")).unwrap();
+    let path = temp_path("hard-spot.gltf");
+    std::fs::write(
+        &path,
+        text.replace("\"innerConeAngle\": 0.2", "\"innerConeAngle\": 0.5"),
+    )
+    .unwrap();
+    let data = io::load_scene(&path).unwrap();
+    let spot = &data.punctual_lights[0];
+    let outer = 0.5f32.to_degrees();
+    assert!((spot.outer_cone_degrees - outer).abs() < 1e-4);
+    assert!(spot.inner_cone_degrees < outer && spot.inner_cone_degrees > 0.998 * outer);
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+}
+
+/// A tiny Radiance .hdr written with the image crate reads back (RGBE keeps about 1% of
+/// precision), rows from the top; so does an EXR written by `io::write_exr`, exactly.
+#[test]
+fn environment_maps_load_from_hdr_and_exr() {
+    let (width, height) = (4u32, 2u32);
+    let pixels: Vec<f32> = (0..width * height * 3)
+        .map(|i| 0.25 * (i + 1) as f32)
+        .collect();
+    let hdr = temp_path("env.hdr");
+    let file = std::io::BufWriter::new(std::fs::File::create(&hdr).unwrap());
+    let texels: Vec<image::Rgb<f32>> = pixels
+        .chunks_exact(3)
+        .map(|p| image::Rgb([p[0], p[1], p[2]]))
+        .collect();
+    image::codecs::hdr::HdrEncoder::new(file)
+        .encode(&texels, width as usize, height as usize)
+        .unwrap();
+    let (read, w, h) = io::load_environment(&hdr).unwrap();
+    assert_eq!((w, h), (width, height));
+    for (got, expected) in read.iter().zip(&pixels) {
+        assert!(
+            (got - expected).abs() <= 0.01 * expected,
+            "{got} vs {expected}"
+        );
+    }
+    std::fs::remove_file(&hdr).unwrap();
+
+    let exr = temp_path("env.exr");
+    io::write_exr(&exr, width, height, &pixels).unwrap();
+    assert_eq!(io::load_environment(&exr).unwrap(), (pixels, width, height));
+    std::fs::remove_file(&exr).unwrap();
+}
+
+#[test]
+fn environment_map_errors_name_the_file() {
+    let missing = temp_path("missing.hdr");
+    let message = io::load_environment(&missing).unwrap_err().message;
+    assert!(message.contains("missing.hdr"), "{message}");
+    let wrong = temp_path("env.png");
+    let message = io::load_environment(&wrong).unwrap_err().message;
+    assert!(message.contains("expected .hdr or .exr"), "{message}");
+    let garbage = temp_path("garbage.hdr");
+    std::fs::write(&garbage, b"not an image").unwrap();
+    let message = io::load_environment(&garbage).unwrap_err().message;
+    assert!(message.contains("garbage.hdr"), "{message}");
+    std::fs::remove_file(&garbage).unwrap();
+    let negative = temp_path("negative.exr");
+    io::write_exr(&negative, 2, 1, &[1.0, 1.0, 1.0, 1.0, -2.0, 1.0]).unwrap();
+    let message = io::load_environment(&negative).unwrap_err().message;
+    assert!(
+        message.contains("column 1, row 0") && message.contains("G = -2"),
+        "{message}"
+    );
+    std::fs::remove_file(&negative).unwrap();
+}

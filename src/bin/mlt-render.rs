@@ -5,6 +5,7 @@
 use clap::{Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mlt::io::{CameraFile, ImageFormat, SceneData};
+use mlt::scene::{EnvironmentDesc, LightsDesc, SunDesc};
 use mlt::{MutationWeights, RenderSettings, RenderStats, Scene, StopReason};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -81,6 +82,91 @@ impl std::fmt::Display for WeightsArg {
         write!(f, "{b},{l},{c},{m}")
     }
 }
+
+/// Three comma-separated numbers: a colour or a direction.
+#[derive(Clone, Copy, Debug)]
+struct Vec3Arg([f32; 3]);
+
+/// Parses `N,N,N` (or `N,N,N,N` when `allow_fourth`), each number finite.
+fn parse_numbers(text: &str, allow_fourth: bool) -> Result<Vec<f32>, String> {
+    let values: Vec<f32> = text
+        .split(',')
+        .map(|v| {
+            let v = v.trim();
+            match v.parse::<f32>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                Ok(x) => Err(format!("{x} is not a finite number")),
+                Err(e) => Err(format!("{v:?}: {e}")),
+            }
+        })
+        .collect::<Result<_, _>>()?;
+    let expected = if allow_fourth { "3 or 4" } else { "3" };
+    if values.len() == 3 || (allow_fourth && values.len() == 4) {
+        Ok(values)
+    } else {
+        Err(format!(
+            "{expected} comma-separated numbers are needed, not {}",
+            values.len()
+        ))
+    }
+}
+
+/// A linear RGB radiance or irradiance: three numbers, each >= 0.
+fn parse_rgb(text: &str) -> Result<Vec3Arg, String> {
+    let v = parse_numbers(text, false)?;
+    if let Some(x) = v.iter().find(|x| **x < 0.0) {
+        return Err(format!("{x} is negative; light must be >= 0"));
+    }
+    Ok(Vec3Arg([v[0], v[1], v[2]]))
+}
+
+/// A direction, then an optional angular radius in degrees (the sun's).
+#[derive(Clone, Copy, Debug)]
+struct SunArg {
+    direction: [f32; 3],
+    angular_radius_degrees: Option<f32>,
+}
+
+fn parse_sun(text: &str) -> Result<SunArg, String> {
+    let v = parse_numbers(text, true)?;
+    let direction = [v[0], v[1], v[2]];
+    if direction == [0.0; 3] {
+        return Err("the direction 0,0,0 has no direction".into());
+    }
+    let angular_radius_degrees = v.get(3).copied();
+    if let Some(r) = angular_radius_degrees
+        && !(0.0..=45.0).contains(&r)
+    {
+        return Err(format!(
+            "the angular radius {r} must be in [0, 45] degrees (0: a delta direction)"
+        ));
+    }
+    Ok(SunArg {
+        direction,
+        angular_radius_degrees,
+    })
+}
+
+/// A finite number >= 0.
+fn parse_scale(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        Ok(x) => Err(format!("{x} must be a finite number >= 0")),
+        Err(e) => Err(format!("{text:?}: {e}")),
+    }
+}
+
+/// A finite number.
+fn parse_finite(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) => Err(format!("{x} is not a finite number")),
+        Err(e) => Err(format!("{text:?}: {e}")),
+    }
+}
+
+/// The real sun's angular radius, in degrees: `--sun`'s when it gives none.
+const SUN_ANGULAR_RADIUS_DEGREES: f32 = 0.27;
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum BackendArg {
@@ -188,6 +274,32 @@ struct Args {
     /// Ray-intersection backend.
     #[arg(long, value_enum, default_value = "bvh")]
     backend: BackendArg,
+    /// Environment map lighting the scene from infinitely far away: an equirectangular
+    /// (latitude-longitude) .hdr or .exr of linear radiance, +Y up, its centre looking
+    /// along +Z.
+    #[arg(long, value_name = "FILE.{exr,hdr}", conflicts_with = "background")]
+    env: Option<PathBuf>,
+    /// Multiplies the environment (--env or --background).
+    #[arg(long, value_name = "S", default_value_t = 1.0, value_parser = parse_scale, allow_hyphen_values = true)]
+    env_scale: f32,
+    /// Turns the environment about +Y by this many degrees (counter-clockwise seen from
+    /// above).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = parse_finite, allow_hyphen_values = true)]
+    env_rotate: f32,
+    /// A constant environment of this linear RGB radiance (instead of --env).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, allow_hyphen_values = true)]
+    background: Option<Vec3Arg>,
+    /// The sun: the direction towards it and its angular radius in degrees (0 to 45; 0 is a
+    /// delta direction, the default 0.27 the real sun's). Needs --sun-irradiance or
+    /// --sun-radiance.
+    #[arg(long, value_name = "DIR_X,DIR_Y,DIR_Z[,RADIUS_DEG]", value_parser = parse_sun, allow_hyphen_values = true)]
+    sun: Option<SunArg>,
+    /// With --sun: its linear RGB irradiance on a plane facing it.
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires = "sun", conflicts_with = "sun_radiance", allow_hyphen_values = true)]
+    sun_irradiance: Option<Vec3Arg>,
+    /// With --sun: the linear RGB radiance of its disc (needs a radius > 0).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb, requires = "sun", allow_hyphen_values = true)]
+    sun_radiance: Option<Vec3Arg>,
     /// Output image: .pfm, .exr or .png.
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
@@ -248,7 +360,25 @@ fn run(args: &Args) -> Result<(), String> {
         BackendArg::Bvh => mlt::Backend::Bvh,
         BackendArg::Embree => mlt::Backend::Embree,
     };
-    let scene = Scene::new(&data.desc(backend)).map_err(|e| {
+    let sun = sun(args)?;
+    let environment = match (&args.env, args.background) {
+        (Some(path), _) => Some(mlt::io::load_environment(path).map_err(|e| e.to_string())?),
+        (None, Some(Vec3Arg(rgb))) => Some((rgb.to_vec(), 1, 1)),
+        (None, None) => None,
+    };
+    let mut desc = data.desc(backend);
+    desc.lights.sun = sun;
+    desc.lights.environment = environment
+        .as_ref()
+        .map(|(pixels, width, height)| EnvironmentDesc {
+            pixels,
+            width: *width,
+            height: *height,
+            rotation_degrees: args.env_rotate,
+            scale: args.env_scale,
+        });
+    let lights = describe_lights(&desc.lights);
+    let scene = Scene::new(&desc).map_err(|e| {
         format!(
             "cannot build the scene from {}: {}: {}",
             args.scene.display(),
@@ -277,8 +407,57 @@ fn run(args: &Args) -> Result<(), String> {
 
     mlt::io::write_image(&args.out, settings.width, settings.height, &rgb)
         .map_err(|e| e.to_string())?;
-    print_summary(args, &scene, &settings, &stats, load_seconds);
+    print_summary(args, &scene, &lights, &settings, &stats, load_seconds);
     Ok(())
+}
+
+/// The sun of `--sun` with `--sun-irradiance` or `--sun-radiance`.
+fn sun(args: &Args) -> Result<Option<SunDesc>, String> {
+    let Some(sun) = args.sun else {
+        return Ok(None);
+    };
+    let radius = sun
+        .angular_radius_degrees
+        .unwrap_or(SUN_ANGULAR_RADIUS_DEGREES);
+    match (args.sun_irradiance, args.sun_radiance) {
+        (Some(Vec3Arg(irradiance)), _) => Ok(Some(SunDesc {
+            direction: sun.direction,
+            angular_radius_degrees: radius,
+            irradiance,
+        })),
+        (None, Some(Vec3Arg(radiance))) => {
+            if radius == 0.0 {
+                return Err(
+                    "--sun-radiance needs a sun of angular radius > 0 (a delta sun has only an irradiance: use --sun-irradiance)".into(),
+                );
+            }
+            Ok(Some(SunDesc::from_radiance(
+                sun.direction,
+                radius,
+                radiance,
+            )))
+        }
+        (None, None) => Err("--sun needs --sun-irradiance R,G,B or --sun-radiance R,G,B".into()),
+    }
+}
+
+/// The lights besides emissive triangles, for the summary ("" if none).
+fn describe_lights(lights: &LightsDesc) -> String {
+    let mut parts = Vec::new();
+    if let Some(e) = &lights.environment {
+        parts.push(if e.width * e.height == 1 {
+            "constant environment".to_owned()
+        } else {
+            format!("{} x {} environment", e.width, e.height)
+        });
+    }
+    if let Some(sun) = &lights.sun {
+        parts.push(format!("sun of {}°", sun.angular_radius_degrees));
+    }
+    if !lights.punctual.is_empty() {
+        parts.push(format!("{} punctual", lights.punctual.len()));
+    }
+    parts.join(", ")
 }
 
 fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
@@ -357,6 +536,7 @@ fn row(label: &str, value: impl std::fmt::Display) {
 fn print_summary(
     args: &Args,
     scene: &Scene,
+    lights: &str,
     settings: &RenderSettings,
     stats: &RenderStats,
     load_seconds: f64,
@@ -405,6 +585,9 @@ fn print_summary(
             load_seconds
         ),
     );
+    if !lights.is_empty() {
+        row("lights", lights);
+    }
     row("wall time", format!("{:.3} s", stats.seconds));
     row(
         "samples",

@@ -6,7 +6,7 @@ use crate::accel::Backend;
 use crate::error::*;
 use crate::integrators::mlt::driver::MutationWeights;
 use crate::render::{Algorithm, RenderSettings};
-use crate::scene::{Camera, MaterialKind};
+use crate::scene::{Camera, MaterialKind, PunctualLight, PunctualLightKind, SunDesc};
 use glam::Vec3A;
 
 pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
@@ -17,6 +17,37 @@ pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
         other => Err(Error::invalid(format!(
             "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
         ))),
+    }
+}
+
+pub(super) fn punctual_light(light: &MltPunctualLight, index: usize) -> Result<PunctualLight> {
+    let kind = match light.kind {
+        MLT_LIGHT_POINT => PunctualLightKind::Point,
+        MLT_LIGHT_SPOT => PunctualLightKind::Spot,
+        MLT_LIGHT_DIRECTIONAL => PunctualLightKind::Directional,
+        other => {
+            return Err(Error::invalid(format!(
+                "desc.punctual_lights[{index}].kind is {other}; use MLT_LIGHT_POINT (0), MLT_LIGHT_SPOT (1) or MLT_LIGHT_DIRECTIONAL (2)"
+            )));
+        }
+    };
+    Ok(PunctualLight {
+        kind,
+        position: light.position,
+        direction: light.direction,
+        intensity: light.intensity,
+        inner_cone_degrees: light.inner_cone_degrees,
+        outer_cone_degrees: light.outer_cone_degrees,
+    })
+}
+
+impl From<&MltSun> for SunDesc {
+    fn from(s: &MltSun) -> Self {
+        SunDesc {
+            direction: s.direction,
+            angular_radius_degrees: s.angular_radius_degrees,
+            irradiance: s.irradiance,
+        }
     }
 }
 

@@ -16,7 +16,7 @@ use super::marshal::check_pointer;
 use super::types::*;
 use crate::error::*;
 use crate::render::RenderSettings;
-use crate::scene::Camera;
+use crate::scene::{Camera, PunctualLight};
 use std::mem::{align_of, offset_of, size_of};
 
 /// A C struct that begins with `struct_size: u32` and only grows by appending fields, all
@@ -212,7 +212,8 @@ impl Extensible for MltMaterial {
 impl Extensible for MltSceneDesc {
     const TYPE_NAME: &'static str = "MltSceneDesc";
     const INITIALIZER: &'static str = "mlt_scene_desc_default";
-    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    /// Before the lights besides emissive triangles (mlt 0.2's header): no lights.
+    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltSceneDesc, environment)];
     fn defaults() -> Self {
         MltSceneDesc {
             struct_size: size_of::<Self>() as u32,
@@ -225,6 +226,58 @@ impl Extensible for MltSceneDesc {
             materials: std::ptr::null(),
             materials_len: 0,
             backend: MLT_BACKEND_BVH,
+            environment: std::ptr::null(),
+            sun: std::ptr::null(),
+            punctual_lights: std::ptr::null(),
+            punctual_lights_len: 0,
+        }
+    }
+}
+
+impl Extensible for MltEnvironment {
+    const TYPE_NAME: &'static str = "MltEnvironment";
+    const INITIALIZER: &'static str = "mlt_environment_default";
+    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    fn defaults() -> Self {
+        MltEnvironment {
+            struct_size: size_of::<Self>() as u32,
+            pixels: std::ptr::null(),
+            width: 0,
+            height: 0,
+            rotation_degrees: 0.0,
+            scale: 1.0,
+        }
+    }
+}
+
+impl Extensible for MltSun {
+    const TYPE_NAME: &'static str = "MltSun";
+    const INITIALIZER: &'static str = "mlt_sun_default";
+    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    fn defaults() -> Self {
+        MltSun {
+            struct_size: size_of::<Self>() as u32,
+            direction: [0.0, 1.0, 0.0],
+            angular_radius_degrees: 0.27,
+            irradiance: [1.0; 3],
+        }
+    }
+}
+
+impl Extensible for MltPunctualLight {
+    const TYPE_NAME: &'static str = "MltPunctualLight";
+    const INITIALIZER: &'static str = "mlt_punctual_light_default";
+    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    fn defaults() -> Self {
+        let d = PunctualLight::point([0.0; 3], [1.0; 3]);
+        MltPunctualLight {
+            struct_size: size_of::<Self>() as u32,
+            kind: MLT_LIGHT_POINT,
+            position: d.position,
+            direction: d.direction,
+            intensity: d.intensity,
+            inner_cone_degrees: d.inner_cone_degrees,
+            outer_cone_degrees: d.outer_cone_degrees,
         }
     }
 }
@@ -357,6 +410,9 @@ mod tests {
         assert_sizes_grow::<MltRenderSettings>();
         assert_sizes_grow::<MltRenderStats>();
         assert_sizes_grow::<MltSceneInfo>();
+        assert_sizes_grow::<MltEnvironment>();
+        assert_sizes_grow::<MltSun>();
+        assert_sizes_grow::<MltPunctualLight>();
     }
 
     #[test]

@@ -25,7 +25,10 @@ pub use types::*;
 use crate::accel::Backend;
 use crate::error::*;
 use crate::render::{self, StopReason};
-use crate::scene::{Camera, Material, Scene, SceneDesc};
+use crate::scene::{
+    Camera, EnvironmentDesc, LightsDesc, MLT_MAX_PUNCTUAL_LIGHTS, Material, Scene, SceneDesc,
+    SunDesc,
+};
 use convert::*;
 use extensible::*;
 use marshal::*;
@@ -95,6 +98,45 @@ pub unsafe extern "C" fn mlt_material_init(out: *mut MltMaterial, struct_size: u
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mlt_scene_desc_init(
     out: *mut MltSceneDesc,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Fills `out` with an empty environment (no pixels, rotation 0, scale 1): set `pixels`,
+/// `width` and `height` before passing it.
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_environment_init(
+    out: *mut MltEnvironment,
+    struct_size: usize,
+) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Fills `out` with a white sun of irradiance 1 straight above (+Y), of the real sun's
+/// angular radius (0.27 degrees).
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_sun_init(out: *mut MltSun, struct_size: usize) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Fills `out` with a point light of intensity 1 at the origin (for a spot: axis -Z, cone
+/// 0 to 45 degrees).
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_punctual_light_init(
+    out: *mut MltPunctualLight,
     struct_size: usize,
 ) -> MltStatus {
     // SAFETY: forwarded contract.
@@ -194,12 +236,39 @@ pub unsafe extern "C" fn mlt_scene_create(
                 })
             })
             .collect::<Result<Vec<_>>>()?;
+        let environment = unsafe { read_environment(desc.environment) }?;
+        let sun = if desc.sun.is_null() {
+            None
+        } else {
+            Some(SunDesc::from(&unsafe { read_host(desc.sun, "desc.sun") }?))
+        };
+        if desc.punctual_lights_len > MLT_MAX_PUNCTUAL_LIGHTS {
+            return Err(Error::invalid(format!(
+                "desc.punctual_lights_len is {}; at most {MLT_MAX_PUNCTUAL_LIGHTS} punctual lights are allowed",
+                desc.punctual_lights_len
+            )));
+        }
+        let punctual = unsafe {
+            read_host_array(
+                desc.punctual_lights,
+                desc.punctual_lights_len,
+                "desc.punctual_lights",
+            )
+        }?
+        .iter()
+        .enumerate()
+        .map(|(i, light)| punctual_light(light, i))
+        .collect::<Result<Vec<_>>>()?;
         let scene = Scene::new(&SceneDesc {
             positions,
             indices,
             material_ids,
             materials: &materials,
-            lights: Default::default(),
+            lights: LightsDesc {
+                environment,
+                sun,
+                punctual: &punctual,
+            },
             backend: backend(desc.backend)?,
         })?;
         let handle = Box::into_raw(Box::new(MltScene {
@@ -210,6 +279,33 @@ pub unsafe extern "C" fn mlt_scene_create(
         unsafe { out.write(handle) };
         Ok(MLT_STATUS_OK)
     })
+}
+
+/// The host's environment, if `environment` is not NULL: its size checked before its pixels
+/// are looked at (the rest is validated with the scene).
+///
+/// # Safety
+/// If non-null, `environment` must point to an `MltEnvironment` of the layout its
+/// `struct_size` names, whose `pixels` point to width × height × 3 floats.
+unsafe fn read_environment<'a>(
+    environment: *const MltEnvironment,
+) -> Result<Option<EnvironmentDesc<'a>>> {
+    if environment.is_null() {
+        return Ok(None);
+    }
+    // SAFETY: forwarded contract.
+    let e = unsafe { read_host(environment, "desc.environment") }?;
+    EnvironmentDesc::validate_size(e.width, e.height)?;
+    let len = e.width as usize * e.height as usize * 3;
+    // SAFETY: forwarded contract; the size is checked above, so `len` does not overflow.
+    let pixels = unsafe { host_slice(e.pixels, len, "desc.environment.pixels") }?;
+    Ok(Some(EnvironmentDesc {
+        pixels,
+        width: e.width,
+        height: e.height,
+        rotation_degrees: e.rotation_degrees,
+        scale: e.scale,
+    }))
 }
 
 /// Releases a scene. NULL is a no-op. The scene must not be in use by another thread.

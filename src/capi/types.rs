@@ -21,6 +21,16 @@ pub const MLT_MATERIAL_MIRROR: i32 = 1;
 /// `MltMaterial.kind`: smooth dielectric (glass) with index of refraction `ior`, tinted by `color`.
 pub const MLT_MATERIAL_DIELECTRIC: i32 = 2;
 
+/// `MltPunctualLight.kind`: radiates `intensity` equally in every direction from `position`.
+pub const MLT_LIGHT_POINT: i32 = 0;
+/// `MltPunctualLight.kind`: radiates from `position` into a cone about `direction`, full
+/// `intensity` within `inner_cone_degrees` of the axis, none beyond `outer_cone_degrees`,
+/// with glTF's smooth falloff between.
+pub const MLT_LIGHT_SPOT: i32 = 1;
+/// `MltPunctualLight.kind`: light travelling along `direction` from infinitely far away,
+/// with irradiance `intensity` on a plane facing it.
+pub const MLT_LIGHT_DIRECTIONAL: i32 = 2;
+
 /// `MltSceneDesc.backend`: mlt's own SIMD BVH (8-wide with AVX2, else 4-wide; built with
 /// obvhs), always available.
 pub const MLT_BACKEND_BVH: i32 = 0;
@@ -87,12 +97,89 @@ pub struct MltMaterial {
     pub ior: f32,
 }
 
+/// An environment: radiance arriving from infinitely far away, seen by every ray that
+/// leaves the scene and sampled as a light by every algorithm. Initialize with
+/// `mlt_environment_default`; for a constant colour, `mlt_environment_constant`.
+///
+/// The map is equirectangular (latitude-longitude) with +Y up: column u in [0, 1) (left to
+/// right) is the azimuth phi = 2 pi u, row v in [0, 1) (top to bottom) the polar angle
+/// theta = pi v from +Y, and the direction is (sin phi sin theta, cos theta, -cos phi sin
+/// theta): the map's centre looks along +Z, its left and right edges along -Z (Mitsuba 3's
+/// convention).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltEnvironment {
+    /// sizeof(MltEnvironment) of the header the host was built with: set by `mlt_environment_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
+    /// Linear RGB radiance, 3 floats per texel, rows from the top: width × height × 3
+    /// floats, each finite and >= 0. Copied by `mlt_scene_create`.
+    pub pixels: *const f32,
+    /// Texels per row and rows, each in [1, `MLT_MAX_ENVIRONMENT_SIDE`], at most
+    /// `MLT_MAX_ENVIRONMENT_TEXELS` together. A 1 × 1 map is a constant environment.
+    pub width: u32,
+    pub height: u32,
+    /// Turns the environment about +Y by this many degrees (counter-clockwise seen from
+    /// above); finite.
+    pub rotation_degrees: f32,
+    /// Multiplies every texel; finite and >= 0. Default 1.
+    pub scale: f32,
+}
+
+/// The sun: a distant disc of uniform radiance (or a delta direction, with an angular
+/// radius of 0). Initialize with `mlt_sun_default`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltSun {
+    /// sizeof(MltSun) of the header the host was built with: set by `mlt_sun_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
+    /// From the scene towards the sun; any finite length but zero. Default +Y (noon).
+    pub direction: [f32; 3],
+    /// Half the angle the disc subtends, in degrees, in [0, 45]: 0 is a delta direction
+    /// (hard shadows); the real sun is about 0.27 (the default).
+    pub angular_radius_degrees: f32,
+    /// Linear RGB irradiance on a plane facing the sun, each finite and >= 0 (the disc's
+    /// radiance is this over pi sin^2 of the angular radius). Default 1.
+    pub irradiance: [f32; 3],
+}
+
+/// A point, spot or directional light (glTF's `KHR_lights_punctual`): a delta light, hit by
+/// no ray, reached by connections only. Initialize with `mlt_punctual_light_default` (a
+/// white point light at the origin).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltPunctualLight {
+    /// sizeof(MltPunctualLight) of the header the host was built with: set by `mlt_punctual_light_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
+    /// One of `MLT_LIGHT_*`.
+    pub kind: i32,
+    /// Point and spot lights: where the light is; finite (ignored for directional lights).
+    pub position: [f32; 3],
+    /// Spot: the cone's axis; directional: the direction the light travels. Any finite
+    /// length but zero (ignored for point lights).
+    pub direction: [f32; 3],
+    /// Linear RGB, each finite and >= 0: radiant intensity (W/sr) of a point light and of a
+    /// spot on its axis, irradiance (W/m^2) on a plane facing a directional light.
+    pub intensity: [f32; 3],
+    /// Spot: full intensity within this angle from the axis, in degrees (default 0).
+    pub inner_cone_degrees: f32,
+    /// Spot: no light beyond this angle from the axis, in degrees; 0 <= inner < outer <= 90
+    /// (default 45).
+    pub outer_cone_degrees: f32,
+}
+
 /// Everything `mlt_scene_create` needs, as plain arrays the host keeps ownership of (they are
 /// copied; the host may free them once the call returns). Initialize with
 /// `mlt_scene_desc_default`.
 ///
 /// Degenerate triangles (zero area, e.g. repeated or collinear vertices) are accepted: they
 /// keep their id but are never hit and never emit. `mlt_scene_get_info` counts them.
+///
+/// Light comes from emissive triangles and from an environment, a sun and punctual lights
+/// (the fields after `backend`; a host built against a header from before them, whose
+/// struct ends at `backend`, gets none of those).
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltSceneDesc {
@@ -116,6 +203,16 @@ pub struct MltSceneDesc {
     pub materials_len: usize,
     /// One of `MLT_BACKEND_*`.
     pub backend: i32,
+    /// An environment lighting the scene from infinitely far away, or NULL (the default)
+    /// for none (black).
+    pub environment: *const MltEnvironment,
+    /// The sun, or NULL (the default) for none.
+    pub sun: *const MltSun,
+    /// Point, spot and directional lights, each initialized by `mlt_punctual_light_default`;
+    /// may be NULL with a length of 0 (the default).
+    pub punctual_lights: *const MltPunctualLight,
+    /// Number of entries in `punctual_lights`, at most `MLT_MAX_PUNCTUAL_LIGHTS`.
+    pub punctual_lights_len: usize,
 }
 
 /// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with

@@ -2,12 +2,19 @@
 //! [`super::load_scene`].
 
 use super::scene_data::{CameraFile, GLTF_DEFAULT_HEIGHT, IoError, SceneData};
+use crate::scene::PunctualLight;
 use crate::{Camera, Material};
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
+
+/// Lumens per watt: glTF's photometric light units (candela for point and spot lights, lux
+/// for directional ones) are divided by this, the luminous efficacy of light at 555 nm, to
+/// give radiometric ones (W/sr, W/m²). Blender's glTF exporter and importer use the same
+/// factor, so a Blender lamp of P watts is P watts here.
+pub(crate) const LUMENS_PER_WATT: f32 = 683.0;
 
 pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let fail =
@@ -65,6 +72,10 @@ impl Loader<'_> {
                 self.add_primitive(&mesh, &primitive, world)?;
             }
         }
+        if let Some(light) = node.light() {
+            let light = self.light(node, &light, world)?;
+            self.data.punctual_lights.push(light);
+        }
         if self.data.camera.is_none()
             && let Some(camera) = node.camera()
             && let ::gltf::camera::Projection::Perspective(perspective) = camera.projection()
@@ -75,6 +86,61 @@ impl Loader<'_> {
             self.visit(&child, world)?;
         }
         Ok(())
+    }
+
+    /// A `KHR_lights_punctual` light at its node: position the node's world origin, direction
+    /// its world −Z (normalized), radiometric intensity `color × intensity / 683` (see
+    /// [`LUMENS_PER_WATT`]), cone angles in degrees. `range` is ignored (the light falls off
+    /// with the inverse square of the distance everywhere).
+    fn light(
+        &self,
+        node: &::gltf::Node,
+        light: &::gltf::khr_lights_punctual::Light,
+        world: Mat4,
+    ) -> Result<PunctualLight, IoError> {
+        use ::gltf::khr_lights_punctual::Kind;
+        let what = || format!("light {} (of node {})", light.index(), node.index());
+        let intensity = light
+            .color()
+            .map(|c| c * light.intensity() / LUMENS_PER_WATT);
+        if intensity.iter().any(|v| !(*v >= 0.0 && v.is_finite())) {
+            return Err(self.fail(format!(
+                "{} has color {:?} and intensity {}; both must be finite and >= 0",
+                what(),
+                light.color(),
+                light.intensity()
+            )));
+        }
+        let position = world.transform_point3(Vec3::ZERO).to_array();
+        let axis = world.transform_vector3(Vec3::NEG_Z);
+        let direction = axis.try_normalize().ok_or_else(|| {
+            self.fail(format!(
+                "{}: its node's transform maps -Z to {axis}, which has no direction",
+                what()
+            ))
+        })?;
+        let direction = direction.to_array();
+        Ok(match light.kind() {
+            Kind::Point => PunctualLight::point(position, intensity),
+            Kind::Directional => PunctualLight::directional(direction, intensity),
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let (inner, outer) = (inner_cone_angle.to_degrees(), outer_cone_angle.to_degrees());
+                if !(inner >= 0.0 && inner <= outer && outer > 0.0 && outer <= 90.0) {
+                    return Err(self.fail(format!(
+                        "{} has innerConeAngle {inner_cone_angle} and outerConeAngle {outer_cone_angle}; glTF needs 0 <= inner <= outer <= pi/2 (and outer > 0)",
+                        what()
+                    )));
+                }
+                // Equal angles (a hard-edged cone, as Blender exports a spot without blend):
+                // the kernel's falloff needs inner < outer, so the falloff is made 0.1% of
+                // the cone wide.
+                let inner = inner.min(outer * (1.0 - 1e-3));
+                PunctualLight::spot(position, direction, intensity, inner, outer)
+            }
+        })
     }
 
     fn camera(

@@ -5,6 +5,7 @@
 //! - [`load_scene`] reads Wavefront OBJ (+ MTL, + `NAME.camera.json` beside it) or glTF 2.0
 //!   (`.gltf` / `.glb`) into flat arrays ([`SceneData`]) ready for [`crate::Scene::new`].
 //! - [`load_camera_json`] reads a camera sidecar file.
+//! - [`load_environment`] reads an environment map (`.hdr`, `.exr`) as linear RGB floats.
 //! - [`write_image`] writes the renderer's linear RGB buffer as PFM, OpenEXR or PNG.
 //!
 //! Every failure is an [`IoError`] whose message is one sentence naming the file and what is
@@ -31,6 +32,7 @@
 //! Textures are ignored.
 
 mod camera_file;
+mod environment_file;
 mod gltf_file;
 mod image_file;
 mod obj;
@@ -39,6 +41,7 @@ mod scene_data;
 use std::path::Path;
 
 pub use camera_file::load_camera_json;
+pub use environment_file::load_environment;
 pub use image_file::{ImageFormat, read_pfm, write_exr, write_image, write_pfm, write_png};
 pub use scene_data::{CameraFile, IoError, SceneData};
 
@@ -57,6 +60,11 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   with `KHR_materials_ior` (1.5 if absent); metallic 1 and roughness 0 → mirror with the
 ///   base color; else diffuse with the base color. Primitives without a material get the glTF
 ///   default material (white diffuse). Textures, normals and other attributes are ignored.
+///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into
+///   [`SceneData::punctual_lights`]: at their node's world origin, pointing along its world
+///   −Z, with `color × intensity / 683` (candela and lux over 683 lm/W, Blender's factor:
+///   W/sr for point and spot lights, W/m² for directional ones), spot cone angles in
+///   degrees; `range` is ignored.
 ///
 /// A file without any triangle is an error.
 pub fn load_scene(path: &Path) -> Result<SceneData, IoError> {

@@ -8,6 +8,13 @@
 
 use crate::error::{Error, Result, check_finite, check_finite3};
 
+/// Largest width or height of an environment map, in texels.
+pub const MLT_MAX_ENVIRONMENT_SIDE: u32 = 1 << 16;
+/// Most texels of an environment map (width × height): 2^28, 3 GiB of RGB floats.
+pub const MLT_MAX_ENVIRONMENT_TEXELS: u64 = 1 << 28;
+/// Most punctual lights of a scene.
+pub const MLT_MAX_PUNCTUAL_LIGHTS: usize = 1 << 20;
+
 /// An environment: radiance arriving from infinitely far away, seen by every ray that
 /// leaves the scene and sampled by every algorithm as a light.
 ///
@@ -41,33 +48,47 @@ impl<'a> EnvironmentDesc<'a> {
         }
     }
 
-    pub(crate) fn validate(&self) -> Result<()> {
-        if self.width == 0 || self.height == 0 {
+    /// Checks the size alone (before the pixels are looked at): at least 1 × 1, each side
+    /// at most [`MLT_MAX_ENVIRONMENT_SIDE`], at most [`MLT_MAX_ENVIRONMENT_TEXELS`] texels.
+    pub(crate) fn validate_size(width: u32, height: u32) -> Result<()> {
+        if width == 0 || height == 0 {
             return Err(Error::invalid(format!(
-                "the environment map is {} x {} texels; it needs at least 1 x 1",
-                self.width, self.height
+                "desc.environment is {width} x {height} texels; it needs at least 1 x 1"
             )));
         }
+        if width > MLT_MAX_ENVIRONMENT_SIDE
+            || height > MLT_MAX_ENVIRONMENT_SIDE
+            || width as u64 * height as u64 > MLT_MAX_ENVIRONMENT_TEXELS
+        {
+            return Err(Error::invalid(format!(
+                "desc.environment is {width} x {height} texels; each side may be at most {MLT_MAX_ENVIRONMENT_SIDE} and the map at most {MLT_MAX_ENVIRONMENT_TEXELS} texels"
+            )));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn validate(&self) -> Result<()> {
+        Self::validate_size(self.width, self.height)?;
         let expected = self.width as u64 * self.height as u64 * 3;
         if self.pixels.len() as u64 != expected {
             return Err(Error::invalid(format!(
-                "the environment map has {} floats, but {} x {} RGB texels need {expected}",
+                "desc.environment.pixels has {} floats, but {} x {} RGB texels need {expected}",
                 self.pixels.len(),
                 self.width,
                 self.height
             )));
         }
-        check_finite(&"environment.rotation_degrees", self.rotation_degrees)?;
+        check_finite(&"desc.environment.rotation_degrees", self.rotation_degrees)?;
         if !(self.scale >= 0.0 && self.scale.is_finite()) {
             return Err(Error::invalid(format!(
-                "environment.scale is {}; it must be a finite number >= 0",
+                "desc.environment.scale is {}; it must be a finite number >= 0",
                 self.scale
             )));
         }
         for (i, &value) in self.pixels.iter().enumerate() {
             if !(value >= 0.0 && value.is_finite()) {
                 return Err(Error::invalid(format!(
-                    "environment texel {} (row {}, column {}), channel {}, is {value}; radiance must be finite and >= 0",
+                    "desc.environment.pixels[{i}] (texel {}, row {}, column {}, {}) is {value}; radiance must be finite and >= 0",
                     i / 3,
                     i / 3 / self.width as usize,
                     i / 3 % self.width as usize,
@@ -113,14 +134,14 @@ impl SunDesc {
     }
 
     pub(crate) fn validate(&self) -> Result<()> {
-        check_direction("sun.direction", self.direction)?;
+        check_direction("desc.sun.direction", self.direction)?;
         let radius = self.angular_radius_degrees;
         if !(0.0..=SUN_MAX_ANGULAR_RADIUS_DEGREES).contains(&radius) {
             return Err(Error::invalid(format!(
-                "sun.angular_radius_degrees is {radius}; it must be in [0, {SUN_MAX_ANGULAR_RADIUS_DEGREES}] (0: a delta direction)"
+                "desc.sun.angular_radius_degrees is {radius}; it must be in [0, {SUN_MAX_ANGULAR_RADIUS_DEGREES}] (0: a delta direction)"
             )));
         }
-        check_non_negative3("sun.irradiance", self.irradiance)
+        check_non_negative3("desc.sun.irradiance", self.irradiance)
     }
 }
 
@@ -193,7 +214,7 @@ impl PunctualLight {
     }
 
     pub(crate) fn validate(&self, index: usize) -> Result<()> {
-        let name = |field: &str| format!("punctual_lights[{index}].{field}");
+        let name = |field: &str| format!("desc.punctual_lights[{index}].{field}");
         check_non_negative3(&name("intensity"), self.intensity)?;
         if self.kind != PunctualLightKind::Directional {
             check_finite3(&name("position"), self.position)?;
@@ -225,6 +246,12 @@ pub struct LightsDesc<'a> {
 
 impl LightsDesc<'_> {
     pub(crate) fn validate(&self) -> Result<()> {
+        if self.punctual.len() > MLT_MAX_PUNCTUAL_LIGHTS {
+            return Err(Error::invalid(format!(
+                "desc.punctual_lights has {} lights; at most {MLT_MAX_PUNCTUAL_LIGHTS} are allowed",
+                self.punctual.len()
+            )));
+        }
         if let Some(environment) = &self.environment {
             environment.validate()?;
         }

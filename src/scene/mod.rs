@@ -6,7 +6,10 @@ pub(crate) mod lights;
 mod material;
 
 pub use camera::{Camera, CameraModel};
-pub use light_desc::{EnvironmentDesc, LightsDesc, PunctualLight, PunctualLightKind, SunDesc};
+pub use light_desc::{
+    EnvironmentDesc, LightsDesc, MLT_MAX_ENVIRONMENT_SIDE, MLT_MAX_ENVIRONMENT_TEXELS,
+    MLT_MAX_PUNCTUAL_LIGHTS, PunctualLight, PunctualLightKind, SunDesc,
+};
 pub use lights::AreaLight;
 pub use material::{Material, MaterialKind};
 
