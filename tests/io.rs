@@ -195,15 +195,8 @@ fn window_room_scene_files_are_what_the_generator_writes() {
     if std::env::var_os("MLT_WRITE_SCENES").is_some() {
         io::write_exr(&sky_path, width, height, &pixels).unwrap();
     }
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        &sky_path,
-        |resolution, _| vec![[0.0f32; 3]; resolution.width() * resolution.height()],
-        move |texels: &mut Vec<[f32; 3]>, position, (r, g, b, _a): (f32, f32, f32, f32)| {
-            texels[position.y() * width as usize + position.x()] = [r, g, b];
-        },
-    )
-    .unwrap();
-    let read: Vec<f32> = image.layer_data.channel_data.pixels.concat();
+    let (read, read_width, read_height) = io::load_environment(&sky_path).unwrap();
+    assert_eq!((read_width, read_height), (width, height));
     assert!(
         read == pixels,
         "sky.exr differs from its generator: rewrite it with MLT_WRITE_SCENES=1 cargo test --test io"
