@@ -41,9 +41,11 @@ use super::{PathSpace, PathVertex};
 use crate::accel::Ray;
 use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
-use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere};
+use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
+use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
+use std::f32::consts::TAU;
 
 /// Probabilities of δ = n_a − n_d = −2, −1, 0, 1, 2: mostly the same length, as Veach
 /// suggests. Symmetric, so p_add(n_a | n_d) = p_add(n_d | n_a).
@@ -162,6 +164,12 @@ impl Bidirectional {
         }
         let from_light = ((rng.uniform() * (added + 1) as f32) as usize).min(added);
         let from_eye = added - from_light;
+        // Keeping the whole path as the lens side and adding vertices before its light makes
+        // the light an inner vertex: possible for an emissive triangle, never for a point
+        // light or a direction.
+        if added > 0 && b == 0 && x[0].light.is_some() {
+            return None;
+        }
 
         // Light side: the kept prefix, then `from_light` sampled vertices.
         y.clear();
@@ -173,8 +181,11 @@ impl Bidirectional {
         // Lens side: sampled backwards from the kept suffix into `eye` (lens-side order).
         let suffix = &x[b as usize..];
         eye.clear();
-        for _ in 0..from_eye {
-            let next = self.extend_eye_side(space, suffix, eye, rng, rays)?;
+        for i in 0..from_eye {
+            // The last vertex sampled from the lens side is the light when the light side
+            // is empty: a ray that leaves the scene then ends on the lights at infinity.
+            let is_light = y.is_empty() && i + 1 == from_eye;
+            let next = self.extend_eye_side(space, suffix, eye, is_light, rng, rays)?;
             eye.push(next);
         }
         let s = y.len();
@@ -216,8 +227,10 @@ impl Bidirectional {
                 if !scene.has_lights() {
                     return None;
                 }
+                // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
+                // which are `sample_emission`'s).
                 match scene.sample_light(rng.uniform(), rng.uniform2())? {
-                    crate::scene::lights::LightSample::Area {
+                    LightSample::Area {
                         point,
                         normal,
                         triangle,
@@ -226,19 +239,60 @@ impl Bidirectional {
                         p: point,
                         normal,
                         triangle,
+                        light: None,
                     }),
-                    // Path-space MLT refuses scenes with other lights (see `render`).
-                    _ => None,
+                    LightSample::Point {
+                        light, position, ..
+                    } => Some(PathVertex::point_light(light, position)),
+                    LightSample::Direction {
+                        emitter, toward, ..
+                    } => Some(PathVertex::at_infinity(emitter, toward)),
                 }
             }
-            [light] => {
-                let local = cosine_hemisphere(rng.uniform2());
-                if local.z <= 0.0 {
-                    return None;
+            [light] => match light.light {
+                None => {
+                    let local = cosine_hemisphere(rng.uniform2());
+                    if local.z <= 0.0 {
+                        return None;
+                    }
+                    let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
+                    space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
                 }
-                let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
-                space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
-            }
+                Some(Emitter::Point(index)) => {
+                    // Uniform over the sphere or the spot's outer cone: the density
+                    // `PointLight::direction_pdf` gives.
+                    let point = scene.point_light(index);
+                    let u = rng.uniform2();
+                    let direction = match &point.cone {
+                        None => uniform_sphere(u),
+                        Some(cone) => {
+                            let cos_theta = 1.0 - u[0] * (1.0 - cone.cos_outer);
+                            let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                            let (sin_phi, cos_phi) = (TAU * u[1]).sin_cos();
+                            OrthonormalBasis::from_normal(cone.axis).to_world(Vec3A::new(
+                                cos_phi * sin_theta,
+                                sin_phi * sin_theta,
+                                cos_theta,
+                            ))
+                        }
+                    };
+                    if point.direction_pdf(direction) <= 0.0 {
+                        return None;
+                    }
+                    space.trace(&Ray::new(light.p, direction, 0.0, f32::INFINITY), rays)
+                }
+                Some(_) => {
+                    // From a uniform point of the disc facing the light that covers the
+                    // scene's bounding sphere (as `sample_emission`): density `disc_pdf`.
+                    let (center, radius) = scene.bounding_sphere;
+                    let toward = light.normal;
+                    let [dx, dy] = uniform_disk(rng.uniform2());
+                    let basis = OrthonormalBasis::from_normal(toward);
+                    let origin =
+                        center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
+                    space.trace(&Ray::new(origin, -toward, 0.0, f32::INFINITY), rays)
+                }
+            },
             [.., previous, end] => {
                 let wi = sample_direction(space, previous, end, TransportMode::Importance, rng)?;
                 space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)
@@ -247,12 +301,15 @@ impl Bidirectional {
     }
 
     /// The next vertex of the lens side: `eye` holds its sampled vertices so far (nearest
-    /// the lens first), continuing the kept `suffix` (empty: a new lens point).
+    /// the lens first), continuing the kept `suffix` (empty: a new lens point). With
+    /// `is_light`, the vertex is the path's light (a ray leaving the scene is then on the
+    /// lights at infinity).
     fn extend_eye_side(
         &self,
         space: &PathSpace,
         suffix: &[PathVertex],
         eye: &[PathVertex],
+        is_light: bool,
         rng: &mut Rng,
         rays: &mut u64,
     ) -> Option<PathVertex> {
@@ -270,21 +327,27 @@ impl Bidirectional {
             (end, suffix.get(1))
         } else {
             let lens = camera.sample_lens(rng.uniform2());
-            return Some(PathVertex {
-                p: lens,
-                normal: camera.forward,
-                triangle: 0,
-            });
+            return Some(PathVertex::point(lens, camera.forward));
         };
         let Some(previous) = previous else {
             // The end is the lens: a new film position, uniform over the film.
             let [u, v] = rng.uniform2();
             let direction =
                 camera.direction_through(end.p, u * camera.width as f32, v * camera.height as f32);
-            return space.trace(&Ray::new(end.p, direction, 0.0, f32::INFINITY), rays);
+            let ray = Ray::new(end.p, direction, 0.0, f32::INFINITY);
+            return if is_light {
+                space.trace_or_escape(&ray, rays)
+            } else {
+                space.trace(&ray, rays)
+            };
         };
         let wi = sample_direction(space, previous, end, TransportMode::Radiance, rng)?;
-        space.trace(&spawn_ray(space.scene, end.p, end.normal, wi), rays)
+        let ray = spawn_ray(space.scene, end.p, end.normal, wi);
+        if is_light {
+            space.trace_or_escape(&ray, rays)
+        } else {
+            space.trace(&ray, rays)
+        }
     }
 }
 
@@ -297,7 +360,11 @@ fn sample_direction(
     mode: TransportMode,
     rng: &mut Rng,
 ) -> Option<Vec3A> {
-    let wo = (from.p - at.p).normalize();
+    let wo = if from.is_at_infinity() {
+        from.normal
+    } else {
+        (from.p - at.p).normalize()
+    };
     let s = space
         .surface_bsdf(at)
         .sample(wo, rng.uniform2(), rng.uniform(), mode)?;
@@ -707,6 +774,7 @@ mod tests {
             p: space.camera.eye,
             normal: space.camera.forward,
             triangle: 0,
+            light: None,
         };
         assert_eq!(
             [light, wall, floor].map(|v| Surface::of(&v)),
@@ -756,6 +824,7 @@ mod tests {
                             p: Vec3A::from(p.as_vec3()),
                             normal: Vec3A::from(r.normal().as_vec3()),
                             triangle: 0,
+                            light: None,
                         };
                         nodes.push((cell, vertex, weight));
                     }
