@@ -376,14 +376,6 @@ impl Scene {
         !self.lights.is_empty()
     }
 
-    /// Whether the scene has a light that is not an emissive triangle.
-    #[inline]
-    pub(crate) fn has_non_area_lights(&self) -> bool {
-        self.lights
-            .iter()
-            .any(|light| !matches!(light, Light::Area(_)))
-    }
-
     /// The area density with which `sample_light` picks a point on internal triangle
     /// `triangle` (0 for triangles that do not emit).
     #[inline]

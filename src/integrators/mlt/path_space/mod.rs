@@ -597,6 +597,230 @@ mod tests {
         }
     }
 
+    /// Fixed perturbation moves: a film offset, directions turned by a fixed rotation.
+    struct FixedKernel {
+        film_offset: [f32; 2],
+        rotation: glam::Quat,
+    }
+
+    impl perturbation::Kernel for FixedKernel {
+        fn film_offset(&mut self) -> [f32; 2] {
+            self.film_offset
+        }
+        fn direction(&mut self, old: Vec3A, _: Vec3A, _: Vec3A) -> Option<Vec3A> {
+            Some(Vec3A::from(self.rotation * glam::Vec3::from(old)))
+        }
+    }
+
+    /// The perturbations of paths whose light is a direction at infinity or a delta light
+    /// are reversible with exact, reciprocal ratios: for BDPT's strategy paths x in the
+    /// open glass box under each kind of light, a lens, multi-chain or caustic perturbation
+    /// with a fixed move gives y, the opposite move takes y back to x (the same light
+    /// kind; an eye ray through the glass that escaped escapes again), the product of the
+    /// two ratios is 1, and y admits the same
+    /// perturbations as x (the chains pick them with x's probabilities). The caustic
+    /// perturbation does not apply where its specular chain starts at a light that is not
+    /// a triangle.
+    #[test]
+    fn perturbations_with_every_kind_of_light_are_reversible() {
+        use super::perturbation::{self, applicable};
+        use crate::scene::{EnvironmentDesc, LightsDesc, PunctualLight, SunDesc};
+        let sky = [0.4f32, 0.5, 0.7];
+        let sun = SunDesc::from_radiance([-0.3, 1.0, -0.6], 5.0, [200.0, 180.0, 150.0]);
+        let point = [PunctualLight::point([278.0, 400.0, 280.0], [4e4, 3e4, 2e4])];
+        let directional = [PunctualLight::directional(
+            [0.3, -1.0, 0.5],
+            [3.0, 2.5, 2.0],
+        )];
+        let cases: [(&str, LightsDesc); 3] = [
+            (
+                "sky + sun",
+                LightsDesc {
+                    environment: Some(EnvironmentDesc::constant(&sky)),
+                    sun: Some(sun),
+                    punctual: &[],
+                },
+            ),
+            (
+                "point",
+                LightsDesc {
+                    punctual: &point,
+                    ..Default::default()
+                },
+            ),
+            (
+                "directional",
+                LightsDesc {
+                    punctual: &directional,
+                    ..Default::default()
+                },
+            ),
+        ];
+        let rotation =
+            glam::Quat::from_axis_angle(glam::Vec3::new(0.3, 0.8, -0.5).normalize(), 2e-4);
+        for (label, lights) in cases {
+            let (scene, camera) = open("cornell-glass", lights);
+            let camera = camera.model(32, 32);
+            let space = PathSpace {
+                scene: &scene,
+                camera: &camera,
+            };
+            let bdpt = Bdpt {
+                scene: &scene,
+                max_depth: 5,
+                min_depth: 0,
+            };
+            let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
+            let mut counters = SampleCounters::default();
+            let mut rng = Rng::new(11, 0);
+            let (mut x, mut y, mut back) = (Vec::new(), Vec::new(), Vec::new());
+            // Per (perturbation, light kind of x_0): moves checked.
+            let mut checked = std::collections::BTreeMap::<(usize, &str), u32>::new();
+            for _ in 0..4_000 {
+                let [fx, fy] = rng.uniform2();
+                let (n_camera, n_light) = bdpt.trace_subpaths(
+                    &camera,
+                    fx * 32.0,
+                    fy * 32.0,
+                    7,
+                    6,
+                    &mut rng,
+                    &mut scratch,
+                    &mut counters,
+                );
+                for t in 1..=n_camera {
+                    for s in 0..=n_light {
+                        if s + t < 2 || s + t - 2 > 5 || (s == 1 && t == 1) {
+                            continue;
+                        }
+                        let c = bdpt.connect(&camera, &mut scratch, s, t, &mut rng, &mut counters);
+                        if !c.is_some_and(|c| c.weight > 0.0) {
+                            continue;
+                        }
+                        bdpt.strategy_path(&scratch, s, t, &mut x);
+                        let kind = match x[0].light {
+                            None => continue,
+                            Some(Emitter::Infinite) => "infinite",
+                            Some(Emitter::Point(_)) => "point",
+                            Some(_) => "directional",
+                        };
+                        // Paths into a corner (an edge of a few units in a box of 550) or
+                        // grazing a surface are too ill-conditioned for the round trip's
+                        // rounding (rays leave surfaces from offset origins).
+                        let n = x.len();
+                        let short = x.windows(2).enumerate().any(|(i, e)| {
+                            let Some((w, _)) = direction(&e[0], &e[1]) else {
+                                return true;
+                            };
+                            let grazing = |v: &PathVertex| w.dot(v.normal).abs() < 0.1;
+                            (!e[0].is_at_infinity() && (e[0].p - e[1].p).length() < 20.0)
+                                || (i > 0 && grazing(&e[0]))
+                                || (i + 2 < n && grazing(&e[1]))
+                        });
+                        if short {
+                            continue;
+                        }
+                        // The sky seen through the glass: the lens perturbation's eye ray
+                        // leaves the scene.
+                        let kind = if kind == "infinite"
+                            && x[1..x.len() - 1].iter().all(|v| space.is_specular(v))
+                        {
+                            "infinite, seen"
+                        } else {
+                            kind
+                        };
+                        let admits = applicable(&space, &x);
+                        if admits.caustic {
+                            let start = (1..x.len() - 3)
+                                .rev()
+                                .find(|&k| !space.is_specular(&x[k]))
+                                .unwrap_or(0);
+                            assert!(start > 0, "{label}: caustic from a {kind} light");
+                        }
+                        for which in 0..3 {
+                            let mut forward = FixedKernel {
+                                film_offset: [0.05, -0.03],
+                                rotation,
+                            };
+                            let mut reverse = FixedKernel {
+                                film_offset: [-0.05, 0.03],
+                                rotation: rotation.inverse(),
+                            };
+                            let mut perturb =
+                                |kernel: &mut FixedKernel,
+                                 from: &[PathVertex],
+                                 to: &mut Vec<PathVertex>| {
+                                    match which {
+                                        0 => perturbation::lens(
+                                            &space, kernel, false, from, to, &mut 0,
+                                        ),
+                                        1 => perturbation::lens(
+                                            &space, kernel, true, from, to, &mut 0,
+                                        ),
+                                        _ => {
+                                            perturbation::caustic(&space, kernel, from, to, &mut 0)
+                                        }
+                                    }
+                                };
+                            let Some(p) = perturb(&mut forward, &x, &mut y) else {
+                                continue;
+                            };
+                            assert_eq!(applicable(&space, &y), admits, "{label} {which}");
+                            assert_eq!(y[0].light, x[0].light, "{label} {which}");
+                            // Across an edge of the tessellated sphere the normal jumps: the
+                            // opposite move need not come back.
+                            if x.iter().zip(&y).any(|(a, b)| a.triangle != b.triangle) {
+                                continue;
+                            }
+                            let Some(q) = perturb(&mut reverse, &y, &mut back) else {
+                                panic!("{label} {which} {kind}: no way back from {y:?} to {x:?}");
+                            };
+                            if x.iter().zip(&back).any(|(a, b)| a.triangle != b.triangle) {
+                                continue;
+                            }
+                            for (a, b) in x.iter().zip(&back) {
+                                assert_eq!(a.light, b.light, "{label} {which}");
+                                let scale = if a.is_at_infinity() { 1e-2 } else { 2.0 };
+                                assert!(
+                                    (a.p - b.p).length() < scale
+                                        && (a.normal - b.normal).length() < 2e-2,
+                                    "{label} {which} {kind}: {x:?} came back as {back:?}"
+                                );
+                            }
+                            assert!(
+                                (p.ratio * q.ratio - 1.0).abs() < 5e-2,
+                                "{label} {which} {kind}: ratios {} and {}: {x:?} → {y:?} → {back:?}, values {} {} {}",
+                                p.ratio,
+                                q.ratio,
+                                space
+                                    .unweighted_contribution(&x, s, false)
+                                    .map_or(Spectrum::ZERO, |c| c.0),
+                                p.value,
+                                q.value
+                            );
+                            *checked.entry((which, kind)).or_default() += 1;
+                        }
+                    }
+                }
+            }
+            println!("{label}: {checked:?}");
+            let wanted: &[(usize, &str)] = match label {
+                "sky + sun" => &[
+                    (0, "infinite"),
+                    (0, "infinite, seen"),
+                    (1, "infinite"),
+                    (2, "infinite"),
+                ],
+                "point" => &[(0, "point"), (1, "point"), (2, "point")],
+                _ => &[(0, "directional"), (1, "directional"), (2, "directional")],
+            };
+            for key in wanted {
+                let count = checked.get(key).copied().unwrap_or_default();
+                assert!(count >= 20, "{label}: {key:?} checked {count} times");
+            }
+        }
+    }
+
     /// For every strategy of many BDPT samples, the contribution evaluated on the path the
     /// strategy built equals BDPT's own (its weighted value over its MIS weight), on the
     /// diffuse box and through glass.
