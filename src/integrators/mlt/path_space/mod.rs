@@ -746,7 +746,7 @@ mod tests {
                                 film_offset: [-0.05, 0.03],
                                 rotation: rotation.inverse(),
                             };
-                            let mut perturb =
+                            let perturb =
                                 |kernel: &mut FixedKernel,
                                  from: &[PathVertex],
                                  to: &mut Vec<PathVertex>| {
