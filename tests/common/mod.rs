@@ -660,11 +660,11 @@ pub fn open_scene(lights: OpenLights) -> (Scene, Camera) {
         mlt::PunctualLight::spot(
             [200.0, 500.0, 250.0],
             [0.3, -1.0, 0.2],
-            [8e4, 6e4, 4e4],
+            [3.2e5, 2.4e5, 1.6e5],
             15.0,
             35.0,
         ),
-        mlt::PunctualLight::directional([-0.4, -1.0, 0.3], [2.0, 2.0, 1.6]),
+        mlt::PunctualLight::directional([-0.4, -1.0, 0.3], [0.8, 0.8, 0.6]),
     ];
     open_cornell_box(match lights {
         OpenLights::SkyAndSun => mlt::LightsDesc {
