@@ -258,39 +258,9 @@ impl Bidirectional {
                     let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
                     space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
                 }
-                Some(Emitter::Point(index)) => {
-                    // Uniform over the sphere or the spot's outer cone: the density
-                    // `PointLight::direction_pdf` gives.
-                    let point = scene.point_light(index);
-                    let u = rng.uniform2();
-                    let direction = match &point.cone {
-                        None => uniform_sphere(u),
-                        Some(cone) => {
-                            let cos_theta = 1.0 - u[0] * (1.0 - cone.cos_outer);
-                            let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                            let (sin_phi, cos_phi) = (TAU * u[1]).sin_cos();
-                            OrthonormalBasis::from_normal(cone.axis).to_world(Vec3A::new(
-                                cos_phi * sin_theta,
-                                sin_phi * sin_theta,
-                                cos_theta,
-                            ))
-                        }
-                    };
-                    if point.direction_pdf(direction) <= 0.0 {
-                        return None;
-                    }
-                    space.trace(&Ray::new(light.p, direction, 0.0, f32::INFINITY), rays)
-                }
                 Some(_) => {
-                    // From a uniform point of the disc facing the light that covers the
-                    // scene's bounding sphere (as `sample_emission`): density `disc_pdf`.
-                    let (center, radius) = scene.bounding_sphere;
-                    let toward = light.normal;
-                    let [dx, dy] = uniform_disk(rng.uniform2());
-                    let basis = OrthonormalBasis::from_normal(toward);
-                    let origin =
-                        center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
-                    space.trace(&Ray::new(origin, -toward, 0.0, f32::INFINITY), rays)
+                    let ray = emission_ray(scene, light, rng.uniform2())?;
+                    space.trace(&ray, rays)
                 }
             },
             [.., previous, end] => {
@@ -347,6 +317,46 @@ impl Bidirectional {
             space.trace_or_escape(&ray, rays)
         } else {
             space.trace(&ray, rays)
+        }
+    }
+}
+
+/// The first ray of a light side from light vertex `light` that is not a triangle, with
+/// the density `unweighted_contribution` gives it: from a point or spot light uniformly
+/// over the sphere or the spot's outer cone (`PointLight::direction_pdf`); from a light at
+/// infinity along it, from a uniform point of the disc facing it that covers the scene's
+/// bounding sphere (`Scene::disc_pdf`, as `sample_emission`).
+fn emission_ray(scene: &crate::scene::Scene, light: &PathVertex, u: [f32; 2]) -> Option<Ray> {
+    match light.light? {
+        Emitter::Point(index) => {
+            let point = scene.point_light(index);
+            let direction = match &point.cone {
+                None => uniform_sphere(u),
+                Some(cone) => {
+                    let cos_theta = 1.0 - u[0] * (1.0 - cone.cos_outer);
+                    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                    let (sin_phi, cos_phi) = (TAU * u[1]).sin_cos();
+                    OrthonormalBasis::from_normal(cone.axis).to_world(Vec3A::new(
+                        cos_phi * sin_theta,
+                        sin_phi * sin_theta,
+                        cos_theta,
+                    ))
+                }
+            };
+            if point.direction_pdf(direction) <= 0.0 {
+                return None;
+            }
+            Some(Ray::new(light.p, direction, 0.0, f32::INFINITY))
+        }
+        Emitter::Area(_) => None,
+        Emitter::Directional(_) | Emitter::Infinite => {
+            let (center, radius) = scene.bounding_sphere;
+            let toward = light.normal;
+            let [dx, dy] = uniform_disk(u);
+            let basis = OrthonormalBasis::from_normal(toward);
+            let origin =
+                center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
+            Some(Ray::new(origin, -toward, 0.0, f32::INFINITY))
         }
     }
 }
@@ -478,6 +488,11 @@ mod tests {
     const FOV_Y_DEG: f32 = 60.0;
 
     fn scene() -> Scene {
+        scene_with(Default::default())
+    }
+
+    /// The small scene with more lights.
+    fn scene_with(lights: crate::scene::LightsDesc) -> Scene {
         let mut positions = Vec::new();
         let mut indices = Vec::new();
         let mut material_ids = Vec::new();
@@ -503,7 +518,7 @@ mod tests {
                 Material::diffuse(albedo(Surface::Wall)),
                 Material::diffuse([0.0; 3]).with_emission([EMISSION; 3]),
             ],
-            lights: Default::default(),
+            lights,
             backend: Backend::Bvh,
         })
         .unwrap()
@@ -866,6 +881,100 @@ mod tests {
     /// Normal quantiles: 99.9% and 99.99%.
     const Z_999: f64 = 3.090_232;
     const Z_9999: f64 = 3.719_016;
+
+    /// The first rays of a light side from a point light, a spot light and a light at
+    /// infinity have the densities `unweighted_contribution` divides by: directions
+    /// uniform over the sphere or the spot's outer cone (cos θ and φ uniform), and origins
+    /// uniform over the disc of radius R facing the light, at R from the bounding sphere's
+    /// centre (r² / R² and the angle uniform), leaving along the light's direction. Chi-square
+    /// tests over 20 bins of each coordinate, and one with the cone's density shaped
+    /// (cos θ = 1 − u²(1 − cos θ_max)) fails.
+    #[test]
+    fn emission_rays_from_lights_that_are_not_triangles_have_their_densities() {
+        use crate::scene::{LightsDesc, PunctualLight, SunDesc};
+        let punctual = [
+            PunctualLight::point([0.0, 1.2, 0.0], [1.0; 3]),
+            PunctualLight::spot([0.0, 1.2, 0.0], [0.2, -1.0, 0.1], [1.0; 3], 10.0, 40.0),
+            PunctualLight::directional([0.3, -1.0, 0.4], [1.0; 3]),
+        ];
+        let scene = scene_with(LightsDesc {
+            sun: Some(SunDesc::from_radiance([-0.2, 1.0, 0.3], 4.0, [50.0; 3])),
+            punctual: &punctual,
+            ..Default::default()
+        });
+        let (center, radius) = scene.bounding_sphere;
+        let bins = 20;
+        let draws = 100_000;
+        let threshold = chi_square_quantile(bins - 1, Z_9999);
+        let uniform = vec![1.0 / bins as f64; bins];
+        let bin = |x: f32| ((x * bins as f32) as usize).min(bins - 1);
+        // The lights' indices: the area lights (triangles) first, then the punctual ones.
+        let areas = scene
+            .lights
+            .iter()
+            .filter(|l| matches!(l, crate::scene::lights::Light::Area(_)))
+            .count() as u32;
+        let lights = [
+            PathVertex::point_light(areas, Vec3A::new(0.0, 1.2, 0.0)),
+            PathVertex::point_light(areas + 1, Vec3A::new(0.0, 1.2, 0.0)),
+            PathVertex::at_infinity(
+                Emitter::Directional(areas + 2),
+                Vec3A::new(-0.3, 1.0, -0.4).normalize(),
+            ),
+            PathVertex::at_infinity(Emitter::Infinite, Vec3A::new(0.1, 0.9, 0.2).normalize()),
+        ];
+        let mut rng = Rng::new(0xE111, 0);
+        for (index, light) in lights.iter().enumerate() {
+            let (mut first, mut second) = (vec![0u64; bins], vec![0u64; bins]);
+            let mut shaped = vec![0u64; bins];
+            for _ in 0..draws {
+                let u = rng.uniform2();
+                let ray = emission_ray(&scene, light, u).expect("a ray");
+                // Coordinates that are uniform under the density.
+                let (a, b) = match light.light {
+                    Some(Emitter::Point(i)) => {
+                        let point = scene.point_light(i);
+                        let (axis, cos_max) = point
+                            .cone
+                            .map_or((Vec3A::Y, -1.0), |c| (c.axis, c.cos_outer));
+                        let basis = OrthonormalBasis::from_normal(axis);
+                        let w = ray.direction;
+                        assert!((ray.origin - light.p).length() < 1e-6);
+                        let phi = basis.bitangent.dot(w).atan2(basis.tangent.dot(w));
+                        let a = (1.0 - axis.dot(w)) / (1.0 - cos_max);
+                        if point.cone.is_some() {
+                            // A shaped cone, cos θ = 1 − u²(1 − cos θ_max), would have a = u².
+                            shaped[bin(u[0] * u[0])] += 1;
+                        }
+                        (a, phi / TAU + 0.5)
+                    }
+                    _ => {
+                        let toward = light.normal;
+                        assert!((ray.direction + toward).length() < 1e-5);
+                        let offset = ray.origin - center - toward * radius;
+                        assert!(offset.dot(toward).abs() < 1e-3 * radius);
+                        let basis = OrthonormalBasis::from_normal(toward);
+                        let (x, y) = (basis.tangent.dot(offset), basis.bitangent.dot(offset));
+                        ((x * x + y * y) / (radius * radius), y.atan2(x) / TAU + 0.5)
+                    }
+                };
+                first[bin(a)] += 1;
+                second[bin(b)] += 1;
+            }
+            for (name, counts) in [("radial", &first), ("angle", &second)] {
+                let stat = chi_square(counts, 0, &uniform);
+                assert!(
+                    stat < threshold,
+                    "light {index} {name}: chi-square {stat} ≥ {threshold}: {counts:?}"
+                );
+            }
+            if matches!(light.light, Some(Emitter::Point(i)) if scene.point_light(i).cone.is_some())
+            {
+                let stat = chi_square(&shaped, 0, &uniform);
+                assert!(stat > 10.0 * threshold, "the shaped cone passes: {stat}");
+            }
+        }
+    }
 
     /// The proposal density: the proposals of one discrete choice from a fixed path x,
     /// histogrammed over cells of the new vertex, against T(x→y) = p_del · p_add · Σ_i p_i(y)
