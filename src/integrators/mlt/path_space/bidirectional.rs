@@ -33,7 +33,14 @@
 //! ```
 //!
 //! where |·| is luminance and splits that cannot produce the path (a connection at a
-//! specular vertex) have p_i = 0 and no term. This is Veach's form (the sum over splits);
+//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term.
+//!
+//! A new light vertex is picked as `Scene::sample_light` picks it (a point on a triangle, a
+//! point or spot light, or a direction at infinity), and the light side's first ray leaves
+//! it as `sample_emission`'s would (`emission_ray`); a lens side whose last vertex is the
+//! path's light ends on the lights at infinity if its ray leaves the scene. A light that is
+//! not a triangle never becomes an inner vertex (a move keeping the whole path as its lens
+//! side and adding vertices before it is refused; such paths have f = 0). This is Veach's form (the sum over splits);
 //! every term comes from `PathSpace::unweighted_contribution`, which the tests check
 //! against BDPT strategy by strategy.
 

@@ -26,6 +26,18 @@
 //! the refraction Jacobian is the one BDPT already gets right (its strategies agree with the
 //! path tracer through glass). `unweighted_contribution` evaluates C_s for a given path and
 //! the tests check it against BDPT's own numbers for every strategy.
+//!
+//! # Lights that are not triangles
+//!
+//! A path's light x_0 may be a point or spot light, or a light at infinity (the environment
+//! and sun disc, or a directional light): `PathVertex::light` says which. A vertex at
+//! infinity is a direction (`normal`, from the scene towards the light), as in BDPT:
+//! densities towards it are in solid angle, light sides leave it from a uniform point of the
+//! disc covering the scene's bounding sphere (x_1's area density is the disc's times its
+//! |cos|, which cancels G's), and a lens side that leaves the scene ends on it. The
+//! strategy that would have to hit a delta light (s = 0) has no density: C_0 is `None` there,
+//! as BDPT gives it no weight. The mutations keep x_0's kind where they keep x_0, and where
+//! they sample it they do so with the densities C_s divides by (see each module).
 
 mod bidirectional;
 mod chain;

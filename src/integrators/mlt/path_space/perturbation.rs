@@ -13,6 +13,16 @@
 //!   vertex before the specular chain by a small angle, trace through the chain to a new
 //!   last vertex and connect it to the lens.
 //!
+//! Lights that are not triangles: the lens and multi-chain perturbations keep x_0 unless
+//! they trace to it (`L S* E`), and then a light at infinity is found by a ray that leaves
+//! the scene, a triangle by one that hits it: a proposal whose light changes kind is
+//! refused (both ways), so the perturbations keep the light's kind and with it the
+//! applicable perturbations. The caustic perturbation does not apply when its chain starts
+//! at a light that is not a triangle (`L S+ D E` under a point light or from infinity): a
+//! point light's emission is not cosine-weighted about a normal and a direction's starts
+//! anywhere on a disc, so there is no emitted direction to turn within the densities
+//! above. Those paths are still explored by the bidirectional mutation.
+//!
 //! # Transfer ratios
 //!
 //! The film offset has a density that depends only on its length, so it is symmetric in
