@@ -840,73 +840,12 @@ mod tests {
     fn unweighted_contributions_match_bdpt_for_every_strategy() {
         for name in ["cornell-box", "cornell-glass"] {
             let (scene, camera) = canonical(name);
-            let camera = camera.model(32, 32);
-            let max_depth = 6;
-            let bdpt = Bdpt {
-                scene: &scene,
-                max_depth,
-                min_depth: 0,
-            };
-            let space = PathSpace {
-                scene: &scene,
-                camera: &camera,
-            };
-            let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
-            let mut counters = SampleCounters::default();
-            let mut rng = Rng::new(7, 0);
-            let mut path = Vec::new();
             // Per (s, t): strategies compared, and those through a specular vertex.
-            let mut compared = std::collections::BTreeMap::<(usize, usize), (u32, u32)>::new();
-            for _ in 0..20_000 {
-                let [x, y] = rng.uniform2();
-                let (n_camera, n_light) = bdpt.trace_subpaths(
-                    &camera,
-                    x * 32.0,
-                    y * 32.0,
-                    max_depth as usize + 2,
-                    max_depth as usize + 1,
-                    &mut rng,
-                    &mut scratch,
-                    &mut counters,
-                );
-                for t in 1..=n_camera {
-                    for s in 0..=n_light {
-                        if s + t < 2 || s + t - 2 > max_depth as usize || (s == 1 && t == 1) {
-                            continue;
-                        }
-                        let Some(c) =
-                            bdpt.connect(&camera, &mut scratch, s, t, &mut rng, &mut counters)
-                        else {
-                            continue;
-                        };
-                        bdpt.strategy_path(&scratch, s, t, &mut path);
-                        let expected = c.value / c.weight;
-                        let (value, pixel) = space
-                            .unweighted_contribution(&path, s, true)
-                            .unwrap_or_else(|| {
-                                panic!("{name} ({s}, {t}): none, BDPT {expected}: {path:?}")
-                            });
-                        let error = ((value - expected).abs()
-                            / expected.abs().max(Spectrum::splat(1e-6)))
-                        .max_component();
-                        assert!(
-                            error < 2e-3,
-                            "{name} ({s}, {t}): {value} vs BDPT's {expected}"
-                        );
-                        if let Some(splat) = c.splat_pixel {
-                            assert_eq!(pixel, splat, "{name} ({s}, {t})");
-                        }
-                        let specular = path.iter().any(|v| space.is_specular(v));
-                        let entry = compared.entry((s, t)).or_default();
-                        entry.0 += 1;
-                        entry.1 += specular as u32;
-                    }
-                }
-            }
+            let compared = compare_with_bdpt(name, &scene, &camera, 6, 20_000);
             // Every kind of connection, and (in glass) paths through specular vertices on
             // both sides, were compared.
             for (s, t) in [(0, 3), (1, 2), (2, 2), (3, 1), (2, 4), (4, 2)] {
-                let (count, _) = compared.get(&(s, t)).copied().unwrap_or_default();
+                let (count, ..) = compared.get(&(s, t)).copied().unwrap_or_default();
                 assert!(count > 50, "{name}: ({s}, {t}) compared {count} times");
             }
             if name == "cornell-glass" {
@@ -918,7 +857,7 @@ mod tests {
                     (4, 2, 50),
                     (6, 1, 100),
                 ] {
-                    let (_, through_glass) = compared.get(&(s, t)).copied().unwrap_or_default();
+                    let (_, through_glass, _) = compared.get(&(s, t)).copied().unwrap_or_default();
                     assert!(
                         through_glass >= least,
                         "{name}: ({s}, {t}) through glass {through_glass} times"
