@@ -62,6 +62,7 @@ use crate::accel::Ray;
 use crate::bsdf::SpecularLobe;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
+use crate::scene::lights::Emitter;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -330,18 +331,24 @@ pub(crate) fn lens(
             // x's light was seen through the specular chain: so must y's, a light of the
             // same kind (a surface, or a direction at infinity, which a ray that leaves the
             // scene finds), so that the proposal admits the same perturbations as x.
-            let v = if x[0].is_at_infinity() {
-                let v = space.trace_or_escape(&ray, rays)?;
-                if !v.is_at_infinity() {
-                    return None;
+            let v = match x[0].light {
+                None => {
+                    let v = space.trace(&ray, rays)?;
+                    if space.is_specular(&v) {
+                        return None;
+                    }
+                    v
                 }
-                v
-            } else {
-                let v = space.trace(&ray, rays)?;
-                if space.is_specular(&v) {
-                    return None;
+                Some(Emitter::Infinite) => {
+                    let v = space.trace_or_escape(&ray, rays)?;
+                    if !v.is_at_infinity() {
+                        return None;
+                    }
+                    v
                 }
-                v
+                // A delta light (reached from the light side only, by light tracing): no
+                // ray finds it.
+                Some(_) => return None,
             };
             y[0] = v;
             break 0;
