@@ -818,7 +818,8 @@ impl Bdpt<'_> {
             // Connect light vertex s-1 and camera vertex t-1.
             let qs = light[s - 1];
             let pt = camera[t - 1];
-            if !qs.connectible() || !pt.connectible() {
+            // A camera subpath that left the scene ends on a direction: nothing to connect.
+            if !qs.connectible() || !pt.connectible() || pt.at_infinity() {
                 return None;
             }
             let d = pt.p - qs.p;
@@ -853,10 +854,18 @@ impl Bdpt<'_> {
         t: usize,
         out: &mut Vec<PathVertex>,
     ) {
-        let as_path_vertex = |v: &Vertex| PathVertex {
-            p: v.p,
-            normal: v.normal,
-            triangle: v.triangle,
+        let as_path_vertex = |v: &Vertex| match v.kind {
+            // A point on an emissive triangle is told by its triangle, as a surface hit.
+            VertexKind::Light(Emitter::Point(light)) => PathVertex::point_light(light, v.p),
+            VertexKind::Light(emitter @ (Emitter::Directional(_) | Emitter::Infinite)) => {
+                PathVertex::at_infinity(emitter, v.normal)
+            }
+            _ => PathVertex {
+                p: v.p,
+                normal: v.normal,
+                triangle: v.triangle,
+                light: None,
+            },
         };
         out.clear();
         for i in 0..s {

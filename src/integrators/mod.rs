@@ -9,19 +9,30 @@ use crate::accel::Ray;
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
 use crate::sampling::Rng;
+use crate::scene::lights::Emitter;
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
 /// A vertex of a light path: a point on a light (the first), on a surface, or on the lens
 /// (the last).
+///
+/// The first vertex may be a light that is not an emissive triangle (`light`): a point or
+/// spot light (`p` its position, `normal` zero), or a light at infinity (the environment
+/// and sun disc, or a directional light), which is a direction, not a point: `normal` is
+/// the unit direction from the scene towards the light and `p` is zero (meaningless).
+/// Densities towards and from such a vertex are in solid angle, as in BDPT.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct PathVertex {
     pub p: Vec3A,
-    /// The triangle's front geometric normal; the camera's view direction for the lens.
+    /// The triangle's front geometric normal; the camera's view direction for the lens;
+    /// see above for lights that are not triangles.
     pub normal: Vec3A,
-    /// Internal triangle index (unused for the lens).
+    /// Internal triangle index (unused for the lens and for `light` vertices).
     pub triangle: u32,
+    /// `Some` for a first vertex on a light that is not an emissive triangle (a point on an
+    /// emissive triangle is `None`, told by its triangle, as any surface vertex).
+    pub light: Option<Emitter>,
 }
 
 impl PathVertex {
@@ -33,7 +44,53 @@ impl PathVertex {
             p: si.p,
             normal: si.geometric_normal,
             triangle: si.triangle,
+            light: None,
         }
+    }
+
+    /// A vertex on the lens (or any point that is not on a surface or a light).
+    #[inline]
+    pub fn point(p: Vec3A, normal: Vec3A) -> PathVertex {
+        PathVertex {
+            p,
+            normal,
+            triangle: 0,
+            light: None,
+        }
+    }
+
+    /// The light at infinity `emitter` seen towards unit direction `toward`.
+    #[inline]
+    pub fn at_infinity(emitter: Emitter, toward: Vec3A) -> PathVertex {
+        PathVertex {
+            p: Vec3A::ZERO,
+            normal: toward,
+            triangle: 0,
+            light: Some(emitter),
+        }
+    }
+
+    /// Point or spot light number `light` at `position`.
+    #[inline]
+    pub fn point_light(light: u32, position: Vec3A) -> PathVertex {
+        PathVertex {
+            p: position,
+            normal: Vec3A::ZERO,
+            triangle: 0,
+            light: Some(Emitter::Point(light)),
+        }
+    }
+
+    /// Whether the vertex is a direction at infinity.
+    #[inline]
+    pub fn is_at_infinity(&self) -> bool {
+        matches!(self.light, Some(e) if e.at_infinity())
+    }
+
+    /// Whether the vertex is a point or spot light.
+    #[inline]
+    pub fn is_point_light(&self) -> bool {
+        matches!(self.light, Some(Emitter::Point(_)))
     }
 }
 

@@ -196,19 +196,6 @@ fn render_into(
 ) -> Result<RenderStats> {
     settings.validate()?;
     camera.validate()?;
-    if matches!(
-        settings.algorithm,
-        Algorithm::PathSpaceMlt | Algorithm::Erpt
-    ) && scene.lights.has_non_area_lights()
-    {
-        return Err(Error::new(
-            crate::error::MltStatus::MLT_STATUS_UNSUPPORTED,
-            format!(
-                "{:?} does not support environment, sun or punctual lights yet (only emissive triangles); use path, bdpt, pssmlt, pssmlt-bdpt or mmlt",
-                settings.algorithm
-            ),
-        ));
-    }
     let needed = settings.output_len()?;
     let shortest = rgb_out
         .len()

@@ -611,3 +611,107 @@ pub fn host_triple() -> Option<&'static str> {
         _ => return None,
     })
 }
+
+/// The Cornell box open above: without its ceiling and its ceiling light, lit by `lights`
+/// only (light from infinity gets in from above and through the open front). A camera
+/// nearer than the canonical one sees the floor, the walls and some sky above them.
+pub fn open_cornell_box(lights: mlt::LightsDesc) -> (Scene, Camera) {
+    let mesh = canonical_mesh("cornell-box");
+    let top = mesh
+        .positions
+        .chunks(3)
+        .map(|p| p[1])
+        .fold(f32::MIN, f32::max);
+    let mut indices = Vec::new();
+    let mut material_ids = Vec::new();
+    for (triangle, &material) in mesh.indices.chunks(3).zip(&mesh.material_ids) {
+        let high = triangle
+            .iter()
+            .all(|&v| mesh.positions[3 * v as usize + 1] >= top - 1.0);
+        if high {
+            continue;
+        }
+        indices.extend_from_slice(triangle);
+        material_ids.push(material);
+    }
+    let scene = Scene::new(&mlt::SceneDesc {
+        positions: &mesh.positions,
+        indices: &indices,
+        material_ids: &material_ids,
+        materials: &mesh.materials,
+        lights,
+        backend: mlt::Backend::Bvh,
+    })
+    .unwrap();
+    let camera = Camera {
+        eye: [278.0, 420.0, -500.0],
+        target: [278.0, 330.0, 0.0],
+        ..canonical_camera("cornell-box")
+    };
+    (scene, camera)
+}
+
+/// The lights of the open scenes of the path-space MLT and ERPT tests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OpenLights {
+    /// A constant sky and a sun disc.
+    SkyAndSun,
+    /// A spot light inside the box and a directional light from above.
+    SpotAndDirectional,
+}
+
+/// [`open_cornell_box`] with `lights`.
+pub fn open_scene(lights: OpenLights) -> (Scene, Camera) {
+    let sky = [0.5f32, 0.6, 0.8];
+    let punctual = [
+        mlt::PunctualLight::spot(
+            [200.0, 500.0, 250.0],
+            [0.3, -1.0, 0.2],
+            [3.2e5, 2.4e5, 1.6e5],
+            15.0,
+            35.0,
+        ),
+        mlt::PunctualLight::directional([-0.4, -1.0, 0.3], [0.8, 0.8, 0.6]),
+    ];
+    open_cornell_box(match lights {
+        OpenLights::SkyAndSun => mlt::LightsDesc {
+            environment: Some(mlt::EnvironmentDesc::constant(&sky)),
+            sun: Some(mlt::SunDesc::from_radiance(
+                [0.4, 1.0, -0.5],
+                3.0,
+                [300.0, 270.0, 220.0],
+            )),
+            punctual: &[],
+        },
+        OpenLights::SpotAndDirectional => mlt::LightsDesc {
+            punctual: &punctual,
+            ..Default::default()
+        },
+    })
+}
+
+/// Image size and depth of the open-scene tests (small: they run in CI).
+pub const OPEN_SIZE: u32 = 32;
+pub const OPEN_MAX_DEPTH: u32 = 3;
+
+/// The path tracer's estimate of an open scene: 8 renders of `OPEN_SIZE`² at 1024 samples.
+pub fn open_reference(lights: OpenLights) -> &'static Estimate {
+    cached_estimate(&format!("path open {lights:?}"), || {
+        let (scene, camera) = open_scene(lights);
+        let renders: Vec<Vec<f32>> = (2000..2008)
+            .map(|seed| {
+                let settings = mlt::RenderSettings {
+                    width: OPEN_SIZE,
+                    height: OPEN_SIZE,
+                    algorithm: mlt::Algorithm::Path,
+                    samples_per_pixel: 1024,
+                    max_depth: OPEN_MAX_DEPTH,
+                    seed,
+                    ..Default::default()
+                };
+                render_image(&scene, &camera, &settings)
+            })
+            .collect();
+        Estimate::from_renders(OPEN_SIZE as usize, OPEN_SIZE as usize, &renders)
+    })
+}

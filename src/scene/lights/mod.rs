@@ -376,14 +376,6 @@ impl SceneLights {
         !self.lights.is_empty()
     }
 
-    /// Whether the scene has a light that is not an emissive triangle.
-    #[inline]
-    pub(crate) fn has_non_area_lights(&self) -> bool {
-        self.lights
-            .iter()
-            .any(|light| !matches!(light, Light::Area(_)))
-    }
-
     /// Whether rays that leave the scene can find light (an environment or a sun disc).
     #[inline]
     pub(crate) fn has_infinite_light(&self) -> bool {

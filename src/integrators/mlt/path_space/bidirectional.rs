@@ -33,7 +33,14 @@
 //! ```
 //!
 //! where |·| is luminance and splits that cannot produce the path (a connection at a
-//! specular vertex) have p_i = 0 and no term. This is Veach's form (the sum over splits);
+//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term.
+//!
+//! A new light vertex is picked as `Scene::sample_light` picks it (a point on a triangle, a
+//! point or spot light, or a direction at infinity), and the light side's first ray leaves
+//! it as `sample_emission`'s would (`emission_ray`); a lens side whose last vertex is the
+//! path's light ends on the lights at infinity if its ray leaves the scene. A light that is
+//! not a triangle never becomes an inner vertex (a move keeping the whole path as its lens
+//! side and adding vertices before it is refused; such paths have f = 0). This is Veach's form (the sum over splits);
 //! every term comes from `PathSpace::unweighted_contribution`, which the tests check
 //! against BDPT strategy by strategy.
 
@@ -41,9 +48,11 @@ use super::{PathSpace, PathVertex};
 use crate::accel::Ray;
 use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
-use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere};
+use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
+use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
+use std::f32::consts::TAU;
 
 /// Probabilities of δ = n_a − n_d = −2, −1, 0, 1, 2: mostly the same length, as Veach
 /// suggests. Symmetric, so p_add(n_a | n_d) = p_add(n_d | n_a).
@@ -162,6 +171,12 @@ impl Bidirectional {
         }
         let from_light = ((rng.uniform() * (added + 1) as f32) as usize).min(added);
         let from_eye = added - from_light;
+        // Keeping the whole path as the lens side and adding vertices before its light makes
+        // the light an inner vertex: possible for an emissive triangle, never for a point
+        // light or a direction.
+        if added > 0 && b == 0 && x[0].light.is_some() {
+            return None;
+        }
 
         // Light side: the kept prefix, then `from_light` sampled vertices.
         y.clear();
@@ -173,8 +188,11 @@ impl Bidirectional {
         // Lens side: sampled backwards from the kept suffix into `eye` (lens-side order).
         let suffix = &x[b as usize..];
         eye.clear();
-        for _ in 0..from_eye {
-            let next = self.extend_eye_side(space, suffix, eye, rng, rays)?;
+        for i in 0..from_eye {
+            // The last vertex sampled from the lens side is the light when the light side
+            // is empty: a ray that leaves the scene then ends on the lights at infinity.
+            let is_light = y.is_empty() && i + 1 == from_eye;
+            let next = self.extend_eye_side(space, suffix, eye, is_light, rng, rays)?;
             eye.push(next);
         }
         let s = y.len();
@@ -216,8 +234,10 @@ impl Bidirectional {
                 if !scene.lights.has_lights() {
                     return None;
                 }
+                // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
+                // which are `sample_emission`'s).
                 match scene.lights.sample_light(rng.uniform(), rng.uniform2())? {
-                    crate::scene::lights::LightSample::Area {
+                    LightSample::Area {
                         point,
                         normal,
                         triangle,
@@ -226,19 +246,30 @@ impl Bidirectional {
                         p: point,
                         normal,
                         triangle,
+                        light: None,
                     }),
-                    // Path-space MLT refuses scenes with other lights (see `render`).
-                    _ => None,
+                    LightSample::Point {
+                        light, position, ..
+                    } => Some(PathVertex::point_light(light, position)),
+                    LightSample::Direction {
+                        emitter, toward, ..
+                    } => Some(PathVertex::at_infinity(emitter, toward)),
                 }
             }
-            [light] => {
-                let local = cosine_hemisphere(rng.uniform2());
-                if local.z <= 0.0 {
-                    return None;
+            [light] => match light.light {
+                None => {
+                    let local = cosine_hemisphere(rng.uniform2());
+                    if local.z <= 0.0 {
+                        return None;
+                    }
+                    let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
+                    space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
                 }
-                let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
-                space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
-            }
+                Some(_) => {
+                    let ray = emission_ray(scene, light, rng.uniform2())?;
+                    space.trace(&ray, rays)
+                }
+            },
             [.., previous, end] => {
                 let wi = sample_direction(space, previous, end, TransportMode::Importance, rng)?;
                 space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)
@@ -247,12 +278,15 @@ impl Bidirectional {
     }
 
     /// The next vertex of the lens side: `eye` holds its sampled vertices so far (nearest
-    /// the lens first), continuing the kept `suffix` (empty: a new lens point).
+    /// the lens first), continuing the kept `suffix` (empty: a new lens point). With
+    /// `is_light`, the vertex is the path's light (a ray leaving the scene is then on the
+    /// lights at infinity).
     fn extend_eye_side(
         &self,
         space: &PathSpace,
         suffix: &[PathVertex],
         eye: &[PathVertex],
+        is_light: bool,
         rng: &mut Rng,
         rays: &mut u64,
     ) -> Option<PathVertex> {
@@ -270,21 +304,67 @@ impl Bidirectional {
             (end, suffix.get(1))
         } else {
             let lens = camera.sample_lens(rng.uniform2());
-            return Some(PathVertex {
-                p: lens,
-                normal: camera.forward,
-                triangle: 0,
-            });
+            return Some(PathVertex::point(lens, camera.forward));
         };
         let Some(previous) = previous else {
             // The end is the lens: a new film position, uniform over the film.
             let [u, v] = rng.uniform2();
             let direction =
                 camera.direction_through(end.p, u * camera.width as f32, v * camera.height as f32);
-            return space.trace(&Ray::new(end.p, direction, 0.0, f32::INFINITY), rays);
+            let ray = Ray::new(end.p, direction, 0.0, f32::INFINITY);
+            return if is_light {
+                space.trace_or_escape(&ray, rays)
+            } else {
+                space.trace(&ray, rays)
+            };
         };
         let wi = sample_direction(space, previous, end, TransportMode::Radiance, rng)?;
-        space.trace(&spawn_ray(space.scene, end.p, end.normal, wi), rays)
+        let ray = spawn_ray(space.scene, end.p, end.normal, wi);
+        if is_light {
+            space.trace_or_escape(&ray, rays)
+        } else {
+            space.trace(&ray, rays)
+        }
+    }
+}
+
+/// The first ray of a light side from light vertex `light` that is not a triangle, with
+/// the density `unweighted_contribution` gives it: from a point or spot light uniformly
+/// over the sphere or the spot's outer cone (`PointLight::direction_pdf`); from a light at
+/// infinity along it, from a uniform point of the disc facing it that covers the scene's
+/// bounding sphere (`Scene::disc_pdf`, as `sample_emission`).
+fn emission_ray(scene: &crate::scene::Scene, light: &PathVertex, u: [f32; 2]) -> Option<Ray> {
+    match light.light? {
+        Emitter::Point(index) => {
+            let point = scene.lights.point_light(index);
+            let direction = match &point.cone {
+                None => uniform_sphere(u),
+                Some(cone) => {
+                    let cos_theta = 1.0 - u[0] * (1.0 - cone.cos_outer);
+                    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                    let (sin_phi, cos_phi) = (TAU * u[1]).sin_cos();
+                    OrthonormalBasis::from_normal(cone.axis).to_world(Vec3A::new(
+                        cos_phi * sin_theta,
+                        sin_phi * sin_theta,
+                        cos_theta,
+                    ))
+                }
+            };
+            if point.direction_pdf(direction) <= 0.0 {
+                return None;
+            }
+            Some(Ray::new(light.p, direction, 0.0, f32::INFINITY))
+        }
+        Emitter::Area(_) => None,
+        Emitter::Directional(_) | Emitter::Infinite => {
+            let (center, radius) = scene.lights.bounding_sphere;
+            let toward = light.normal;
+            let [dx, dy] = uniform_disk(u);
+            let basis = OrthonormalBasis::from_normal(toward);
+            let origin =
+                center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
+            Some(Ray::new(origin, -toward, 0.0, f32::INFINITY))
+        }
     }
 }
 
@@ -297,7 +377,11 @@ fn sample_direction(
     mode: TransportMode,
     rng: &mut Rng,
 ) -> Option<Vec3A> {
-    let wo = (from.p - at.p).normalize();
+    let wo = if from.is_at_infinity() {
+        from.normal
+    } else {
+        (from.p - at.p).normalize()
+    };
     let s = space
         .surface_bsdf(at)
         .sample(wo, rng.uniform2(), rng.uniform(), mode)?;
@@ -411,6 +495,11 @@ mod tests {
     const FOV_Y_DEG: f32 = 60.0;
 
     fn scene() -> Scene {
+        scene_with(Default::default())
+    }
+
+    /// The small scene with more lights.
+    fn scene_with(lights: crate::scene::LightsDesc) -> Scene {
         let mut positions = Vec::new();
         let mut indices = Vec::new();
         let mut material_ids = Vec::new();
@@ -436,7 +525,7 @@ mod tests {
                 Material::diffuse(albedo(Surface::Wall)),
                 Material::diffuse([0.0; 3]).with_emission([EMISSION; 3]),
             ],
-            lights: Default::default(),
+            lights,
             backend: Backend::Bvh,
         })
         .unwrap()
@@ -707,6 +796,7 @@ mod tests {
             p: space.camera.eye,
             normal: space.camera.forward,
             triangle: 0,
+            light: None,
         };
         assert_eq!(
             [light, wall, floor].map(|v| Surface::of(&v)),
@@ -756,6 +846,7 @@ mod tests {
                             p: Vec3A::from(p.as_vec3()),
                             normal: Vec3A::from(r.normal().as_vec3()),
                             triangle: 0,
+                            light: None,
                         };
                         nodes.push((cell, vertex, weight));
                     }
@@ -797,6 +888,101 @@ mod tests {
     /// Normal quantiles: 99.9% and 99.99%.
     const Z_999: f64 = 3.090_232;
     const Z_9999: f64 = 3.719_016;
+
+    /// The first rays of a light side from a point light, a spot light and a light at
+    /// infinity have the densities `unweighted_contribution` divides by: directions
+    /// uniform over the sphere or the spot's outer cone (cos θ and φ uniform), and origins
+    /// uniform over the disc of radius R facing the light, at R from the bounding sphere's
+    /// centre (r² / R² and the angle uniform), leaving along the light's direction. Chi-square
+    /// tests over 20 bins of each coordinate, and one with the cone's density shaped
+    /// (cos θ = 1 − u²(1 − cos θ_max)) fails.
+    #[test]
+    fn emission_rays_from_lights_that_are_not_triangles_have_their_densities() {
+        use crate::scene::{LightsDesc, PunctualLight, SunDesc};
+        let punctual = [
+            PunctualLight::point([0.0, 1.2, 0.0], [1.0; 3]),
+            PunctualLight::spot([0.0, 1.2, 0.0], [0.2, -1.0, 0.1], [1.0; 3], 10.0, 40.0),
+            PunctualLight::directional([0.3, -1.0, 0.4], [1.0; 3]),
+        ];
+        let scene = scene_with(LightsDesc {
+            sun: Some(SunDesc::from_radiance([-0.2, 1.0, 0.3], 4.0, [50.0; 3])),
+            punctual: &punctual,
+            ..Default::default()
+        });
+        let (center, radius) = scene.lights.bounding_sphere;
+        let bins = 20;
+        let draws = 100_000;
+        let threshold = chi_square_quantile(bins - 1, Z_9999);
+        let uniform = vec![1.0 / bins as f64; bins];
+        let bin = |x: f32| ((x * bins as f32) as usize).min(bins - 1);
+        // The lights' indices: the area lights (triangles) first, then the punctual ones.
+        let areas = scene
+            .lights
+            .lights
+            .iter()
+            .filter(|l| matches!(l, crate::scene::lights::Light::Area(_)))
+            .count() as u32;
+        let lights = [
+            PathVertex::point_light(areas, Vec3A::new(0.0, 1.2, 0.0)),
+            PathVertex::point_light(areas + 1, Vec3A::new(0.0, 1.2, 0.0)),
+            PathVertex::at_infinity(
+                Emitter::Directional(areas + 2),
+                Vec3A::new(-0.3, 1.0, -0.4).normalize(),
+            ),
+            PathVertex::at_infinity(Emitter::Infinite, Vec3A::new(0.1, 0.9, 0.2).normalize()),
+        ];
+        let mut rng = Rng::new(0xE111, 0);
+        for (index, light) in lights.iter().enumerate() {
+            let (mut first, mut second) = (vec![0u64; bins], vec![0u64; bins]);
+            let mut shaped = vec![0u64; bins];
+            for _ in 0..draws {
+                let u = rng.uniform2();
+                let ray = emission_ray(&scene, light, u).expect("a ray");
+                // Coordinates that are uniform under the density.
+                let (a, b) = match light.light {
+                    Some(Emitter::Point(i)) => {
+                        let point = scene.lights.point_light(i);
+                        let (axis, cos_max) = point
+                            .cone
+                            .map_or((Vec3A::Y, -1.0), |c| (c.axis, c.cos_outer));
+                        let basis = OrthonormalBasis::from_normal(axis);
+                        let w = ray.direction;
+                        assert!((ray.origin - light.p).length() < 1e-6);
+                        let phi = basis.bitangent.dot(w).atan2(basis.tangent.dot(w));
+                        let a = (1.0 - axis.dot(w)) / (1.0 - cos_max);
+                        if point.cone.is_some() {
+                            // A shaped cone, cos θ = 1 − u²(1 − cos θ_max), would have a = u².
+                            shaped[bin(u[0] * u[0])] += 1;
+                        }
+                        (a, phi / TAU + 0.5)
+                    }
+                    _ => {
+                        let toward = light.normal;
+                        assert!((ray.direction + toward).length() < 1e-5);
+                        let offset = ray.origin - center - toward * radius;
+                        assert!(offset.dot(toward).abs() < 1e-3 * radius);
+                        let basis = OrthonormalBasis::from_normal(toward);
+                        let (x, y) = (basis.tangent.dot(offset), basis.bitangent.dot(offset));
+                        ((x * x + y * y) / (radius * radius), y.atan2(x) / TAU + 0.5)
+                    }
+                };
+                first[bin(a)] += 1;
+                second[bin(b)] += 1;
+            }
+            for (name, counts) in [("radial", &first), ("angle", &second)] {
+                let stat = chi_square(counts, 0, &uniform);
+                assert!(
+                    stat < threshold,
+                    "light {index} {name}: chi-square {stat} ≥ {threshold}: {counts:?}"
+                );
+            }
+            if matches!(light.light, Some(Emitter::Point(i)) if scene.lights.point_light(i).cone.is_some())
+            {
+                let stat = chi_square(&shaped, 0, &uniform);
+                assert!(stat > 10.0 * threshold, "the shaped cone passes: {stat}");
+            }
+        }
+    }
 
     /// The proposal density: the proposals of one discrete choice from a fixed path x,
     /// histogrammed over cells of the new vertex, against T(x→y) = p_del · p_add · Σ_i p_i(y)

@@ -13,6 +13,16 @@
 //!   vertex before the specular chain by a small angle, trace through the chain to a new
 //!   last vertex and connect it to the lens.
 //!
+//! Lights that are not triangles: the lens and multi-chain perturbations keep x_0 unless
+//! they trace to it (`L S* E`), and then a light at infinity is found by a ray that leaves
+//! the scene, a triangle by one that hits it: a proposal whose light changes kind is
+//! refused (both ways), so the perturbations keep the light's kind and with it the
+//! applicable perturbations. The caustic perturbation does not apply when its chain starts
+//! at a light that is not a triangle (`L S+ D E` under a point light or from infinity): a
+//! point light's emission is not cosine-weighted about a normal and a direction's starts
+//! anywhere on a disc, so there is no emitted direction to turn within the densities
+//! above. Those paths are still explored by the bidirectional mutation.
+//!
 //! # Transfer ratios
 //!
 //! The film offset has a density that depends only on its length, so it is symmetric in
@@ -52,6 +62,7 @@ use crate::accel::Ray;
 use crate::bsdf::SpecularLobe;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
+use crate::scene::lights::Emitter;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -200,8 +211,15 @@ impl Kernel for RandomKernel<'_> {
 /// diffuse surface's side facing the vertex `from` it was arrived at from.
 #[inline]
 fn sampling_side(from: Option<&PathVertex>, at: &PathVertex) -> Vec3A {
+    let toward = |from: &PathVertex| {
+        if from.is_at_infinity() {
+            from.normal
+        } else {
+            from.p - at.p
+        }
+    };
     match from {
-        Some(from) if at.normal.dot(from.p - at.p) < 0.0 => -at.normal,
+        Some(from) if at.normal.dot(toward(from)) < 0.0 => -at.normal,
         _ => at.normal,
     }
 }
@@ -228,8 +246,25 @@ pub(crate) fn applicable(space: &PathSpace, x: &[PathVertex]) -> Applicable {
     let n = x.len();
     let m = first_non_specular_from_lens(space, x);
     let lens = m == 0 || !space.is_specular(&x[m - 1]);
-    let caustic = n >= 4 && !space.is_specular(&x[n - 2]) && space.is_specular(&x[n - 3]);
+    // A light that is not a triangle (a point light, a direction) has no emitted direction
+    // to perturb (a direction's emission starts anywhere on a disc): the caustic
+    // perturbation applies only where its chain starts at a surface. The perturbations keep
+    // the light's kind, so this too is the same at x and at its proposals.
+    let caustic = n >= 4
+        && !space.is_specular(&x[n - 2])
+        && space.is_specular(&x[n - 3])
+        && (x[0].light.is_none() || caustic_start(space, x) > 0);
     Applicable { lens, caustic }
+}
+
+/// The non-specular vertex the caustic perturbation turns: where the specular chain before
+/// x_{n-2} starts (x_0, the light, at the latest).
+#[inline]
+fn caustic_start(space: &PathSpace, x: &[PathVertex]) -> usize {
+    (1..x.len() - 3)
+        .rev()
+        .find(|&k| !space.is_specular(&x[k]))
+        .unwrap_or(0)
 }
 
 /// The lobe vertex `k` of `x` scatters through (x_{k+1} → x_k → x_{k-1}).
@@ -292,16 +327,34 @@ pub(crate) fn lens(
     );
     let mut k = n - 2;
     let s = loop {
-        let v = space.trace(&ray, rays)?;
-        let specular = space.is_specular(&v);
         if k == 0 {
-            // x's light was seen through the specular chain: so must y's.
-            if specular {
-                return None;
-            }
+            // x's light was seen through the specular chain: so must y's, a light of the
+            // same kind (a surface, or a direction at infinity, which a ray that leaves the
+            // scene finds), so that the proposal admits the same perturbations as x.
+            let v = match x[0].light {
+                None => {
+                    let v = space.trace(&ray, rays)?;
+                    if space.is_specular(&v) {
+                        return None;
+                    }
+                    v
+                }
+                Some(Emitter::Infinite) => {
+                    let v = space.trace_or_escape(&ray, rays)?;
+                    if !v.is_at_infinity() {
+                        return None;
+                    }
+                    v
+                }
+                // A delta light (reached from the light side only, by light tracing): no
+                // ray finds it.
+                Some(_) => return None,
+            };
             y[0] = v;
             break 0;
         }
+        let v = space.trace(&ray, rays)?;
+        let specular = space.is_specular(&v);
         if specular != space.is_specular(&x[k]) {
             return None;
         }
@@ -368,10 +421,7 @@ pub(crate) fn caustic(
         return None;
     }
     // The non-specular vertex the specular chain before x_{n-2} starts from.
-    let c = (1..n - 3)
-        .rev()
-        .find(|&k| !space.is_specular(&x[k]))
-        .unwrap_or(0);
+    let c = caustic_start(space, x);
     let (old, _) = direction(&x[c], &x[c + 1])?;
     let from = c.checked_sub(1).map(|i| &x[i]);
     let side = sampling_side(from, &x[c]);
@@ -530,6 +580,7 @@ mod tests {
             p: camera.eye,
             normal: camera.forward,
             triangle: 0,
+            light: None,
         }
     }
 
