@@ -19,13 +19,15 @@ use mlt::{
 };
 use std::f64::consts::PI;
 
-/// Every algorithm that renders these lights.
-const ALGORITHMS: [Algorithm; 5] = [
+/// Every algorithm.
+const ALGORITHMS: [Algorithm; 7] = [
     Algorithm::Path,
     Algorithm::Bdpt,
     Algorithm::Pssmlt,
     Algorithm::PssmltBdpt,
     Algorithm::Mmlt,
+    Algorithm::PathSpaceMlt,
+    Algorithm::Erpt,
 ];
 
 const SIZE: u32 = 16;
@@ -459,9 +461,11 @@ fn bdpt_agrees_with_the_path_tracer(name: &str) {
     );
 }
 
+/// A Metropolis algorithm (or ERPT, whose camera samples are BDPT's) against BDPT.
 fn metropolis_agrees_with_bdpt(name: &str, algorithm: Algorithm) {
     let settings = RenderSettings {
         algorithm,
+        samples_per_pixel: 40 * effort(name),
         mutations_per_pixel: 128 * effort(name),
         bootstrap_samples: 1 << 16,
         chains: 256,
@@ -490,15 +494,29 @@ fn spot_and_sun_bdpt_agrees_with_the_path_tracer() {
 }
 
 #[test]
-fn window_room_metropolis_agrees_with_bdpt() {
+fn window_room_primary_space_metropolis_agrees_with_bdpt() {
     for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt, Algorithm::Mmlt] {
         metropolis_agrees_with_bdpt("window-room", algorithm);
     }
 }
 
 #[test]
-fn spot_and_sun_metropolis_agrees_with_bdpt() {
+fn spot_and_sun_primary_space_metropolis_agrees_with_bdpt() {
     for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt, Algorithm::Mmlt] {
+        metropolis_agrees_with_bdpt("spot-and-sun", algorithm);
+    }
+}
+
+#[test]
+fn window_room_path_space_mlt_and_erpt_agree_with_bdpt() {
+    for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
+        metropolis_agrees_with_bdpt("window-room", algorithm);
+    }
+}
+
+#[test]
+fn spot_and_sun_path_space_mlt_and_erpt_agree_with_bdpt() {
+    for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
         metropolis_agrees_with_bdpt("spot-and-sun", algorithm);
     }
 }
