@@ -574,18 +574,7 @@ fn window_room_images_agree() {
     let mesh = canonical_mesh("window-room");
     let camera = canonical_camera("window-room");
     let sky = window_room::sky_pixels();
-    let (width, height) = window_room::SKY_SIZE;
-    let lights = mlt::LightsDesc {
-        environment: Some(mlt::EnvironmentDesc {
-            pixels: &sky,
-            width,
-            height,
-            rotation_degrees: 0.0,
-            scale: 1.0,
-        }),
-        sun: Some(window_room::sun()),
-        ..Default::default()
-    };
+    let lights = window_room::lights(&sky);
     let estimate = |backend, seeds: std::ops::Range<u64>| {
         let scene = mesh.scene_lit(backend, lights);
         let renders: Vec<Vec<f32>> = seeds

@@ -327,18 +327,7 @@ fn plane_under_a_directional_and_a_point_light() {
 fn window_room_scene() -> (Scene, Camera) {
     let mesh = canonical_mesh("window-room");
     let sky = window_room::sky_pixels();
-    let (width, height) = window_room::SKY_SIZE;
-    let lights = LightsDesc {
-        environment: Some(EnvironmentDesc {
-            pixels: &sky,
-            width,
-            height,
-            rotation_degrees: 0.0,
-            scale: 1.0,
-        }),
-        sun: Some(window_room::sun()),
-        ..Default::default()
-    };
+    let lights = window_room::lights(&sky);
     (
         mesh.scene_lit(Backend::Bvh, lights),
         canonical_camera("window-room"),
@@ -378,19 +367,8 @@ fn spot_and_sun_box() -> (Scene, Camera) {
 fn sky_spheres_scene() -> (Scene, Camera) {
     let data = mlt::io::load_scene(&common::scenes_dir().join("sky-spheres.gltf")).unwrap();
     let sky = window_room::sky_pixels();
-    let (width, height) = window_room::SKY_SIZE;
     let mut desc = data.desc(Backend::Bvh);
-    desc.lights = LightsDesc {
-        environment: Some(EnvironmentDesc {
-            pixels: &sky,
-            width,
-            height,
-            rotation_degrees: 0.0,
-            scale: 1.0,
-        }),
-        sun: Some(window_room::sun()),
-        ..Default::default()
-    };
+    desc.lights = window_room::lights(&sky);
     (Scene::new(&desc).unwrap(), data.camera.unwrap().camera)
 }
 

@@ -62,20 +62,9 @@ pub fn load_scene(name: &str) -> (Scene, Camera) {
     let data = mlt::io::load_scene(&path)
         .unwrap_or_else(|e| panic!("scene {name} (MLT_BENCH_SCENES) does not load: {e}"));
     let sky = super::window_room::sky_pixels();
-    let (sky_width, sky_height) = super::window_room::SKY_SIZE;
     let mut desc = data.desc(mlt::Backend::Bvh);
     if name == "window-room" {
-        desc.lights = mlt::LightsDesc {
-            environment: Some(mlt::EnvironmentDesc {
-                pixels: &sky,
-                width: sky_width,
-                height: sky_height,
-                rotation_degrees: 0.0,
-                scale: 1.0,
-            }),
-            sun: Some(super::window_room::sun()),
-            ..Default::default()
-        };
+        desc.lights = super::window_room::lights(&sky);
     }
     let scene = Scene::new(&desc).expect("scene builds");
     let camera = data.camera.expect("camera sidecar").camera;

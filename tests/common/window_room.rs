@@ -14,7 +14,7 @@
 //! the sun's way.
 
 use super::obj_text::{self, Obj};
-use mlt::SunDesc;
+use mlt::{EnvironmentDesc, LightsDesc, SunDesc};
 
 const WIDTH: f64 = 4000.0;
 const HEIGHT: f64 = 2800.0;
@@ -129,4 +129,20 @@ pub fn sky_pixels() -> Vec<f32> {
         }
     }
     pixels
+}
+
+/// The scene's lights: `sky` (from `sky_pixels`) as the environment, and the sun.
+pub fn lights(sky: &[f32]) -> LightsDesc<'_> {
+    let (width, height) = SKY_SIZE;
+    LightsDesc {
+        environment: Some(EnvironmentDesc {
+            pixels: sky,
+            width,
+            height,
+            rotation_degrees: 0.0,
+            scale: 1.0,
+        }),
+        sun: Some(sun()),
+        ..Default::default()
+    }
 }
