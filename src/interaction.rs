@@ -18,13 +18,11 @@ use glam::Vec3A;
 pub(crate) struct SurfaceInteraction {
     pub p: Vec3A,
     /// Unit geometric normal of the triangle's front (counter-clockwise) side: for cosines
-    /// in geometry terms and for moving ray origins off the surface.
+    /// in geometry terms and for moving ray origins off the surface. (The BSDF's shading
+    /// frame may differ: interpolated or mapped normals.)
     pub geometric_normal: Vec3A,
-    /// The normal of the shading frame the BSDF is evaluated in. Today it is the geometric
-    /// normal (there are no interpolated or mapped normals yet).
-    pub shading_normal: Vec3A,
-    /// Barycentrics of the hit: the point is `(1-u-v)·v0 + u·v1 + v·v2`. For textures.
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// Barycentrics of the hit: the point is `(1-u-v)·v0 + u·v1 + v·v2`. Where the vertex
+    /// attributes (shading normals, texture coordinates) are interpolated.
     pub uv: [f32; 2],
     /// Internal triangle index.
     pub triangle: u32,
@@ -43,7 +41,6 @@ impl SurfaceInteraction {
         SurfaceInteraction {
             p: ray.origin + ray.direction * hit.t,
             geometric_normal: shading.normal,
-            shading_normal: shading.normal,
             uv: [hit.u, hit.v],
             triangle: hit.triangle,
             material: shading.material,
@@ -53,11 +50,8 @@ impl SurfaceInteraction {
 
     /// The surface's BSDF here.
     #[inline]
-    pub fn bsdf<'s>(&self, scene: &'s Scene) -> Bsdf<'s> {
-        Bsdf::new(
-            &scene.materials[self.material as usize],
-            self.shading_normal,
-        )
+    pub fn bsdf(&self, scene: &Scene) -> Bsdf {
+        scene.bsdf_at(self.triangle, self.uv)
     }
 
     /// Radiance the surface emits from its front side (its material's emission; only
@@ -69,14 +63,11 @@ impl SurfaceInteraction {
 }
 
 /// The BSDF at a path vertex stored without its interaction (BDPT and path-space vertices
-/// keep only the point, the normal and the triangle, to stay small): the material of
-/// internal triangle `triangle` in the frame of `shading_normal`. Exact while shading frames
-/// are constant over a triangle; once they are not, such vertices must keep their
-/// barycentrics (or the interaction).
+/// keep only the point, the geometric normal, the triangle and the barycentrics, to stay
+/// small): the same BSDF the interaction gave.
 #[inline]
-pub(crate) fn vertex_bsdf(scene: &Scene, triangle: u32, shading_normal: Vec3A) -> Bsdf<'_> {
-    let material = scene.shading[triangle as usize].material;
-    Bsdf::new(&scene.materials[material as usize], shading_normal)
+pub(crate) fn vertex_bsdf(scene: &Scene, triangle: u32, barycentrics: [f32; 2]) -> Bsdf {
+    scene.bsdf_at(triangle, barycentrics)
 }
 
 #[cfg(test)]
@@ -99,6 +90,7 @@ mod tests {
             materials: &materials,
             lights: Default::default(),
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap();
         let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
@@ -106,7 +98,7 @@ mod tests {
         let si = SurfaceInteraction::new(&scene, &ray, &hit);
         assert_eq!(si.p, Vec3A::new(0.0, 0.0, 1.0));
         assert_eq!(si.geometric_normal, Vec3A::new(0.0, 0.0, -1.0));
-        assert_eq!(si.shading_normal, si.geometric_normal);
+        assert_eq!(si.bsdf(&scene).shading_normal(), si.geometric_normal);
         assert_eq!(si.uv, [hit.u, hit.v]);
         assert_eq!((si.triangle, si.material), (hit.triangle, 0));
         // The only light: picked with probability 1 over its area 2.

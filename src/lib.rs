@@ -17,6 +17,7 @@
 //!     materials: &materials,
 //!     lights: Default::default(),
 //!     backend: Default::default(),
+//!     ..Default::default()
 //! })
 //! .unwrap();
 //! let camera = Camera { eye: [0.0, 0.0, -3.0], target: [0.0; 3], ..Camera::default() };

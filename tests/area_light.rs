@@ -63,6 +63,7 @@ fn scene(split_light: bool) -> Scene {
         materials: &materials,
         lights: Default::default(),
         backend: Backend::Bvh,
+        ..Default::default()
     })
     .unwrap()
 }

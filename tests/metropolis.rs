@@ -216,6 +216,7 @@ fn glass_caustic() -> (Scene, Camera) {
         ],
         lights: Default::default(),
         backend: mlt::Backend::Bvh,
+        ..Default::default()
     })
     .unwrap();
     let camera = Camera {

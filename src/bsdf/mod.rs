@@ -1,11 +1,12 @@
 //! Scattering at a surface: sampling and evaluating each material's BSDF.
 //!
 //! Directions point away from the surface: `wo` towards where the path came from, `wi` the
-//! new direction. `normal` is the normal of the shading frame, which today is the triangle's
-//! front (counter-clockwise) geometric normal.
+//! new direction. `normal` is the normal of the shading frame (interpolated or
+//! normal-mapped); the triangle's front (counter-clockwise) geometric normal decides which
+//! side of the surface a direction is on.
 //!
-//! Integrators use `Bsdf`, a material evaluated at a surface point (built by
-//! `interaction.rs`), and ask it for its `BsdfLobes` instead of matching on the material's
+//! Integrators use `Bsdf`, a material evaluated at a surface point (built by the scene,
+//! textures applied), and ask it for its `BsdfLobes` instead of matching on the material's
 //! kind; the free functions below are its arithmetic, one `match` per operation.
 
 mod dielectric;
@@ -37,15 +38,6 @@ impl BsdfLobes {
     pub(crate) const GLOSSY: BsdfLobes = BsdfLobes(2);
     pub(crate) const SPECULAR: BsdfLobes = BsdfLobes(4);
 
-    /// The lobes of `material`.
-    #[inline]
-    pub fn of(material: &Material) -> BsdfLobes {
-        match material.kind {
-            MaterialKind::Diffuse => BsdfLobes::DIFFUSE,
-            MaterialKind::Mirror | MaterialKind::Dielectric => BsdfLobes::SPECULAR,
-        }
-    }
-
     /// Whether all of `other`'s lobes are among these.
     #[inline]
     #[cfg_attr(not(test), allow(dead_code))]
@@ -75,29 +67,145 @@ impl std::ops::BitOr for BsdfLobes {
     }
 }
 
-/// A material's BSDF at a surface point: the material and the shading frame's normal.
-/// Small and `Copy`; its methods are the free functions of this module, so the arithmetic
-/// is theirs.
+/// The scattering model at a surface point, with its parameters evaluated there (textures
+/// and vertex colours applied).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Bsdf<'a> {
-    material: &'a Material,
-    /// Normal of the shading frame (today the geometric normal).
-    normal: Vec3A,
+pub(crate) enum BsdfModel {
+    /// Lambertian with this albedo, two-sided.
+    Diffuse(Spectrum),
+    /// A perfect mirror with this reflectance, two-sided.
+    Mirror(Spectrum),
+    /// A smooth dielectric interface: index of refraction inside (the back side), tint.
+    Dielectric { ior: f32, tint: Spectrum },
 }
 
-impl<'a> Bsdf<'a> {
+impl BsdfModel {
+    /// The model of an untextured `material`.
     #[inline]
-    pub fn new(material: &'a Material, normal: Vec3A) -> Self {
-        Bsdf { material, normal }
+    pub fn of(material: &Material) -> BsdfModel {
+        BsdfModel::with_color(material, Spectrum::from(material.color))
+    }
+
+    /// The model of `material` with its colour replaced by `color` (textured).
+    #[inline]
+    pub fn with_color(material: &Material, color: Spectrum) -> BsdfModel {
+        match material.kind {
+            MaterialKind::Diffuse => BsdfModel::Diffuse(color),
+            MaterialKind::Mirror => BsdfModel::Mirror(color),
+            MaterialKind::Dielectric => BsdfModel::Dielectric {
+                ior: material.ior,
+                tint: color,
+            },
+            // Until the metallic-roughness BSDF lands, scenes with it are refused at
+            // construction (see `Scene::new`); this arm is never reached.
+            MaterialKind::MetallicRoughness => BsdfModel::Diffuse(color),
+        }
     }
 
     /// The classes of its lobes.
     #[inline]
     pub fn lobes(&self) -> BsdfLobes {
-        BsdfLobes::of(self.material)
+        match self {
+            BsdfModel::Diffuse(_) => BsdfLobes::DIFFUSE,
+            BsdfModel::Mirror(_) | BsdfModel::Dielectric { .. } => BsdfLobes::SPECULAR,
+        }
+    }
+}
+
+/// A BSDF at a surface point: the evaluated model in the shading frame.
+///
+/// # Shading normals
+///
+/// The model scatters about the shading normal (interpolated or normal-mapped), while
+/// geometry (the cosines of the geometric term, which side of the surface a direction is
+/// on) uses the triangle's geometric normal. Veach (1997, §5.3) shows what keeps every
+/// estimator consistent: the BSDF seen by the geometric measure is
+/// f̃(wo, wi) = f(wo, wi) · |wi·ns| / |wi·ng| with wi the direction light arrives from, so
+/// it is not symmetric, and light subpaths (importance transport, where the sampled
+/// direction is the one towards the camera) carry |wo·ns| / |wo·ng| instead. `eval`
+/// returns f̃ for the given mode and the integrators multiply by the geometric cosine,
+/// which `sample` and `scatter` fold into their weights. A direction that is a reflection
+/// for one normal and a transmission for the other has no scattering (it would leak light
+/// through the surface).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bsdf {
+    model: BsdfModel,
+    /// Normal of the shading frame.
+    normal: Vec3A,
+    /// The triangle's front geometric normal.
+    geometric_normal: Vec3A,
+    /// Whether the two normals differ (without, the corrections are exactly 1 and skipped).
+    shading_normal_differs: bool,
+}
+
+impl Bsdf {
+    /// `model` in the frame of `shading_normal`, on a triangle with `geometric_normal`.
+    #[inline]
+    pub fn new(model: BsdfModel, shading_normal: Vec3A, geometric_normal: Vec3A) -> Self {
+        Bsdf {
+            model,
+            normal: shading_normal,
+            geometric_normal,
+            shading_normal_differs: shading_normal != geometric_normal,
+        }
     }
 
-    /// See [`sample`].
+    /// The classes of its lobes.
+    #[inline]
+    pub fn lobes(&self) -> BsdfLobes {
+        self.model.lobes()
+    }
+
+    /// The normal of the shading frame.
+    #[inline]
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub fn shading_normal(&self) -> Vec3A {
+        self.normal
+    }
+
+    /// Whether `wo` and `wi` are a reflection for both normals or a transmission for both.
+    #[inline]
+    fn sides_agree(&self, wo: Vec3A, wi: Vec3A) -> bool {
+        let geometric = wo.dot(self.geometric_normal) * wi.dot(self.geometric_normal);
+        let shading = wo.dot(self.normal) * wi.dot(self.normal);
+        (geometric > 0.0 && shading > 0.0) || (geometric < 0.0 && shading < 0.0)
+    }
+
+    /// |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|): turns the radiance-mode weight of sampling wi
+    /// from wo into the importance-mode one.
+    #[inline]
+    fn adjoint_factor(&self, wo: Vec3A, wi: Vec3A) -> f32 {
+        let numerator = (wo.dot(self.normal) * wi.dot(self.geometric_normal)).abs();
+        let denominator = (wo.dot(self.geometric_normal) * wi.dot(self.normal)).abs();
+        if denominator > 0.0 {
+            numerator / denominator
+        } else {
+            0.0
+        }
+    }
+
+    /// Corrects a sample of the model for the shading normal (see the type's comment).
+    #[inline]
+    fn corrected(
+        &self,
+        sample: Option<ScatterSample>,
+        wo: Vec3A,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let mut sample = sample?;
+        if self.shading_normal_differs {
+            if !self.sides_agree(wo, sample.wi) {
+                return None;
+            }
+            if mode == TransportMode::Importance {
+                sample.weight *= self.adjoint_factor(wo, sample.wi);
+            }
+        }
+        Some(sample)
+    }
+
+    /// Samples a direction `wi` given `wo`. `u` picks the direction, `u_lobe` the lobe.
+    /// The weight is f̃ · |wi·ng| / pdf for the mode's f̃ (see the type's comment).
     #[inline]
     pub fn sample(
         &self,
@@ -106,48 +214,73 @@ impl<'a> Bsdf<'a> {
         u_lobe: f32,
         mode: TransportMode,
     ) -> Option<ScatterSample> {
-        sample(self.material, self.normal, wo, u, u_lobe, mode)
+        let sample = sample(&self.model, self.normal, wo, u, u_lobe, mode);
+        self.corrected(sample, wo, mode)
     }
 
-    /// See [`eval`].
+    /// f̃(wo, wi) for `mode` (without any cosine) of the non-specular lobes; zero for
+    /// specular ones. In radiance mode wi is where light arrives from; in importance mode
+    /// wo is.
     #[inline]
-    pub fn eval(&self, wo: Vec3A, wi: Vec3A) -> Spectrum {
-        eval(self.material, self.normal, wo, wi)
+    pub fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Spectrum {
+        let f = eval(&self.model, self.normal, wo, wi);
+        if !self.shading_normal_differs || f.is_black() {
+            return f;
+        }
+        if !self.sides_agree(wo, wi) {
+            return Spectrum::ZERO;
+        }
+        let toward_light = match mode {
+            TransportMode::Radiance => wi,
+            TransportMode::Importance => wo,
+        };
+        let cos_geometric = toward_light.dot(self.geometric_normal).abs();
+        if cos_geometric == 0.0 {
+            return Spectrum::ZERO;
+        }
+        f * (toward_light.dot(self.normal).abs() / cos_geometric)
     }
 
-    /// See [`pdf`].
+    /// Solid-angle density with which `sample` generates `wi` from `wo` (non-specular
+    /// lobes only).
     #[inline]
     pub fn pdf(&self, wo: Vec3A, wi: Vec3A) -> f32 {
-        pdf(self.material, self.normal, wo, wi)
+        if self.shading_normal_differs && !self.sides_agree(wo, wi) {
+            return 0.0;
+        }
+        pdf(&self.model, self.normal, wo, wi)
     }
 
-    /// See [`scatter`].
+    /// What `sample` would return for scattering from `wo` into `wi` (see [`scatter`]).
     #[inline]
     pub fn scatter(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Option<ScatterSample> {
-        scatter(self.material, self.normal, wo, wi, mode)
+        let sample = scatter(&self.model, self.normal, wo, wi, mode);
+        self.corrected(sample, wo, mode)
     }
 
-    /// See [`specular_direction`].
+    /// The direction a specular lobe scatters `wo` into (see [`specular_direction`]);
+    /// `None` also where it would leak through the surface.
     #[inline]
     pub fn specular_direction(&self, wo: Vec3A, lobe: SpecularLobe) -> Option<Vec3A> {
-        specular_direction(self.material, self.normal, wo, lobe)
+        let wi = specular_direction(&self.model, self.normal, wo, lobe)?;
+        (!self.shading_normal_differs || self.sides_agree(wo, wi)).then_some(wi)
     }
 }
 
-/// Samples a direction `wi` given `wo`. `u` picks the direction, `u_lobe` the lobe.
+/// Samples a direction `wi` given `wo` in the frame of `normal`. `u` picks the direction,
+/// `u_lobe` the lobe.
 #[inline]
-pub fn sample(
-    material: &Material,
+fn sample(
+    model: &BsdfModel,
     normal: Vec3A,
     wo: Vec3A,
     u: [f32; 2],
     u_lobe: f32,
     mode: TransportMode,
 ) -> Option<ScatterSample> {
-    let color = Spectrum::from(material.color);
     let cos_o = wo.dot(normal);
-    match material.kind {
-        MaterialKind::Diffuse => {
+    match *model {
+        BsdfModel::Diffuse(albedo) => {
             // Two-sided: scatter into the hemisphere wo is in.
             let side_normal = if cos_o >= 0.0 { normal } else { -normal };
             let local = cosine_hemisphere(u);
@@ -157,30 +290,30 @@ pub fn sample(
             let wi = OrthonormalBasis::from_normal(side_normal).to_world(local);
             Some(ScatterSample {
                 wi,
-                weight: color,
+                weight: albedo,
                 pdf: cosine_hemisphere_pdf(local.z),
                 specular: false,
             })
         }
-        MaterialKind::Mirror => Some(ScatterSample {
+        BsdfModel::Mirror(reflectance) => Some(ScatterSample {
             wi: reflect(wo, normal),
-            weight: color,
+            weight: reflectance,
             pdf: 1.0,
             specular: true,
         }),
-        MaterialKind::Dielectric => {
-            dielectric::sample(material.ior, color, normal, wo, u_lobe, mode)
+        BsdfModel::Dielectric { ior, tint } => {
+            dielectric::sample(ior, tint, normal, wo, u_lobe, mode)
         }
     }
 }
 
-/// BSDF value f(wo, wi) (without the cosine) for non-specular materials; zero otherwise.
+/// BSDF value f(wo, wi) (without the cosine) for non-specular models; zero otherwise.
 #[inline]
-pub fn eval(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectrum {
-    match material.kind {
-        MaterialKind::Diffuse => {
+fn eval(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectrum {
+    match *model {
+        BsdfModel::Diffuse(albedo) => {
             if wo.dot(normal) * wi.dot(normal) > 0.0 {
-                Spectrum::from(material.color) * FRAC_1_PI
+                albedo * FRAC_1_PI
             } else {
                 Spectrum::ZERO
             }
@@ -191,9 +324,9 @@ pub fn eval(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectru
 
 /// Solid-angle density with which `sample` generates `wi` from `wo` (non-specular only).
 #[inline]
-pub fn pdf(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
-    match material.kind {
-        MaterialKind::Diffuse => {
+fn pdf(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
+    match model {
+        BsdfModel::Diffuse(_) => {
             let cos_i = wi.dot(normal);
             if wo.dot(normal) * cos_i > 0.0 {
                 cosine_hemisphere_pdf(cos_i.abs())
@@ -211,30 +344,29 @@ pub fn pdf(material: &Material, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
 /// the exact mirror or refracted direction of its side (the path was traced that way); it
 /// is not checked.
 #[inline]
-pub fn scatter(
-    material: &Material,
+fn scatter(
+    model: &BsdfModel,
     normal: Vec3A,
     wo: Vec3A,
     wi: Vec3A,
     mode: TransportMode,
 ) -> Option<ScatterSample> {
-    let color = Spectrum::from(material.color);
     let (cos_o, cos_i) = (wo.dot(normal), wi.dot(normal));
     let same_side = cos_o * cos_i > 0.0;
-    match material.kind {
-        MaterialKind::Diffuse => same_side.then(|| ScatterSample {
+    match *model {
+        BsdfModel::Diffuse(albedo) => same_side.then(|| ScatterSample {
             wi,
-            weight: color,
+            weight: albedo,
             pdf: cosine_hemisphere_pdf(cos_i.abs()),
             specular: false,
         }),
-        MaterialKind::Mirror => same_side.then_some(ScatterSample {
+        BsdfModel::Mirror(reflectance) => same_side.then_some(ScatterSample {
             wi,
-            weight: color,
+            weight: reflectance,
             pdf: 1.0,
             specular: true,
         }),
-        MaterialKind::Dielectric => dielectric::scatter(material.ior, color, normal, wo, wi, mode),
+        BsdfModel::Dielectric { ior, tint } => dielectric::scatter(ior, tint, normal, wo, wi, mode),
     }
 }
 
@@ -257,21 +389,21 @@ impl SpecularLobe {
     }
 }
 
-/// The direction a specular material scatters `wo` into through `lobe`, or `None` if it
-/// has no such lobe (a mirror's refraction, total internal reflection).
+/// The direction a specular model scatters `wo` into through `lobe`, or `None` if it has
+/// no such lobe (a mirror's refraction, total internal reflection).
 #[inline]
-pub fn specular_direction(
-    material: &Material,
+fn specular_direction(
+    model: &BsdfModel,
     normal: Vec3A,
     wo: Vec3A,
     lobe: SpecularLobe,
 ) -> Option<Vec3A> {
-    match (material.kind, lobe) {
-        (MaterialKind::Mirror | MaterialKind::Dielectric, SpecularLobe::Reflection) => {
+    match (*model, lobe) {
+        (BsdfModel::Mirror(_) | BsdfModel::Dielectric { .. }, SpecularLobe::Reflection) => {
             Some(reflect(wo, normal))
         }
-        (MaterialKind::Dielectric, SpecularLobe::Refraction) => {
-            dielectric::refracted(material.ior, normal, wo)
+        (BsdfModel::Dielectric { ior, .. }, SpecularLobe::Refraction) => {
+            dielectric::refracted(ior, normal, wo)
         }
         _ => None,
     }
@@ -286,11 +418,11 @@ mod tests {
     /// glossy lobe counts as non-specular, alone or next to a specular one.
     #[test]
     fn lobes_classify_materials() {
-        let diffuse = BsdfLobes::of(&Material::diffuse([0.5; 3]));
+        let diffuse = BsdfModel::of(&Material::diffuse([0.5; 3])).lobes();
         assert!(diffuse.has_non_specular() && !diffuse.is_specular());
         assert!(diffuse.contains(BsdfLobes::DIFFUSE));
         for m in [Material::mirror([1.0; 3]), Material::dielectric(1.5)] {
-            let lobes = BsdfLobes::of(&m);
+            let lobes = BsdfModel::of(&m).lobes();
             assert!(lobes.is_specular() && !lobes.has_non_specular());
             assert!(lobes.contains(BsdfLobes::SPECULAR));
         }
@@ -303,7 +435,7 @@ mod tests {
     /// equals the material's color for diffuse, and the pdf matches eval/cos for diffuse.
     #[test]
     fn diffuse_sample_is_consistent_with_eval_and_pdf() {
-        let m = Material::diffuse([0.5, 0.25, 0.75]);
+        let m = BsdfModel::of(&Material::diffuse([0.5, 0.25, 0.75]));
         let n = Vec3A::new(0.0, 0.6, 0.8);
         let wo = Vec3A::new(0.3, -0.5, -0.8).normalize();
         let mut rng = Rng::new(1, 2);

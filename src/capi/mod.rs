@@ -233,6 +233,7 @@ pub unsafe extern "C" fn mlt_scene_create(
                     color: m.color,
                     emission: m.emission,
                     ior: m.ior,
+                    ..Material::diffuse(m.color)
                 })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -270,6 +271,7 @@ pub unsafe extern "C" fn mlt_scene_create(
                 punctual: &punctual,
             },
             backend: backend(desc.backend)?,
+            ..Default::default()
         })?;
         let handle = Box::into_raw(Box::new(MltScene {
             scene,

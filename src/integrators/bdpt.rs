@@ -68,6 +68,8 @@ struct Vertex {
     pdf_reverse: f32,
     /// Internal triangle index (surfaces and lights).
     triangle: u32,
+    /// Barycentrics of the point on `triangle`, where its BSDF is evaluated.
+    barycentrics: [f32; 2],
     /// Scattering here is a Dirac delta (mirror, glass): no connection can end here. A
     /// surface's BSDF with a diffuse or glossy lobe is connectible.
     specular: bool,
@@ -83,6 +85,7 @@ impl Vertex {
         pdf_forward: 0.0,
         pdf_reverse: 0.0,
         triangle: 0,
+        barycentrics: [0.0; 2],
         specular: false,
     };
 
@@ -157,8 +160,8 @@ fn to_area(pdf_solid_angle: f32, from: &Vertex, to: &Vertex) -> f32 {
 impl Bdpt<'_> {
     /// The BSDF of a surface vertex.
     #[inline]
-    fn bsdf(&self, v: &Vertex) -> Bsdf<'_> {
-        vertex_bsdf(self.scene, v.triangle, v.normal)
+    fn bsdf(&self, v: &Vertex) -> Bsdf {
+        vertex_bsdf(self.scene, v.triangle, v.barycentrics)
     }
 
     /// Radiance the light a camera subpath ended on sends back along it: an emitting
@@ -284,6 +287,7 @@ impl Bdpt<'_> {
                 pdf_forward: 0.0,
                 pdf_reverse: 0.0,
                 triangle: si.triangle,
+                barycentrics: si.uv,
                 // Known from the BSDF's lobes, so a subpath cut short here is marked too.
                 specular: bsdf.lobes().is_specular(),
             };
@@ -384,6 +388,7 @@ impl Bdpt<'_> {
             beta: light.emission / light.pdf_origin,
             pdf_forward: light.pdf_origin,
             triangle,
+            barycentrics: light.barycentrics,
             ..Vertex::EMPTY
         };
         if light.pdf_direction <= 0.0 || light.beta.is_black() {
@@ -492,15 +497,17 @@ impl Bdpt<'_> {
         1.0 / (1.0 + sum)
     }
 
-    /// Throughput factor of a surface vertex scattering from its predecessor towards `to`.
+    /// Throughput factor of a surface vertex scattering from its predecessor towards `to`,
+    /// on a subpath carrying `mode` (radiance on camera subpaths, importance on light
+    /// subpaths: the BSDF is not symmetric under shading normals).
     #[inline]
-    fn f(&self, v: &Vertex, to: Vec3A) -> Spectrum {
+    fn f(&self, v: &Vertex, to: Vec3A, mode: TransportMode) -> Spectrum {
         let w = to - v.p;
         let length = w.length();
         if length == 0.0 {
             return Spectrum::ZERO;
         }
-        self.bsdf(v).eval(v.wo, w / length)
+        self.bsdf(v).eval(v.wo, w / length, mode)
     }
 
     /// Whether nothing blocks the way from surface vertex `a` to infinity along `w`.
@@ -695,8 +702,10 @@ impl Bdpt<'_> {
                 ..Vertex::EMPTY
             };
             // s >= 2 here, so qs is a surface vertex.
-            let contribution =
-                qs.beta * sampled.beta * self.f(&qs, lens) * direction.dot(qs.normal).abs();
+            let contribution = qs.beta
+                * sampled.beta
+                * self.f(&qs, lens, TransportMode::Importance)
+                * direction.dot(qs.normal).abs();
             if contribution.is_black() || !self.visible(&qs, &sampled, counters) {
                 return None;
             }
@@ -726,6 +735,7 @@ impl Bdpt<'_> {
                     emission,
                     area_pdf,
                     triangle,
+                    barycentrics,
                 } => {
                     let sampled = Vertex {
                         kind: VertexKind::Light(Emitter::Area(triangle)),
@@ -734,6 +744,7 @@ impl Bdpt<'_> {
                         beta: emission / area_pdf,
                         pdf_forward: area_pdf,
                         triangle,
+                        barycentrics,
                         ..Vertex::EMPTY
                     };
                     let d = sampled.p - pt.p;
@@ -747,7 +758,10 @@ impl Bdpt<'_> {
                         return None;
                     }
                     let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
-                    let contribution = pt.beta * self.f(&pt, sampled.p) * sampled.beta * geometry;
+                    let contribution = pt.beta
+                        * self.f(&pt, sampled.p, TransportMode::Radiance)
+                        * sampled.beta
+                        * geometry;
                     if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
                         return None;
                     }
@@ -773,7 +787,10 @@ impl Bdpt<'_> {
                         ..Vertex::EMPTY
                     };
                     let geometry = w.dot(pt.normal).abs() / distance2;
-                    let contribution = pt.beta * self.f(&pt, position) * sampled.beta * geometry;
+                    let contribution = pt.beta
+                        * self.f(&pt, position, TransportMode::Radiance)
+                        * sampled.beta
+                        * geometry;
                     if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
                         return None;
                     }
@@ -796,7 +813,7 @@ impl Bdpt<'_> {
                         pdf_forward: pdf,
                         ..Vertex::EMPTY
                     };
-                    let f = self.bsdf(&pt).eval(pt.wo, toward);
+                    let f = self.bsdf(&pt).eval(pt.wo, toward, TransportMode::Radiance);
                     let contribution = pt.beta * f * sampled.beta * toward.dot(pt.normal).abs();
                     if contribution.is_black() || !self.unoccluded_towards(&pt, toward, counters) {
                         return None;
@@ -829,7 +846,11 @@ impl Bdpt<'_> {
             }
             let w = d / distance2.sqrt();
             let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
-            let contribution = qs.beta * self.f(&qs, pt.p) * self.f(&pt, qs.p) * pt.beta * geometry;
+            let contribution = qs.beta
+                * self.f(&qs, pt.p, TransportMode::Importance)
+                * self.f(&pt, qs.p, TransportMode::Radiance)
+                * pt.beta
+                * geometry;
             if contribution.is_black() || !self.visible(&qs, &pt, counters) {
                 return None;
             }
@@ -860,12 +881,7 @@ impl Bdpt<'_> {
             VertexKind::Light(emitter @ (Emitter::Directional(_) | Emitter::Infinite)) => {
                 PathVertex::at_infinity(emitter, v.normal)
             }
-            _ => PathVertex {
-                p: v.p,
-                normal: v.normal,
-                triangle: v.triangle,
-                light: None,
-            },
+            _ => PathVertex::on_triangle(v.p, v.normal, v.triangle, v.barycentrics),
         };
         out.clear();
         for i in 0..s {

@@ -30,20 +30,31 @@ pub(crate) struct PathVertex {
     pub normal: Vec3A,
     /// Internal triangle index (unused for the lens and for `light` vertices).
     pub triangle: u32,
+    /// The point's barycentrics on `triangle`: where its BSDF (shading normal, textures)
+    /// is evaluated.
+    pub barycentrics: [f32; 2],
     /// `Some` for a first vertex on a light that is not an emissive triangle (a point on an
     /// emissive triangle is `None`, told by its triangle, as any surface vertex).
     pub light: Option<Emitter>,
 }
 
 impl PathVertex {
-    /// The vertex at a surface interaction. It keeps the geometric normal, which is also
-    /// the shading normal today (see `interaction::vertex_bsdf`).
+    /// The vertex at a surface interaction. It keeps the geometric normal and the
+    /// barycentrics the BSDF is rebuilt from (see `interaction::vertex_bsdf`).
     #[inline]
     pub fn surface(si: &SurfaceInteraction) -> PathVertex {
+        PathVertex::on_triangle(si.p, si.geometric_normal, si.triangle, si.uv)
+    }
+
+    /// The vertex at barycentrics `barycentrics` of internal triangle `triangle`, point `p`
+    /// with front geometric normal `normal`.
+    #[inline]
+    pub fn on_triangle(p: Vec3A, normal: Vec3A, triangle: u32, barycentrics: [f32; 2]) -> Self {
         PathVertex {
-            p: si.p,
-            normal: si.geometric_normal,
-            triangle: si.triangle,
+            p,
+            normal,
+            triangle,
+            barycentrics,
             light: None,
         }
     }
@@ -55,6 +66,7 @@ impl PathVertex {
             p,
             normal,
             triangle: 0,
+            barycentrics: [0.0; 2],
             light: None,
         }
     }
@@ -66,6 +78,7 @@ impl PathVertex {
             p: Vec3A::ZERO,
             normal: toward,
             triangle: 0,
+            barycentrics: [0.0; 2],
             light: Some(emitter),
         }
     }
@@ -77,6 +90,7 @@ impl PathVertex {
             p: position,
             normal: Vec3A::ZERO,
             triangle: 0,
+            barycentrics: [0.0; 2],
             light: Some(Emitter::Point(light)),
         }
     }

@@ -157,7 +157,7 @@ impl PathTracer<'_> {
                 if cos_light <= 0.0 {
                     return Spectrum::ZERO;
                 }
-                let f = bsdf.eval(wo, wi);
+                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
                 if f.is_black() {
                     return Spectrum::ZERO;
                 }
@@ -184,7 +184,7 @@ impl PathTracer<'_> {
                 }
                 let wi = to_light / distance2.sqrt();
                 let intensity = scene.lights.point_light(light).intensity(-wi);
-                let f = bsdf.eval(wo, wi);
+                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
                 if f.is_black() || intensity.is_black() {
                     return Spectrum::ZERO;
                 }
@@ -204,7 +204,7 @@ impl PathTracer<'_> {
                 radiance,
                 pdf,
             }) => {
-                let f = bsdf.eval(wo, wi);
+                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
                 if f.is_black() || radiance.is_black() || pdf <= 0.0 {
                     return Spectrum::ZERO;
                 }

@@ -75,6 +75,7 @@ impl SceneData {
                 ..Default::default()
             },
             backend,
+            ..Default::default()
         }
     }
 

@@ -4,6 +4,7 @@ mod camera;
 mod light_desc;
 pub(crate) mod lights;
 mod material;
+pub(crate) mod surface;
 
 pub use camera::{Camera, CameraModel};
 pub use light_desc::{
@@ -11,7 +12,7 @@ pub use light_desc::{
     MLT_MAX_PUNCTUAL_LIGHTS, PunctualLight, PunctualLightKind, SunDesc,
 };
 pub use lights::AreaLight;
-pub use material::{Material, MaterialKind};
+pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 
 use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
@@ -31,6 +32,49 @@ pub struct SceneDesc<'a> {
     /// Lights besides the emissive triangles: environment, sun, punctual lights.
     pub lights: LightsDesc<'a>,
     pub backend: Backend,
+    /// Per-vertex shading normals, x, y, z per vertex (any nonzero length; normalized on
+    /// use), or empty for flat triangles. Interpolated across each triangle; a normal on the
+    /// back side of its triangle is turned to the front.
+    pub normals: &'a [f32],
+    /// Per-vertex texture coordinates, u, v per vertex, or empty. glTF's convention: (0, 0)
+    /// is the top-left corner of a texture, v grows downwards.
+    pub texcoords: &'a [f32],
+    /// Per-vertex tangents for normal maps, x, y, z, w per vertex (w = ±1: the bitangent
+    /// is w · normal × tangent, glTF's convention), or empty: then they are computed with
+    /// MikkTSpace where a material has a normal map.
+    pub tangents: &'a [f32],
+    /// Per-vertex linear RGBA colours in [0, 1] multiplying the base colour and alpha (glTF
+    /// `COLOR_0`), or empty.
+    pub colors: &'a [f32],
+}
+
+impl Default for SceneDesc<'_> {
+    /// No geometry, no lights, the default backend.
+    fn default() -> Self {
+        SceneDesc {
+            positions: &[],
+            indices: &[],
+            material_ids: &[],
+            materials: &[],
+            lights: LightsDesc::default(),
+            backend: Backend::default(),
+            normals: &[],
+            texcoords: &[],
+            tangents: &[],
+            colors: &[],
+        }
+    }
+}
+
+impl<'a> SceneDesc<'a> {
+    fn vertex_arrays(&self) -> surface::VertexArrays<'a> {
+        surface::VertexArrays {
+            normals: self.normals,
+            texcoords: self.texcoords,
+            tangents: self.tangents,
+            colors: self.colors,
+        }
+    }
 }
 
 /// Facts about a built scene.
@@ -60,6 +104,8 @@ pub struct TriangleShading {
 pub struct Scene {
     pub(crate) accel: Accel,
     pub(crate) shading: Vec<TriangleShading>,
+    /// Per-corner vertex attributes, in internal triangle order.
+    attributes: surface::SurfaceAttributes,
     pub(crate) materials: Vec<Material>,
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
     /// lights, a delta sun, the lights at infinity; with their selection distribution.
@@ -87,6 +133,7 @@ impl Scene {
         let triangle_count = desc.indices.len() / 3;
         let mut kept_vertices = Vec::with_capacity(triangle_count);
         let mut kept_ids = Vec::with_capacity(triangle_count);
+        let vertex_arrays = desc.vertex_arrays();
         let mut bounds_min = Vec3A::splat(f32::INFINITY);
         let mut bounds_max = Vec3A::splat(f32::NEG_INFINITY);
         for (id, tri) in desc.indices.chunks_exact(3).enumerate() {
@@ -119,6 +166,7 @@ impl Scene {
             }
         };
         let mut shading = Vec::with_capacity(order.len());
+        let mut attributes = surface::SurfaceAttributes::with_capacity(&vertex_arrays, order.len());
         let mut internal_to_input = Vec::with_capacity(order.len());
         let mut lights = Vec::new();
         for (internal, &build) in order.iter().enumerate() {
@@ -145,6 +193,8 @@ impl Scene {
                 light_area_pdf: 0.0,
             });
             internal_to_input.push(id);
+            let corners = &desc.indices[id as usize * 3..id as usize * 3 + 3];
+            attributes.push(&vertex_arrays, [corners[0], corners[1], corners[2]]);
         }
         // Lights in the host's triangle order, not the backend's: the same seed then picks
         // the same lights with either backend.
@@ -175,6 +225,7 @@ impl Scene {
         Ok(Scene {
             accel,
             shading,
+            attributes,
             materials: desc.materials.to_vec(),
             lights: scene_lights,
             internal_to_input,
@@ -188,6 +239,20 @@ impl Scene {
     #[inline]
     pub(crate) fn light_area_pdf(&self, triangle: u32) -> f32 {
         self.shading[triangle as usize].light_area_pdf
+    }
+
+    /// The BSDF at barycentrics `barycentrics` of internal triangle `triangle`: its
+    /// material with textures and vertex colours applied, in the shading frame there.
+    #[inline]
+    pub(crate) fn bsdf_at(&self, triangle: u32, barycentrics: [f32; 2]) -> crate::bsdf::Bsdf {
+        let shading = &self.shading[triangle as usize];
+        surface::bsdf_at(
+            &self.attributes,
+            &self.materials[shading.material as usize],
+            triangle,
+            barycentrics,
+            shading.normal,
+        )
     }
 
     /// Radiance the front side of internal triangle `triangle` emits, if it is a light
@@ -285,8 +350,17 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
             )));
         }
     }
+    desc.vertex_arrays().validate(vertex_count)?;
     for (i, material) in desc.materials.iter().enumerate() {
-        material.validate(i)?;
+        material.validate(i, 0)?;
+        if material.kind == MaterialKind::MetallicRoughness {
+            return Err(Error::new(
+                crate::error::MltStatus::MLT_STATUS_UNSUPPORTED,
+                format!(
+                    "desc.materials[{i}] is a metallic-roughness material, which this build cannot render yet"
+                ),
+            ));
+        }
     }
     Ok(())
 }

@@ -95,6 +95,7 @@ pub fn furnace_scene(albedo: [f32; 3], emission: [f32; 3]) -> Scene {
         materials: &materials,
         lights: Default::default(),
         backend: Backend::Bvh,
+        ..Default::default()
     })
     .unwrap()
 }
@@ -493,6 +494,9 @@ impl Mesh {
                     mlt::MaterialKind::Diffuse => mlt::capi::MLT_MATERIAL_DIFFUSE,
                     mlt::MaterialKind::Mirror => mlt::capi::MLT_MATERIAL_MIRROR,
                     mlt::MaterialKind::Dielectric => mlt::capi::MLT_MATERIAL_DIELECTRIC,
+                    mlt::MaterialKind::MetallicRoughness => {
+                        panic!("metallic-roughness materials have no C ABI yet")
+                    }
                 },
                 color: m.color,
                 emission: m.emission,
@@ -518,6 +522,7 @@ impl Mesh {
             materials: &self.materials,
             lights,
             backend,
+            ..Default::default()
         })
         .expect("a valid scene")
     }
@@ -641,6 +646,7 @@ pub fn open_cornell_box(lights: mlt::LightsDesc) -> (Scene, Camera) {
         materials: &mesh.materials,
         lights,
         backend: mlt::Backend::Bvh,
+        ..Default::default()
     })
     .unwrap();
     let camera = Camera {

@@ -177,6 +177,8 @@ pub(crate) enum LightSample {
         area_pdf: f32,
         /// Internal index of the light's triangle.
         triangle: u32,
+        /// The point's barycentrics on that triangle.
+        barycentrics: [f32; 2],
     },
     /// A point or spot light.
     Point {
@@ -222,6 +224,8 @@ pub(crate) struct EmissionSample {
     pub pdf_direction: f32,
     /// The first ray's throughput: emission·|cos| / (pdf_origin · pdf_direction).
     pub beta: Spectrum,
+    /// An area light's point's barycentrics on its triangle (zero for other lights).
+    pub barycentrics: [f32; 2],
 }
 
 impl SceneLights {
@@ -244,6 +248,7 @@ impl SceneLights {
                     emission: light.emission,
                     area_pdf: light.area_pdf,
                     triangle: light.triangle,
+                    barycentrics: [b1, b2],
                 })
             }
             Light::Point(light) => Some(LightSample::Point {
@@ -297,6 +302,7 @@ impl SceneLights {
                     pdf_direction,
                     // Le·cos / (p_position · p_direction).
                     beta: light.emission * (local.z / (light.area_pdf * pdf_direction)),
+                    barycentrics: [b1, b2],
                 })
             }
             Light::Point(light) => {
@@ -312,6 +318,7 @@ impl SceneLights {
                     pdf_origin: select_pdf,
                     pdf_direction,
                     beta: emission / (select_pdf * pdf_direction),
+                    barycentrics: [0.0; 2],
                 })
             }
             Light::Directional { toward, irradiance } => self.emission_from_infinity(
@@ -360,6 +367,7 @@ impl SceneLights {
             pdf_origin,
             pdf_direction,
             beta: emission / (pdf_origin * pdf_direction),
+            barycentrics: [0.0; 2],
         })
     }
 

@@ -241,13 +241,14 @@ impl Bidirectional {
                         point,
                         normal,
                         triangle,
+                        barycentrics,
                         ..
-                    } => Some(PathVertex {
-                        p: point,
+                    } => Some(PathVertex::on_triangle(
+                        point,
                         normal,
                         triangle,
-                        light: None,
-                    }),
+                        barycentrics,
+                    )),
                     LightSample::Point {
                         light, position, ..
                     } => Some(PathVertex::point_light(light, position)),
@@ -527,6 +528,7 @@ mod tests {
             ],
             lights,
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap()
     }
@@ -792,12 +794,7 @@ mod tests {
         let light = hit(space, [0.05, 1.0, -0.25], Vec3A::Y);
         let wall = hit(space, [-0.2, 0.55, 0.0], -Vec3A::Z);
         let floor = hit(space, [0.3, 1.0, 0.2], -Vec3A::Y);
-        let lens = PathVertex {
-            p: space.camera.eye,
-            normal: space.camera.forward,
-            triangle: 0,
-            light: None,
-        };
+        let lens = PathVertex::point(space.camera.eye, space.camera.forward);
         assert_eq!(
             [light, wall, floor].map(|v| Surface::of(&v)),
             [Surface::Light, Surface::Wall, Surface::Floor]
@@ -842,12 +839,10 @@ mod tests {
                     for i in 0..ku {
                         let p = r.point((i as f64 + 0.5) / ku as f64, (j as f64 + 0.5) / kv as f64);
                         let cell = offset + (j / m) * nu + i / m;
-                        let vertex = PathVertex {
-                            p: Vec3A::from(p.as_vec3()),
-                            normal: Vec3A::from(r.normal().as_vec3()),
-                            triangle: 0,
-                            light: None,
-                        };
+                        let vertex = PathVertex::point(
+                            Vec3A::from(p.as_vec3()),
+                            Vec3A::from(r.normal().as_vec3()),
+                        );
                         nodes.push((cell, vertex, weight));
                     }
                 }

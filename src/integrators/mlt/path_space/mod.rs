@@ -83,8 +83,8 @@ fn direction(from: &PathVertex, to: &PathVertex) -> Option<(Vec3A, f32)> {
 impl PathSpace<'_> {
     /// The BSDF of surface vertex `v`.
     #[inline]
-    fn surface_bsdf(&self, v: &PathVertex) -> Bsdf<'_> {
-        vertex_bsdf(self.scene, v.triangle, v.normal)
+    fn surface_bsdf(&self, v: &PathVertex) -> Bsdf {
+        vertex_bsdf(self.scene, v.triangle, v.barycentrics)
     }
 
     /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
@@ -183,12 +183,19 @@ impl PathSpace<'_> {
         })
     }
 
-    /// The BSDF of non-specular vertex `at` between its neighbors (zero for specular ones).
+    /// The BSDF of non-specular vertex `at` between its neighbors (zero for specular ones)
+    /// as the side carrying `mode` sees it: `from` is that side's previous vertex.
     #[inline]
-    fn bsdf(&self, from: &PathVertex, at: &PathVertex, to: &PathVertex) -> Option<Spectrum> {
+    fn bsdf(
+        &self,
+        from: &PathVertex,
+        at: &PathVertex,
+        to: &PathVertex,
+        mode: TransportMode,
+    ) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
-        Some(self.surface_bsdf(at).eval(wo, wi))
+        Some(self.surface_bsdf(at).eval(wo, wi, mode))
     }
 
     /// f(x) / p_s(x): the measurement contribution of `path` (a light vertex first, the
@@ -310,7 +317,7 @@ impl PathSpace<'_> {
             // The lens point's density in solid angle at qs.
             let pdf = distance2 / cos_lens / self.camera.lens_area();
             beta_light
-                * self.bsdf(&path[n - 3], qs, lens)?
+                * self.bsdf(&path[n - 3], qs, lens, TransportMode::Importance)?
                 * w.dot(qs.normal).abs()
                 * (importance.importance / pdf)
         } else {
@@ -323,7 +330,7 @@ impl PathSpace<'_> {
                 // Next-event estimation: the light's own factor is in beta_light.
                 Spectrum::ONE
             } else {
-                self.bsdf(&path[s - 2], qs, pt)?
+                self.bsdf(&path[s - 2], qs, pt, TransportMode::Importance)?
             };
             let geometry = if qs.is_at_infinity() {
                 // Towards a direction: no distance, and no cosine at the light.
@@ -333,7 +340,11 @@ impl PathSpace<'_> {
             } else {
                 w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2
             };
-            beta_light * light_side * geometry * self.bsdf(&path[s + 1], pt, qs)? * beta_eye
+            beta_light
+                * light_side
+                * geometry
+                * self.bsdf(&path[s + 1], pt, qs, TransportMode::Radiance)?
+                * beta_eye
         };
         (value.max_component() > 0.0 && value.is_finite()).then_some((value, pixel))
     }
@@ -359,6 +370,7 @@ mod tests {
             materials: &data.materials,
             lights: Default::default(),
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap();
         let camera = crate::io::load_camera_json(&dir.join(format!("{name}.camera.json")))
@@ -479,6 +491,7 @@ mod tests {
             materials: &data.materials,
             lights,
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap();
         let camera = crate::io::load_camera_json(&dir.join(format!("{name}.camera.json")))

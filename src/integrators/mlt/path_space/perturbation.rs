@@ -541,6 +541,7 @@ mod tests {
             ],
             lights: Default::default(),
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap()
     }
@@ -576,12 +577,7 @@ mod tests {
 
     /// The lens vertex of the pinhole camera.
     fn eye(camera: &CameraModel) -> PathVertex {
-        PathVertex {
-            p: camera.eye,
-            normal: camera.forward,
-            triangle: 0,
-            light: None,
-        }
+        PathVertex::point(camera.eye, camera.forward)
     }
 
     /// The mirror and floor vertices seen from the lens through one film point.
@@ -862,6 +858,7 @@ mod tests {
             ],
             lights: Default::default(),
             backend: Backend::Bvh,
+            ..Default::default()
         })
         .unwrap()
     }
