@@ -6,6 +6,7 @@ pub mod generate;
 pub mod lamp_behind_glass;
 pub mod obj_text;
 pub mod sky_spheres;
+pub mod surfaces;
 pub mod window_room;
 
 use mlt::{Backend, Camera, Material, Scene, SceneDesc};

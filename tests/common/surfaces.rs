@@ -1,0 +1,98 @@
+//! The surfaces scene, built in code: the canonical Cornell box with a smooth-shaded sphere
+//! (per-vertex normals on a coarse icosphere, so shading and geometric normals differ by
+//! up to ~10°) standing on the short block. It is where the algorithms must agree once
+//! BSDFs are evaluated in a shading frame that is not the triangle's: light tracing and
+//! path tracing see the non-symmetric BSDF of shading normals from opposite ends.
+
+use super::{Mesh, canonical_mesh};
+use mlt::{Backend, Material, Scene, SceneDesc};
+
+/// A scene as arrays, with the per-vertex attributes `Mesh` does not carry.
+pub struct SurfacesMesh {
+    pub mesh: Mesh,
+    /// 3 floats per vertex.
+    pub normals: Vec<f32>,
+}
+
+impl SurfacesMesh {
+    pub fn scene(&self, backend: Backend) -> Scene {
+        Scene::new(&SceneDesc {
+            positions: &self.mesh.positions,
+            indices: &self.mesh.indices,
+            material_ids: &self.mesh.material_ids,
+            materials: &self.mesh.materials,
+            normals: &self.normals,
+            backend,
+            ..Default::default()
+        })
+        .expect("a valid scene")
+    }
+
+    /// Appends a triangle list with its own vertices and normals, all of material
+    /// `material`.
+    fn append(&mut self, positions: &[f32], normals: &[f32], indices: &[u32], material: u32) {
+        let base = (self.mesh.positions.len() / 3) as u32;
+        self.mesh.positions.extend_from_slice(positions);
+        self.normals.extend_from_slice(normals);
+        self.mesh.indices.extend(indices.iter().map(|&i| i + base));
+        self.mesh
+            .material_ids
+            .extend(std::iter::repeat_n(material, indices.len() / 3));
+    }
+}
+
+/// The Cornell box with flat normals (each triangle's own vertices carry its face normal:
+/// shading and geometric normals agree there) and the smooth sphere.
+pub fn surfaces_mesh() -> SurfacesMesh {
+    let box_mesh = canonical_mesh("cornell-box");
+    let mut scene = SurfacesMesh {
+        mesh: Mesh {
+            positions: Vec::new(),
+            indices: Vec::new(),
+            material_ids: Vec::new(),
+            materials: box_mesh.materials.clone(),
+        },
+        normals: Vec::new(),
+    };
+    let corner = |i: u32| -> [f32; 3] {
+        let i = i as usize * 3;
+        [
+            box_mesh.positions[i],
+            box_mesh.positions[i + 1],
+            box_mesh.positions[i + 2],
+        ]
+    };
+    for (triangle, corners) in box_mesh.indices.chunks_exact(3).enumerate() {
+        let [a, b, c] = [corner(corners[0]), corner(corners[1]), corner(corners[2])];
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        let positions: Vec<f32> = [a, b, c].concat();
+        let normals: Vec<f32> = [n, n, n].concat();
+        let material = box_mesh.material_ids.get(triangle).copied().unwrap_or(0);
+        scene.append(&positions, &normals, &[0, 1, 2], material);
+    }
+    // A smooth, off-white sphere on the short block (top at y = 165, centre near
+    // x = 185, z = 169).
+    let sphere_material = scene.mesh.materials.len() as u32;
+    scene
+        .mesh
+        .materials
+        .push(Material::diffuse([0.8, 0.75, 0.7]));
+    let (radius, center) = (70.0f32, [185.0f32, 165.0 + 70.0, 169.0]);
+    let (unit, inward) = super::inward_icosphere(1, 1.0);
+    let outward: Vec<u32> = inward
+        .chunks_exact(3)
+        .flat_map(|t| [t[0], t[2], t[1]])
+        .collect();
+    let positions: Vec<f32> = unit
+        .chunks_exact(3)
+        .flat_map(|v| [0, 1, 2].map(|k| center[k] + radius * v[k]))
+        .collect();
+    scene.append(&positions, &unit, &outward, sphere_material);
+    scene
+}
