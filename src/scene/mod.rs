@@ -4,6 +4,7 @@ mod camera;
 mod light_desc;
 pub(crate) mod lights;
 mod material;
+mod tangents;
 
 pub use camera::{Camera, CameraModel};
 pub use light_desc::{
