@@ -252,6 +252,17 @@
 #define MLT_MAX_PUNCTUAL_LIGHTS (1 << 20)
 
 /**
+ * Largest width or height of a texture, in texels.
+ */
+#define MLT_MAX_TEXTURE_SIDE (1 << 15)
+
+/**
+ * Most texels of a texture (width × height): 2^28, 16384 × 16384 — 1 GiB as 8-bit RGBA,
+ * 4 GiB as float RGBA.
+ */
+#define MLT_MAX_TEXTURE_TEXELS (1 << 28)
+
+/**
  * Result of every fallible mlt call. Values are stable: hosts may store them.
  */
 typedef enum MltStatus {

@@ -40,6 +40,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod spectrum;
+mod texture;
 
 #[cfg(feature = "cli")]
 pub mod io;
@@ -55,6 +56,10 @@ pub use render::{
 pub use scene::{
     Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight, PunctualLightKind,
     Scene, SceneDesc, SceneInfo, SunDesc,
+};
+pub use texture::{
+    MLT_MAX_TEXTURE_SIDE, MLT_MAX_TEXTURE_TEXELS, TexelData, TextureDesc, TextureEncoding,
+    TextureFilter, WrapMode,
 };
 
 // One scene serves renders and queries from many threads at once.

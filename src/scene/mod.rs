@@ -5,6 +5,7 @@ mod light_desc;
 pub(crate) mod lights;
 mod material;
 pub(crate) mod surface;
+mod tangents;
 
 pub use camera::{Camera, CameraModel};
 pub use light_desc::{

@@ -1,0 +1,696 @@
+//! Image textures: the host's description, and the validated copy the kernel samples.
+//!
+//! Coordinates follow glTF: uv (0, 0) is the top-left corner of the image (the first texel
+//! of the first row), u grows to the right and v downwards. Texel (i, j) covers
+//! [i/w, (i+1)/w] × [j/h, (j+1)/h], so its centre is ((i + 0.5)/w, (j + 0.5)/h).
+
+// Materials do not sample textures yet; until they do only the tests use `Texture`.
+#![cfg_attr(not(test), allow(dead_code))]
+
+use std::sync::OnceLock;
+
+use crate::error::{Error, MLT_STATUS_OUT_OF_MEMORY, Result};
+
+/// Largest width or height of a texture, in texels.
+pub const MLT_MAX_TEXTURE_SIDE: u32 = 1 << 15;
+/// Most texels of a texture (width × height): 2^28, 16384 × 16384 — 1 GiB as 8-bit RGBA,
+/// 4 GiB as float RGBA.
+pub const MLT_MAX_TEXTURE_TEXELS: u64 = 1 << 28;
+
+/// The texel values of a texture, row-major from the top row of the image to the bottom,
+/// channels interleaved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TexelData<'a> {
+    /// 8-bit values, 255 meaning 1; decoded according to the [`TextureEncoding`].
+    U8(&'a [u8]),
+    /// Linear floats, finite and >= 0 (above 1 is allowed: emission may be HDR).
+    F32(&'a [f32]),
+}
+
+/// How the colour channels of 8-bit data encode linear values. Alpha (the 4th channel, or
+/// the 2nd of a grey + alpha image) is always linear.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TextureEncoding {
+    /// The sRGB transfer function (IEC 61966-2-1), as glTF base colour and emissive images
+    /// use. Only for [`TexelData::U8`].
+    Srgb,
+    /// value / 255 for 8-bit data (glTF normal, metallic-roughness and occlusion images);
+    /// the value itself for float data.
+    Linear,
+}
+
+/// What a coordinate outside [0, 1] reads: glTF's sampler `wrapS` / `wrapT`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum WrapMode {
+    /// The image tiles the plane (glTF's default).
+    #[default]
+    Repeat,
+    /// The edge texels extend outwards.
+    ClampToEdge,
+    /// The image tiles with period 2, mirrored on every odd tile.
+    MirroredRepeat,
+}
+
+/// How a point between texel centres is read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TextureFilter {
+    /// The texel containing the point.
+    Nearest,
+    /// The four texels around the point, weighted by distance (on linear values).
+    #[default]
+    Bilinear,
+}
+
+/// A texture as the host passes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureDesc<'a> {
+    pub width: u32,
+    pub height: u32,
+    /// 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA).
+    pub channels: u32,
+    /// width × height × channels values.
+    pub data: TexelData<'a>,
+    pub encoding: TextureEncoding,
+    /// Along u (glTF `wrapS`).
+    pub wrap_u: WrapMode,
+    /// Along v (glTF `wrapT`).
+    pub wrap_v: WrapMode,
+    pub filter: TextureFilter,
+}
+
+/// The texels, kept at the host's precision: an 8-bit texture takes a quarter of the
+/// memory floats would.
+#[derive(Clone, Debug)]
+enum Texels {
+    U8 {
+        values: Box<[u8]>,
+        /// Decodes the colour channels: the sRGB table or the linear one.
+        colour_table: &'static [f32; 256],
+    },
+    F32(Box<[f32]>),
+}
+
+/// A validated texture, sampled by the kernel.
+#[derive(Clone, Debug)]
+pub(crate) struct Texture {
+    width: u32,
+    height: u32,
+    channels: u32,
+    texels: Texels,
+    wrap_u: WrapMode,
+    wrap_v: WrapMode,
+    filter: TextureFilter,
+}
+
+/// 8-bit value → value / 255.
+static LINEAR_U8_TO_F32: [f32; 256] = linear_u8_table();
+
+const fn linear_u8_table() -> [f32; 256] {
+    let mut table = [0.0; 256];
+    let mut i = 0;
+    while i < 256 {
+        table[i] = i as f32 / 255.0;
+        i += 1;
+    }
+    table
+}
+
+/// 8-bit sRGB value → linear value, by the exact IEC 61966-2-1 formula.
+fn srgb_u8_table() -> &'static [f32; 256] {
+    static TABLE: OnceLock<[f32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|i| {
+            let encoded = i as f64 / 255.0;
+            let linear = if encoded <= 0.04045 {
+                encoded / 12.92
+            } else {
+                ((encoded + 0.055) / 1.055).powf(2.4)
+            };
+            linear as f32
+        })
+    })
+}
+
+impl Texture {
+    /// Validates `desc` (reported as `desc.textures[index]`) and copies its texels.
+    pub(crate) fn new(desc: &TextureDesc, index: usize) -> Result<Texture> {
+        let name = format!("desc.textures[{index}]");
+        let (width, height, channels) = (desc.width, desc.height, desc.channels);
+        for (field, side) in [("width", width), ("height", height)] {
+            if side == 0 {
+                return Err(Error::invalid(format!(
+                    "{name}.{field} is 0; a texture needs at least 1 x 1 texels"
+                )));
+            }
+            if side > MLT_MAX_TEXTURE_SIDE {
+                return Err(Error::invalid(format!(
+                    "{name}.{field} is {side}; each side may be at most {MLT_MAX_TEXTURE_SIDE} texels"
+                )));
+            }
+        }
+        let texel_count = width as u64 * height as u64;
+        if texel_count > MLT_MAX_TEXTURE_TEXELS {
+            return Err(Error::invalid(format!(
+                "{name} is {width} x {height} texels; a texture may have at most {MLT_MAX_TEXTURE_TEXELS}"
+            )));
+        }
+        if !(1..=4).contains(&channels) {
+            return Err(Error::invalid(format!(
+                "{name}.channels is {channels}; it must be 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)"
+            )));
+        }
+        let expected = texel_count * channels as u64;
+        let (length, kind) = match desc.data {
+            TexelData::U8(values) => (values.len(), "8-bit values"),
+            TexelData::F32(values) => (values.len(), "floats"),
+        };
+        if length as u64 != expected {
+            return Err(Error::invalid(format!(
+                "{name}.data has {length} {kind}, but {width} x {height} texels of {channels} channels need {expected}"
+            )));
+        }
+        let texels = match desc.data {
+            TexelData::U8(values) => Texels::U8 {
+                values: copy_texels(values, &name)?,
+                colour_table: match desc.encoding {
+                    TextureEncoding::Srgb => srgb_u8_table(),
+                    TextureEncoding::Linear => &LINEAR_U8_TO_F32,
+                },
+            },
+            TexelData::F32(values) => {
+                if desc.encoding == TextureEncoding::Srgb {
+                    return Err(Error::invalid(format!(
+                        "{name}.encoding is Srgb, but the data are floats; sRGB applies to 8-bit data only (floats are linear)"
+                    )));
+                }
+                // Negative values have no meaning as colour, alpha or encoded normals.
+                if let Some(i) = values.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+                    let channel = i % channels as usize;
+                    let texel = i / channels as usize;
+                    return Err(Error::invalid(format!(
+                        "{name}.data[{i}] (row {}, column {}, channel {channel}) is {}; texel values must be finite and >= 0",
+                        texel / width as usize,
+                        texel % width as usize,
+                        values[i]
+                    )));
+                }
+                Texels::F32(copy_texels(values, &name)?)
+            }
+        };
+        Ok(Texture {
+            width,
+            height,
+            channels,
+            texels,
+            wrap_u: desc.wrap_u,
+            wrap_v: desc.wrap_v,
+            filter: desc.filter,
+        })
+    }
+
+    /// The linear RGBA value at `uv`: grey g reads (g, g, g, 1), grey + alpha (g, g, g, a),
+    /// RGB (r, g, b, 1). A non-finite coordinate reads as 0 (so NaN from a degenerate hit
+    /// gives a texel of the image, never a panic); one beyond ±1e30 as ±1e30.
+    pub(crate) fn sample(&self, uv: [f32; 2]) -> [f32; 4] {
+        let [u, v] = uv.map(sanitize_coordinate);
+        let (width, height) = (self.width as f32, self.height as f32);
+        match self.filter {
+            TextureFilter::Nearest => {
+                let column = wrap(self.wrap_u, (u * width).floor() as i64, self.width);
+                let row = wrap(self.wrap_v, (v * height).floor() as i64, self.height);
+                self.texel(column, row)
+            }
+            TextureFilter::Bilinear => {
+                // Texel centres sit at half-integers: shift them onto the integers.
+                let x = u * width - 0.5;
+                let y = v * height - 0.5;
+                let (x0, y0) = (x.floor(), y.floor());
+                let (fx, fy) = (x - x0, y - y0);
+                // `as` saturates; the +1 must too, for coordinates near the i64 limits.
+                let (x0, y0) = (x0 as i64, y0 as i64);
+                let columns = [
+                    wrap(self.wrap_u, x0, self.width),
+                    wrap(self.wrap_u, x0.saturating_add(1), self.width),
+                ];
+                let rows = [
+                    wrap(self.wrap_v, y0, self.height),
+                    wrap(self.wrap_v, y0.saturating_add(1), self.height),
+                ];
+                let top = lerp4(
+                    self.texel(columns[0], rows[0]),
+                    self.texel(columns[1], rows[0]),
+                    fx,
+                );
+                let bottom = lerp4(
+                    self.texel(columns[0], rows[1]),
+                    self.texel(columns[1], rows[1]),
+                    fx,
+                );
+                lerp4(top, bottom, fy)
+            }
+        }
+    }
+
+    /// The linear RGBA value of the texel in `column`, `row` (both in range).
+    #[inline]
+    fn texel(&self, column: u32, row: u32) -> [f32; 4] {
+        let channels = self.channels as usize;
+        let start = (row as usize * self.width as usize + column as usize) * channels;
+        let mut values = [0.0; 4];
+        match &self.texels {
+            Texels::U8 {
+                values: bytes,
+                colour_table,
+            } => {
+                let bytes = &bytes[start..start + channels];
+                // Grey + alpha and RGBA end with alpha, which is always linear.
+                let colour_channels = if channels.is_multiple_of(2) {
+                    channels - 1
+                } else {
+                    channels
+                };
+                for (c, &byte) in bytes.iter().enumerate() {
+                    values[c] = if c < colour_channels {
+                        colour_table[byte as usize]
+                    } else {
+                        LINEAR_U8_TO_F32[byte as usize]
+                    };
+                }
+            }
+            Texels::F32(floats) => {
+                values[..channels].copy_from_slice(&floats[start..start + channels]);
+            }
+        }
+        match channels {
+            1 => [values[0], values[0], values[0], 1.0],
+            2 => [values[0], values[0], values[0], values[1]],
+            3 => [values[0], values[1], values[2], 1.0],
+            _ => values,
+        }
+    }
+}
+
+/// Keeps `coordinate` × texture side finite: at 1e30 an f32 step spans far more than a tile,
+/// so which texel such a coordinate reads is arbitrary anyway.
+#[inline]
+fn sanitize_coordinate(coordinate: f32) -> f32 {
+    const LIMIT: f32 = 1e30;
+    if coordinate.is_finite() {
+        coordinate.clamp(-LIMIT, LIMIT)
+    } else {
+        0.0
+    }
+}
+
+/// Copies the host's texels, reporting an allocation failure instead of aborting.
+fn copy_texels<T: Copy>(values: &[T], name: &str) -> Result<Box<[T]>> {
+    let mut copy = Vec::new();
+    copy.try_reserve_exact(values.len()).map_err(|_| {
+        Error::new(
+            MLT_STATUS_OUT_OF_MEMORY,
+            format!("could not allocate the {} values of {name}", values.len()),
+        )
+    })?;
+    copy.extend_from_slice(values);
+    Ok(copy.into_boxed_slice())
+}
+
+/// Maps a texel index, which may lie outside the image, to one inside it (`size` ≥ 1).
+#[inline]
+fn wrap(mode: WrapMode, index: i64, size: u32) -> u32 {
+    let size = size as i64;
+    let wrapped = match mode {
+        WrapMode::Repeat => index.rem_euclid(size),
+        WrapMode::ClampToEdge => index.clamp(0, size - 1),
+        WrapMode::MirroredRepeat => {
+            let period = index.rem_euclid(2 * size);
+            if period < size {
+                period
+            } else {
+                2 * size - 1 - period
+            }
+        }
+    };
+    wrapped as u32
+}
+
+#[inline]
+fn lerp4(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
+    std::array::from_fn(|c| a[c] + (b[c] - a[c]) * t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::MLT_STATUS_INVALID_ARGUMENT;
+
+    fn desc<'a>(width: u32, height: u32, channels: u32, data: TexelData<'a>) -> TextureDesc<'a> {
+        TextureDesc {
+            width,
+            height,
+            channels,
+            data,
+            encoding: TextureEncoding::Linear,
+            wrap_u: WrapMode::ClampToEdge,
+            wrap_v: WrapMode::ClampToEdge,
+            filter: TextureFilter::Nearest,
+        }
+    }
+
+    fn grey(value: f32) -> [f32; 4] {
+        [value, value, value, 1.0]
+    }
+
+    fn assert_close(actual: [f32; 4], expected: [f32; 4], tolerance: f32) {
+        for c in 0..4 {
+            assert!(
+                (actual[c] - expected[c]).abs() <= tolerance,
+                "channel {c}: {actual:?} != {expected:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn first_row_is_the_top_and_u_grows_to_the_right() {
+        // Row 0 holds 1, 2; row 1 holds 3, 4.
+        let data = [1.0, 2.0, 3.0, 4.0];
+        for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+            let texture = Texture::new(
+                &TextureDesc {
+                    filter,
+                    ..desc(2, 2, 1, TexelData::F32(&data))
+                },
+                0,
+            )
+            .unwrap();
+            assert_eq!(texture.sample([0.25, 0.25]), grey(1.0), "{filter:?}");
+            assert_eq!(texture.sample([0.75, 0.25]), grey(2.0), "{filter:?}");
+            assert_eq!(texture.sample([0.25, 0.75]), grey(3.0), "{filter:?}");
+            assert_eq!(texture.sample([0.75, 0.75]), grey(4.0), "{filter:?}");
+        }
+    }
+
+    #[test]
+    fn srgb_bytes_decode_by_the_iec_formula() {
+        let data = [0, 255, 128, 10];
+        let texture = Texture::new(
+            &TextureDesc {
+                encoding: TextureEncoding::Srgb,
+                ..desc(4, 1, 1, TexelData::U8(&data))
+            },
+            0,
+        )
+        .unwrap();
+        assert!(matches!(texture.texels, Texels::U8 { .. }), "kept as bytes");
+        let at = |i: f32| texture.sample([(i + 0.5) / 4.0, 0.5]);
+        assert_eq!(at(0.0), grey(0.0));
+        assert_eq!(at(1.0), grey(1.0));
+        // ((128/255 + 0.055) / 1.055)^2.4
+        assert_close(at(2.0), grey(0.2158605), 1e-7);
+        // 10/255 is below the 0.04045 knee: the linear segment.
+        assert_close(at(3.0), grey(10.0 / 255.0 / 12.92), 1e-9);
+    }
+
+    #[test]
+    fn srgb_alpha_stays_linear() {
+        let rgba = [128, 128, 128, 128];
+        let grey_alpha = [128, 128];
+        for (channels, data) in [(4, &rgba[..]), (2, &grey_alpha[..])] {
+            let texture = Texture::new(
+                &TextureDesc {
+                    encoding: TextureEncoding::Srgb,
+                    ..desc(1, 1, channels, TexelData::U8(data))
+                },
+                0,
+            )
+            .unwrap();
+            let s = 0.2158605;
+            assert_close(texture.sample([0.5, 0.5]), [s, s, s, 128.0 / 255.0], 1e-7);
+        }
+    }
+
+    #[test]
+    fn linear_bytes_divide_by_255() {
+        let data = [0, 128, 255];
+        let texture = Texture::new(&desc(3, 1, 1, TexelData::U8(&data)), 0).unwrap();
+        assert_eq!(texture.sample([0.5 / 3.0, 0.5]), grey(0.0));
+        assert_eq!(texture.sample([1.5 / 3.0, 0.5]), grey(128.0 / 255.0));
+        assert_eq!(texture.sample([2.5 / 3.0, 0.5]), grey(1.0));
+    }
+
+    #[test]
+    fn each_wrap_mode_reads_the_hand_derived_texel() {
+        // Two texels, 10 and 20, along the axis under test. u = -0.25, 1.25, 2.75 are texel
+        // centres (u·2 = -0.5, 2.5, 5.5):
+        //   Repeat: u - floor(u) = 0.75, 0.25, 0.75 -> texels 1, 0, 1.
+        //   ClampToEdge: 0, 1, 1 -> texels 0, 1, 1.
+        //   MirroredRepeat: tiles [-1, 0] and [1, 2] are mirrored, [2, 3] is not:
+        //   0.25, 2 - 1.25 = 0.75, 2.75 - 2 = 0.75 -> texels 0, 1, 1.
+        let data = [10.0, 20.0];
+        let coordinates = [-0.25, 1.25, 2.75];
+        let cases = [
+            (WrapMode::Repeat, [20.0, 10.0, 20.0]),
+            (WrapMode::ClampToEdge, [10.0, 20.0, 20.0]),
+            (WrapMode::MirroredRepeat, [10.0, 20.0, 20.0]),
+        ];
+        for (mode, expected) in cases {
+            for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+                let along_u = Texture::new(
+                    &TextureDesc {
+                        wrap_u: mode,
+                        filter,
+                        ..desc(2, 1, 1, TexelData::F32(&data))
+                    },
+                    0,
+                )
+                .unwrap();
+                let along_v = Texture::new(
+                    &TextureDesc {
+                        wrap_v: mode,
+                        filter,
+                        ..desc(1, 2, 1, TexelData::F32(&data))
+                    },
+                    0,
+                )
+                .unwrap();
+                for (t, value) in coordinates.into_iter().zip(expected) {
+                    assert_eq!(
+                        along_u.sample([t, 0.5]),
+                        grey(value),
+                        "{mode:?} {filter:?} u={t}"
+                    );
+                    assert_eq!(
+                        along_v.sample([0.5, t]),
+                        grey(value),
+                        "{mode:?} {filter:?} v={t}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bilinear_at_an_edge_blends_with_the_wrapped_neighbour() {
+        // u = 0 is halfway between texel 0 and the texel to its left.
+        let data = [10.0, 20.0];
+        let cases = [
+            (WrapMode::Repeat, 15.0),
+            (WrapMode::ClampToEdge, 10.0),
+            (WrapMode::MirroredRepeat, 10.0),
+        ];
+        for (mode, expected) in cases {
+            let texture = Texture::new(
+                &TextureDesc {
+                    wrap_u: mode,
+                    filter: TextureFilter::Bilinear,
+                    ..desc(2, 1, 1, TexelData::F32(&data))
+                },
+                0,
+            )
+            .unwrap();
+            assert_eq!(texture.sample([0.0, 0.5]), grey(expected), "{mode:?}");
+        }
+    }
+
+    #[test]
+    fn bilinear_between_four_texels_is_the_weighted_mix() {
+        // RGB texels (v, 10 v, 0) with v = 1, 2 on the top row and 3, 4 below.
+        let data = [
+            1.0, 10.0, 0.0, 2.0, 20.0, 0.0, //
+            3.0, 30.0, 0.0, 4.0, 40.0, 0.0,
+        ];
+        let texture = Texture::new(
+            &TextureDesc {
+                filter: TextureFilter::Bilinear,
+                ..desc(2, 2, 3, TexelData::F32(&data))
+            },
+            0,
+        )
+        .unwrap();
+        // uv (0.375, 0.625): 0.25 of the way from the left centres to the right ones and
+        // 0.75 from the top centres to the bottom ones. Weights 0.75·0.25, 0.25·0.25,
+        // 0.75·0.75, 0.25·0.75 on 1, 2, 3, 4: 0.1875 + 0.125 + 1.6875 + 0.75 = 2.75.
+        assert_close(texture.sample([0.375, 0.625]), [2.75, 27.5, 0.0, 1.0], 1e-6);
+    }
+
+    #[test]
+    fn bilinear_at_a_texel_centre_is_that_texel() {
+        let data: Vec<f32> = (0..4 * 4 * 4).map(|i| (i * 37 % 101) as f32).collect();
+        let texture = Texture::new(
+            &TextureDesc {
+                wrap_u: WrapMode::Repeat,
+                wrap_v: WrapMode::MirroredRepeat,
+                filter: TextureFilter::Bilinear,
+                ..desc(4, 4, 4, TexelData::F32(&data))
+            },
+            0,
+        )
+        .unwrap();
+        for row in 0..4 {
+            for column in 0..4 {
+                let uv = [(column as f32 + 0.5) / 4.0, (row as f32 + 0.5) / 4.0];
+                let start = (row * 4 + column) * 4;
+                let expected: [f32; 4] = data[start..start + 4].try_into().unwrap();
+                assert_eq!(texture.sample(uv), expected, "row {row}, column {column}");
+            }
+        }
+    }
+
+    #[test]
+    fn channels_expand_to_rgba() {
+        let cases: [(&[f32], [f32; 4]); 4] = [
+            (&[0.25], [0.25, 0.25, 0.25, 1.0]),
+            (&[0.25, 0.5], [0.25, 0.25, 0.25, 0.5]),
+            (&[0.1, 0.2, 0.3], [0.1, 0.2, 0.3, 1.0]),
+            (&[0.1, 0.2, 0.3, 0.4], [0.1, 0.2, 0.3, 0.4]),
+        ];
+        for (data, expected) in cases {
+            let channels = data.len() as u32;
+            let texture = Texture::new(&desc(1, 1, channels, TexelData::F32(data)), 0).unwrap();
+            assert_eq!(texture.sample([0.5, 0.5]), expected, "{channels} channels");
+        }
+    }
+
+    #[test]
+    fn extreme_coordinates_read_a_texel_without_panicking() {
+        let data = [10.0, 20.0, 30.0];
+        for mode in [
+            WrapMode::Repeat,
+            WrapMode::ClampToEdge,
+            WrapMode::MirroredRepeat,
+        ] {
+            for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+                let texture = Texture::new(
+                    &TextureDesc {
+                        wrap_u: mode,
+                        wrap_v: mode,
+                        filter,
+                        ..desc(3, 1, 1, TexelData::F32(&data))
+                    },
+                    0,
+                )
+                .unwrap();
+                for u in [
+                    f32::NAN,
+                    f32::INFINITY,
+                    f32::NEG_INFINITY,
+                    f32::MAX,
+                    f32::MIN,
+                    1e30,
+                    -1e30,
+                    1e10,
+                ] {
+                    let value = texture.sample([u, u])[0];
+                    assert!(
+                        (10.0..=30.0).contains(&value),
+                        "{mode:?} {filter:?} {u}: {value}"
+                    );
+                }
+                // Non-finite coordinates read as 0.
+                assert_eq!(texture.sample([f32::NAN, 0.5]), texture.sample([0.0, 0.5]));
+            }
+        }
+        // Far from the origin Repeat still tiles: 1000 + 0.5/3 is the centre of texel 0.
+        let texture = Texture::new(
+            &TextureDesc {
+                wrap_u: WrapMode::Repeat,
+                ..desc(3, 1, 1, TexelData::F32(&data))
+            },
+            0,
+        )
+        .unwrap();
+        assert_eq!(texture.sample([1000.0 + 0.5 / 3.0, 0.5]), grey(10.0));
+    }
+
+    #[test]
+    fn validation_names_the_field() {
+        let bytes = [0u8; 16];
+        let floats = [0.0f32; 16];
+        let check = |desc: TextureDesc, needle: &str| {
+            let error = Texture::new(&desc, 3).unwrap_err();
+            assert_eq!(error.status, MLT_STATUS_INVALID_ARGUMENT);
+            assert!(
+                error.message.starts_with(needle),
+                "{:?} should start with {needle:?}",
+                error.message
+            );
+        };
+        check(
+            desc(0, 1, 1, TexelData::U8(&bytes)),
+            "desc.textures[3].width is 0",
+        );
+        check(
+            desc(1, 0, 1, TexelData::U8(&bytes)),
+            "desc.textures[3].height is 0",
+        );
+        check(
+            desc(1, MLT_MAX_TEXTURE_SIDE + 1, 1, TexelData::U8(&bytes)),
+            "desc.textures[3].height is 32769",
+        );
+        check(
+            desc(
+                MLT_MAX_TEXTURE_SIDE,
+                MLT_MAX_TEXTURE_SIDE / 2,
+                1,
+                TexelData::U8(&bytes),
+            ),
+            "desc.textures[3] is 32768 x 16384 texels",
+        );
+        check(
+            desc(2, 2, 0, TexelData::U8(&bytes)),
+            "desc.textures[3].channels is 0",
+        );
+        check(
+            desc(2, 2, 5, TexelData::U8(&bytes)),
+            "desc.textures[3].channels is 5",
+        );
+        check(
+            desc(2, 2, 3, TexelData::U8(&bytes)),
+            "desc.textures[3].data has 16 8-bit values, but 2 x 2 texels of 3 channels need 12",
+        );
+        check(
+            TextureDesc {
+                encoding: TextureEncoding::Srgb,
+                ..desc(2, 2, 4, TexelData::F32(&floats))
+            },
+            "desc.textures[3].encoding is Srgb",
+        );
+        let mut bad = floats;
+        bad[7] = -0.5;
+        check(
+            desc(2, 2, 4, TexelData::F32(&bad)),
+            "desc.textures[3].data[7] (row 0, column 1, channel 3) is -0.5",
+        );
+        bad[7] = f32::NAN;
+        check(
+            desc(2, 2, 4, TexelData::F32(&bad)),
+            "desc.textures[3].data[7] (row 0, column 1, channel 3) is NaN",
+        );
+        bad[7] = 0.0;
+        bad[13] = f32::INFINITY;
+        check(
+            desc(2, 2, 4, TexelData::F32(&bad)),
+            "desc.textures[3].data[13] (row 1, column 1, channel 1) is inf",
+        );
+    }
+}
