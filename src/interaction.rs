@@ -26,8 +26,6 @@ pub(crate) struct SurfaceInteraction {
     pub uv: [f32; 2],
     /// Internal triangle index.
     pub triangle: u32,
-    /// Index into the scene's materials.
-    pub material: u32,
     /// Area density with which light sampling picks this point (0: not on a light); what
     /// MIS weighs an emitter found by BSDF sampling with.
     pub light_area_pdf: f32,
@@ -43,7 +41,6 @@ impl SurfaceInteraction {
             geometric_normal: shading.normal,
             uv: [hit.u, hit.v],
             triangle: hit.triangle,
-            material: shading.material,
             light_area_pdf: shading.light_area_pdf,
         }
     }
@@ -58,7 +55,7 @@ impl SurfaceInteraction {
     /// surfaces with `light_area_pdf` > 0 are lights).
     #[inline]
     pub fn emission(&self, scene: &Scene) -> Spectrum {
-        Spectrum::from(scene.materials[self.material as usize].emission)
+        scene.emission(self.triangle, self.uv)
     }
 }
 
@@ -100,7 +97,7 @@ mod tests {
         assert_eq!(si.geometric_normal, Vec3A::new(0.0, 0.0, -1.0));
         assert_eq!(si.bsdf(&scene).shading_normal(), si.geometric_normal);
         assert_eq!(si.uv, [hit.u, hit.v]);
-        assert_eq!((si.triangle, si.material), (hit.triangle, 0));
+        assert_eq!(si.triangle, hit.triangle);
         // The only light: picked with probability 1 over its area 2.
         assert_eq!(si.light_area_pdf, 0.5);
         assert_eq!(si.emission(&scene), Spectrum::splat(2.0));

@@ -96,6 +96,31 @@ impl Accel {
     /// The bytes the structure holds: for the BVH computed from its arrays' lengths, for
     /// Embree the balance of what Embree allocated (counted by its memory monitor) plus our
     /// own arrays. For comparing backends and sizing scenes; allocator overhead is not counted.
+    /// The closest hit that `accept(triangle, u, v)` keeps (alpha cut-outs): candidates it
+    /// rejects are passed through.
+    // A first version on top of `intersect`: it re-traces past each rejected hit.
+    #[inline]
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        accept: &impl Fn(u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
+        let mut ray = *ray;
+        loop {
+            let hit = self.intersect(&ray)?;
+            if accept(hit.triangle, hit.u, hit.v) {
+                return Some(hit);
+            }
+            ray.tmin = hit.t.next_up();
+        }
+    }
+
+    /// Whether a hit `accept(triangle, u, v)` keeps lies on the ray.
+    #[inline]
+    pub fn occluded_filtered(&self, ray: &Ray, accept: &impl Fn(u32, f32, f32) -> bool) -> bool {
+        self.intersect_filtered(ray, accept).is_some()
+    }
+
     pub fn memory_bytes(&self) -> usize {
         match self {
             Accel::Bvh(bvh) => bvh.memory_bytes(),

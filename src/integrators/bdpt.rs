@@ -172,7 +172,7 @@ impl Bdpt<'_> {
             VertexKind::Surface
                 if self.scene.light_area_pdf(v.triangle) > 0.0 && w.dot(v.normal) > 0.0 =>
             {
-                self.scene.emission(v.triangle)
+                self.scene.emission(v.triangle, v.barycentrics)
             }
             VertexKind::Light(Emitter::Infinite) => self.scene.lights.infinite_radiance(v.normal),
             _ => Spectrum::ZERO,
@@ -259,7 +259,7 @@ impl Bdpt<'_> {
         let mut count = 1;
         while count < max_vertices {
             counters.rays += 1;
-            let Some(hit) = self.scene.accel.intersect(&ray) else {
+            let Some(hit) = self.scene.closest_hit(&ray) else {
                 // A camera subpath that leaves the scene ends on the lights at infinity.
                 if mode == TransportMode::Radiance && self.scene.lights.has_infinite_light() {
                     path[count] = Vertex {
@@ -369,11 +369,7 @@ impl Bdpt<'_> {
         if max_vertices == 0 {
             return 0;
         }
-        let Some(light) = self
-            .scene
-            .lights
-            .sample_emission(u_select, u_point, u_direction)
-        else {
+        let Some(light) = self.scene.sample_emission(u_select, u_point, u_direction) else {
             return 0;
         };
         let triangle = match light.emitter {
@@ -514,10 +510,7 @@ impl Bdpt<'_> {
     #[inline]
     fn unoccluded_towards(&self, a: &Vertex, w: Vec3A, counters: &mut SampleCounters) -> bool {
         counters.rays += 1;
-        !self
-            .scene
-            .accel
-            .occluded(&spawn_ray(self.scene, a.p, a.normal, w))
+        !self.scene.blocked(&spawn_ray(self.scene, a.p, a.normal, w))
     }
 
     /// Whether nothing blocks the segment between two vertices.
@@ -528,7 +521,7 @@ impl Bdpt<'_> {
             return false;
         };
         counters.rays += 1;
-        !self.scene.accel.occluded(&ray)
+        !self.scene.blocked(&ray)
     }
 }
 
@@ -728,7 +721,7 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let (sampled, contribution) = match self.scene.lights.sample_light(u_select, u_point)? {
+            let (sampled, contribution) = match self.scene.sample_light(u_select, u_point)? {
                 LightSample::Area {
                     point,
                     normal,

@@ -48,7 +48,7 @@ impl PathTracer<'_> {
         let mut depth = 0;
         loop {
             *rays += 1;
-            let Some(hit) = scene.accel.intersect(&ray) else {
+            let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
                     let emission = scene.lights.infinite_radiance(ray.direction);
@@ -138,7 +138,7 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
-        match scene.lights.sample_light(u_select, u_point) {
+        match scene.sample_light(u_select, u_point) {
             None => Spectrum::ZERO,
             Some(LightSample::Area {
                 point: y,
@@ -165,7 +165,7 @@ impl PathTracer<'_> {
                     return Spectrum::ZERO;
                 };
                 *rays += 1;
-                if scene.accel.occluded(&ray) {
+                if scene.blocked(&ray) {
                     return Spectrum::ZERO;
                 }
                 let light_pdf = area_pdf * distance2 / cos_light;
@@ -192,7 +192,7 @@ impl PathTracer<'_> {
                     return Spectrum::ZERO;
                 };
                 *rays += 1;
-                if scene.accel.occluded(&ray) {
+                if scene.blocked(&ray) {
                     return Spectrum::ZERO;
                 }
                 // A delta position: no other strategy finds it, so no MIS.
@@ -209,7 +209,7 @@ impl PathTracer<'_> {
                     return Spectrum::ZERO;
                 }
                 *rays += 1;
-                if scene.accel.occluded(&spawn_ray(scene, p, normal, wi)) {
+                if scene.blocked(&spawn_ray(scene, p, normal, wi)) {
                     return Spectrum::ZERO;
                 }
                 let weight = if emitter.is_delta() {

@@ -18,6 +18,7 @@ pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 use crate::accel::{Accel, Backend, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::spectrum::Spectrum;
+use crate::texture::{Texture, TextureDesc};
 use glam::Vec3A;
 
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
@@ -47,6 +48,9 @@ pub struct SceneDesc<'a> {
     /// Per-vertex linear RGBA colours in [0, 1] multiplying the base colour and alpha (glTF
     /// `COLOR_0`), or empty.
     pub colors: &'a [f32],
+    /// Textures the materials refer to by index. A scene with a textured material needs
+    /// `texcoords`.
+    pub textures: &'a [TextureDesc<'a>],
 }
 
 impl Default for SceneDesc<'_> {
@@ -63,6 +67,7 @@ impl Default for SceneDesc<'_> {
             texcoords: &[],
             tangents: &[],
             colors: &[],
+            textures: &[],
         }
     }
 }
@@ -107,10 +112,14 @@ pub struct Scene {
     pub(crate) shading: Vec<TriangleShading>,
     /// Per-corner vertex attributes, in internal triangle order.
     attributes: surface::SurfaceAttributes,
+    textures: Vec<Texture>,
     pub(crate) materials: Vec<Material>,
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
     /// lights, a delta sun, the lights at infinity; with their selection distribution.
     pub(crate) lights: lights::SceneLights,
+    /// Whether some triangle's material is an alpha cut-out (`AlphaMode::Mask`): then ray
+    /// queries test candidate hits against its alpha.
+    has_cutouts: bool,
     /// Internal triangle index → the host's triangle id.
     internal_to_input: Vec<u32>,
     /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
@@ -123,6 +132,13 @@ impl Scene {
     pub fn new(desc: &SceneDesc) -> Result<Scene> {
         validate_arrays(desc)?;
         desc.lights.validate()?;
+        let textures = desc
+            .textures
+            .iter()
+            .enumerate()
+            .map(|(i, texture)| Texture::new(texture, i))
+            .collect::<Result<Vec<_>>>()?;
+        let tangents = corner_tangents(desc);
         let vertex = |i: u32| {
             let i = i as usize * 3;
             Vec3A::new(
@@ -184,6 +200,7 @@ impl Scene {
                     edge2: v2 - v0,
                     normal,
                     emission,
+                    power_scale: 1.0,
                     area_pdf: 0.0,
                     triangle: internal as u32,
                 });
@@ -195,7 +212,25 @@ impl Scene {
             });
             internal_to_input.push(id);
             let corners = &desc.indices[id as usize * 3..id as usize * 3 + 3];
-            attributes.push(&vertex_arrays, [corners[0], corners[1], corners[2]]);
+            attributes.push(
+                &vertex_arrays,
+                [corners[0], corners[1], corners[2]],
+                &tangents,
+                id,
+            );
+        }
+        for light in &mut lights {
+            let material = &desc.materials[shading[light.triangle as usize].material as usize];
+            if material.emission_texture.is_some() {
+                let point = |barycentrics| surface::SurfacePoint {
+                    attributes: &attributes,
+                    textures: &textures,
+                    material,
+                    triangle: light.triangle,
+                    barycentrics,
+                };
+                light.power_scale = surface::mean_emission_scale(point, light.emission);
+            }
         }
         // Lights in the host's triangle order, not the backend's: the same seed then picks
         // the same lights with either backend.
@@ -226,7 +261,12 @@ impl Scene {
         Ok(Scene {
             accel,
             shading,
+            has_cutouts: desc
+                .materials
+                .iter()
+                .any(|m| m.alpha_mode == AlphaMode::Mask),
             attributes,
+            textures,
             materials: desc.materials.to_vec(),
             lights: scene_lights,
             internal_to_input,
@@ -246,22 +286,112 @@ impl Scene {
     /// material with textures and vertex colours applied, in the shading frame there.
     #[inline]
     pub(crate) fn bsdf_at(&self, triangle: u32, barycentrics: [f32; 2]) -> crate::bsdf::Bsdf {
-        let shading = &self.shading[triangle as usize];
-        surface::bsdf_at(
-            &self.attributes,
-            &self.materials[shading.material as usize],
-            triangle,
-            barycentrics,
-            shading.normal,
-        )
+        let normal = self.shading[triangle as usize].normal;
+        self.surface_point(triangle, barycentrics).bsdf(normal)
     }
 
-    /// Radiance the front side of internal triangle `triangle` emits, if it is a light
-    /// (`light_area_pdf` > 0: the integrators ask that first).
+    /// Whether a candidate hit at barycentrics (u, v) of internal triangle `triangle` is a
+    /// surface: false where an alpha cut-out removes it.
     #[inline]
-    pub(crate) fn emission(&self, triangle: u32) -> Spectrum {
+    fn is_solid(&self, triangle: u32, u: f32, v: f32) -> bool {
+        let material = &self.materials[self.shading[triangle as usize].material as usize];
+        material.alpha_mode != AlphaMode::Mask
+            || self.surface_point(triangle, [u, v]).alpha() >= material.alpha_cutoff
+    }
+
+    /// The closest surface `ray` hits (internal triangle ids), through alpha cut-outs.
+    #[inline]
+    pub(crate) fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        if self.has_cutouts {
+            self.accel
+                .intersect_filtered(ray, &|triangle, u, v| self.is_solid(triangle, u, v))
+        } else {
+            self.accel.intersect(ray)
+        }
+    }
+
+    /// Whether a surface blocks `ray` within its interval, through alpha cut-outs.
+    #[inline]
+    pub(crate) fn blocked(&self, ray: &Ray) -> bool {
+        if self.has_cutouts {
+            self.accel
+                .occluded_filtered(ray, &|triangle, u, v| self.is_solid(triangle, u, v))
+        } else {
+            self.accel.occluded(ray)
+        }
+    }
+
+    /// The surface at barycentrics `barycentrics` of internal triangle `triangle`.
+    #[inline]
+    pub(crate) fn surface_point(
+        &self,
+        triangle: u32,
+        barycentrics: [f32; 2],
+    ) -> surface::SurfacePoint<'_> {
+        surface::SurfacePoint {
+            attributes: &self.attributes,
+            textures: &self.textures,
+            material: &self.materials[self.shading[triangle as usize].material as usize],
+            triangle,
+            barycentrics,
+        }
+    }
+
+    /// Radiance the front side of internal triangle `triangle` emits at `barycentrics`, if
+    /// it is a light (`light_area_pdf` > 0: the integrators ask that first).
+    #[inline]
+    pub(crate) fn emission(&self, triangle: u32, barycentrics: [f32; 2]) -> Spectrum {
+        self.surface_point(triangle, barycentrics).emission()
+    }
+
+    /// A light sample (`SceneLights::sample_light`) with the emission texture applied.
+    #[inline]
+    pub(crate) fn sample_light(
+        &self,
+        u_select: f32,
+        u_point: [f32; 2],
+    ) -> Option<lights::LightSample> {
+        let mut sample = self.lights.sample_light(u_select, u_point)?;
+        if let lights::LightSample::Area {
+            triangle,
+            barycentrics,
+            emission,
+            ..
+        } = &mut sample
+            && self.emission_is_textured(*triangle)
+        {
+            *emission = self.emission(*triangle, *barycentrics);
+        }
+        Some(sample)
+    }
+
+    /// An emission sample (`SceneLights::sample_emission`) with the emission texture
+    /// applied.
+    #[inline]
+    pub(crate) fn sample_emission(
+        &self,
+        u_select: f32,
+        u_point: [f32; 2],
+        u_direction: [f32; 2],
+    ) -> Option<lights::EmissionSample> {
+        let mut sample = self
+            .lights
+            .sample_emission(u_select, u_point, u_direction)?;
+        if let lights::Emitter::Area(triangle) = sample.emitter
+            && self.emission_is_textured(triangle)
+        {
+            sample.emission = self.emission(triangle, sample.barycentrics);
+            let cos = sample.direction.dot(sample.normal);
+            sample.beta = sample.emission * (cos / (sample.pdf_origin * sample.pdf_direction));
+        }
+        Some(sample)
+    }
+
+    /// Whether internal triangle `triangle`'s material has an emission texture.
+    #[inline]
+    fn emission_is_textured(&self, triangle: u32) -> bool {
         let material = self.shading[triangle as usize].material;
-        Spectrum::from(self.materials[material as usize].emission)
+        self.materials[material as usize].emission_texture.is_some()
     }
 
     /// Density of light vertex `emitter` as the start of a light subpath (see
@@ -283,7 +413,7 @@ impl Scene {
 
     /// Closest hit in the host's triangle ids; `None` on a miss.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.accel.intersect(ray).map(|hit| Hit {
+        self.closest_hit(ray).map(|hit| Hit {
             triangle: self.internal_to_input[hit.triangle as usize],
             ..hit
         })
@@ -291,7 +421,7 @@ impl Scene {
 
     /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax].
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.accel.occluded(ray)
+        self.blocked(ray)
     }
 }
 
@@ -353,7 +483,12 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     }
     desc.vertex_arrays().validate(vertex_count)?;
     for (i, material) in desc.materials.iter().enumerate() {
-        material.validate(i, 0)?;
+        material.validate(i, desc.textures.len())?;
+        if material.has_textures() && desc.texcoords.is_empty() && !desc.indices.is_empty() {
+            return Err(Error::invalid(format!(
+                "desc.materials[{i}] has textures but desc.texcoords is empty; textured materials need texture coordinates"
+            )));
+        }
         if material.kind == MaterialKind::MetallicRoughness {
             return Err(Error::new(
                 crate::error::MltStatus::MLT_STATUS_UNSUPPORTED,
@@ -364,4 +499,55 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Per-corner tangents of the host's triangles (3 per triangle), where a material has a
+/// normal map: the host's per-vertex tangents, or MikkTSpace's from the normals (vertex
+/// normals averaged from the faces when the host gave none) and texture coordinates.
+/// Empty when no material has a normal map.
+fn corner_tangents(desc: &SceneDesc) -> Vec<[f32; 4]> {
+    if !desc.materials.iter().any(|m| m.normal_texture.is_some()) || desc.texcoords.is_empty() {
+        return Vec::new();
+    }
+    if !desc.tangents.is_empty() {
+        return desc
+            .indices
+            .iter()
+            .map(|&v| {
+                let i = v as usize * 4;
+                [
+                    desc.tangents[i],
+                    desc.tangents[i + 1],
+                    desc.tangents[i + 2],
+                    desc.tangents[i + 3],
+                ]
+            })
+            .collect();
+    }
+    let face_normals;
+    let normals = if desc.normals.is_empty() {
+        face_normals = area_weighted_vertex_normals(desc.positions, desc.indices);
+        &face_normals[..]
+    } else {
+        desc.normals
+    };
+    tangents::mikktspace_tangents(desc.positions, normals, desc.texcoords, desc.indices)
+}
+
+/// Vertex normals as the area-weighted sum of the adjacent faces' normals (+Y where that
+/// sum vanishes).
+fn area_weighted_vertex_normals(positions: &[f32], indices: &[u32]) -> Vec<f32> {
+    let vertex = |i: u32| Vec3A::from_slice(&positions[i as usize * 3..i as usize * 3 + 3]);
+    let mut sums = vec![Vec3A::ZERO; positions.len() / 3];
+    for t in indices.chunks_exact(3) {
+        let n = (vertex(t[1]) - vertex(t[0])).cross(vertex(t[2]) - vertex(t[0]));
+        if n.is_finite() {
+            for &v in t {
+                sums[v as usize] += n;
+            }
+        }
+    }
+    sums.iter()
+        .flat_map(|n| n.try_normalize().unwrap_or(Vec3A::Y).to_array())
+        .collect()
 }

@@ -5,10 +5,11 @@
 //! Attributes are stored per triangle corner in the backend's internal triangle order, so a
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
-use super::Material;
+use super::{Material, TextureRef};
 use crate::bsdf::{Bsdf, BsdfModel};
 use crate::error::{Error, Result};
 use crate::spectrum::Spectrum;
+use crate::texture::Texture;
 use glam::{Vec3A, Vec4};
 
 /// Per-vertex arrays as the host gives them (empty: absent), before they are validated.
@@ -88,6 +89,9 @@ pub(crate) struct SurfaceAttributes {
     normals: Vec<[Vec3A; 3]>,
     texcoords: Vec<[[f32; 2]; 3]>,
     colors: Vec<[Vec4; 3]>,
+    /// xyz and the bitangent sign w, per corner: the host's, or MikkTSpace's where a
+    /// material has a normal map (empty otherwise).
+    tangents: Vec<[Vec4; 3]>,
 }
 
 impl SurfaceAttributes {
@@ -98,11 +102,25 @@ impl SurfaceAttributes {
             normals: Vec::with_capacity(capacity(arrays.normals)),
             texcoords: Vec::with_capacity(capacity(arrays.texcoords)),
             colors: Vec::with_capacity(capacity(arrays.colors)),
+            tangents: Vec::new(),
         }
     }
 
-    /// Appends the next internal triangle, whose corners are vertices `corners`.
-    pub fn push(&mut self, arrays: &VertexArrays, corners: [u32; 3]) {
+    /// Appends the next internal triangle, whose corners are vertices `corners`, and its
+    /// corner tangents if the scene has any (`tangents`: per corner of the host's
+    /// triangles; `id` is this one's host index).
+    pub fn push(
+        &mut self,
+        arrays: &VertexArrays,
+        corners: [u32; 3],
+        tangents: &[[f32; 4]],
+        id: u32,
+    ) {
+        if !tangents.is_empty() {
+            let first = id as usize * 3;
+            self.tangents
+                .push([0, 1, 2].map(|k| Vec4::from_array(tangents[first + k])));
+        }
         if !arrays.normals.is_empty() {
             self.normals.push(corners.map(|c| {
                 let i = c as usize * 3;
@@ -127,6 +145,28 @@ impl SurfaceAttributes {
     #[inline]
     fn is_flat(&self, material: &Material) -> bool {
         self.normals.is_empty() && self.colors.is_empty() && !material.has_textures()
+    }
+
+    /// The interpolated texture coordinates ((0, 0) without any).
+    #[inline]
+    fn texcoord(&self, triangle: u32, b: [f32; 2]) -> [f32; 2] {
+        match self.texcoords.get(triangle as usize) {
+            Some(t) => {
+                let w = 1.0 - b[0] - b[1];
+                [
+                    t[0][0] * w + t[1][0] * b[0] + t[2][0] * b[1],
+                    t[0][1] * w + t[1][1] * b[0] + t[2][1] * b[1],
+                ]
+            }
+            None => [0.0; 2],
+        }
+    }
+
+    /// The interpolated tangent (xyz) and bitangent sign (w), if the scene has tangents.
+    #[inline]
+    fn tangent(&self, triangle: u32, b: [f32; 2]) -> Option<Vec4> {
+        let t = self.tangents.get(triangle as usize)?;
+        Some(t[0] * (1.0 - b[0] - b[1]) + t[1] * b[0] + t[2] * b[1])
     }
 
     /// The interpolated shading normal of internal triangle `triangle` at `barycentrics`,
@@ -158,23 +198,143 @@ impl SurfaceAttributes {
     }
 }
 
-/// The BSDF of `material` at barycentrics `b` of internal triangle `triangle` with front
-/// geometric normal `geometric_normal`.
+/// The texel of `texture` at texture coordinates `uv` (its transform applied).
 #[inline]
-pub(crate) fn bsdf_at(
-    attributes: &SurfaceAttributes,
-    material: &Material,
-    triangle: u32,
-    b: [f32; 2],
-    geometric_normal: Vec3A,
-) -> Bsdf {
-    if attributes.is_flat(material) {
-        return Bsdf::new(BsdfModel::of(material), geometric_normal, geometric_normal);
+fn lookup(textures: &[Texture], texture: &TextureRef, uv: [f32; 2]) -> Vec4 {
+    let [row_u, row_v] = texture.matrix();
+    let uv = [
+        row_u[0] * uv[0] + row_u[1] * uv[1] + row_u[2],
+        row_v[0] * uv[0] + row_v[1] * uv[1] + row_v[2],
+    ];
+    Vec4::from_array(textures[texture.texture as usize].sample(uv))
+}
+
+/// A surface point's look: what its material's textures and the vertex attributes make of
+/// it there.
+pub(crate) struct SurfacePoint<'a> {
+    pub attributes: &'a SurfaceAttributes,
+    pub textures: &'a [Texture],
+    pub material: &'a Material,
+    pub triangle: u32,
+    pub barycentrics: [f32; 2],
+}
+
+impl SurfacePoint<'_> {
+    #[inline]
+    fn texcoord(&self) -> [f32; 2] {
+        self.attributes.texcoord(self.triangle, self.barycentrics)
     }
-    let vertex_color = attributes.color(triangle, b);
-    let color = Spectrum::from(material.color)
-        * Spectrum::new(vertex_color.x, vertex_color.y, vertex_color.z);
-    let model = BsdfModel::with_color(material, color);
-    let normal = attributes.shading_normal(triangle, b, geometric_normal);
-    Bsdf::new(model, normal, geometric_normal)
+
+    /// The base colour (RGB) and alpha: factors × vertex colour × base colour texture.
+    #[inline]
+    fn base_color(&self) -> Vec4 {
+        let m = self.material;
+        let mut color = Vec4::new(m.color[0], m.color[1], m.color[2], m.alpha)
+            * self.attributes.color(self.triangle, self.barycentrics);
+        if let Some(texture) = &m.base_color_texture {
+            color *= lookup(self.textures, texture, self.texcoord());
+        }
+        color
+    }
+
+    /// The coverage `AlphaMode::Mask` tests against the cutoff.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.base_color().w
+    }
+
+    /// Emitted radiance: the emission factor × the emission texture.
+    #[inline]
+    pub fn emission(&self) -> Spectrum {
+        let m = self.material;
+        let mut emission = Spectrum::from(m.emission);
+        if let Some(texture) = &m.emission_texture {
+            let texel = lookup(self.textures, texture, self.texcoord());
+            emission *= Spectrum::new(texel.x, texel.y, texel.z);
+        }
+        emission
+    }
+
+    /// The shading normal: interpolated, then bent by the normal map (tangent space, x and
+    /// y scaled by `normal_scale`); on the side of `geometric_normal`.
+    #[inline]
+    fn shading_normal(&self, geometric_normal: Vec3A) -> Vec3A {
+        let normal =
+            self.attributes
+                .shading_normal(self.triangle, self.barycentrics, geometric_normal);
+        let (Some(texture), Some(tangent)) = (
+            &self.material.normal_texture,
+            self.attributes.tangent(self.triangle, self.barycentrics),
+        ) else {
+            return normal;
+        };
+        let texel = lookup(self.textures, texture, self.texcoord());
+        let scale = self.material.normal_scale;
+        let local = Vec3A::new(
+            (texel.x * 2.0 - 1.0) * scale,
+            (texel.y * 2.0 - 1.0) * scale,
+            texel.z * 2.0 - 1.0,
+        );
+        // Gram-Schmidt: the interpolated tangent is only nearly perpendicular.
+        let t = Vec3A::new(tangent.x, tangent.y, tangent.z);
+        let t = (t - normal * normal.dot(t)).normalize();
+        if !t.is_finite() {
+            return normal;
+        }
+        let bitangent = normal.cross(t) * tangent.w.signum();
+        let mapped = (t * local.x + bitangent * local.y + normal * local.z).normalize();
+        // A map bending the normal behind the triangle has no sensible shading frame.
+        if mapped.is_finite() && mapped.dot(geometric_normal) > 0.0 {
+            mapped
+        } else {
+            normal
+        }
+    }
+
+    /// The BSDF here, on a triangle with front geometric normal `geometric_normal`.
+    #[inline]
+    pub fn bsdf(&self, geometric_normal: Vec3A) -> Bsdf {
+        if self.attributes.is_flat(self.material) {
+            return Bsdf::new(
+                BsdfModel::of(self.material),
+                geometric_normal,
+                geometric_normal,
+            );
+        }
+        let base = self.base_color();
+        let model = BsdfModel::with_color(self.material, Spectrum::new(base.x, base.y, base.z));
+        Bsdf::new(
+            model,
+            self.shading_normal(geometric_normal),
+            geometric_normal,
+        )
+    }
+}
+
+/// The mean of a textured emitter's emission over its triangle relative to its factor,
+/// from a grid of points: what the light's power is scaled by for picking lights. Never
+/// below 10⁻³, so a triangle whose texture the grid happens to see black still gets light
+/// samples where it glows (a zero would make those points unreachable by light sampling).
+pub(crate) fn mean_emission_scale<'a>(
+    point: impl Fn([f32; 2]) -> SurfacePoint<'a>,
+    factor: Spectrum,
+) -> f32 {
+    const STEPS: u32 = 6;
+    let (mut sum, mut count) = (0.0f32, 0u32);
+    for i in 0..STEPS {
+        for j in 0..STEPS - i {
+            let b = [
+                (i as f32 + 1.0 / 3.0) / STEPS as f32,
+                (j as f32 + 1.0 / 3.0) / STEPS as f32,
+            ];
+            sum += point(b).emission().luminance();
+            count += 1;
+        }
+    }
+    let factor = factor.luminance();
+    if factor > 0.0 {
+        (sum / count as f32 / factor).max(1e-3)
+    } else {
+        1.0
+    }
 }

@@ -27,7 +27,11 @@ pub struct AreaLight {
     pub edge1: Vec3A,
     pub edge2: Vec3A,
     pub normal: Vec3A,
+    /// The material's emission factor (an emission texture multiplies it point by point).
     pub emission: Spectrum,
+    /// The mean of the emission texture over the triangle relative to 1 (1 without a
+    /// texture): scales the power the light is picked by.
+    pub power_scale: f32,
     /// Selection probability / area: the area density of light sampling on this light.
     pub area_pdf: f32,
     /// Internal index of the light's triangle.
@@ -467,7 +471,7 @@ impl SceneLights {
         let mut lights: Vec<Light> = Vec::with_capacity(area.len() + desc.punctual.len() + 2);
         let mut power: Vec<f32> = Vec::with_capacity(lights.capacity());
         for light in area {
-            power.push(light.emission.luminance() * area_of(&light));
+            power.push(light.emission.luminance() * light.power_scale * area_of(&light));
             lights.push(Light::Area(light));
         }
         let r2 = bounds_radius * bounds_radius;

@@ -236,7 +236,7 @@ impl Bidirectional {
                 }
                 // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
                 // which are `sample_emission`'s).
-                match scene.lights.sample_light(rng.uniform(), rng.uniform2())? {
+                match scene.sample_light(rng.uniform(), rng.uniform2())? {
                     LightSample::Area {
                         point,
                         normal,

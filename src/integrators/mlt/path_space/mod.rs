@@ -101,7 +101,7 @@ impl PathSpace<'_> {
     #[inline]
     fn trace(&self, ray: &crate::accel::Ray, rays: &mut u64) -> Option<PathVertex> {
         *rays += 1;
-        let hit = self.scene.accel.intersect(ray)?;
+        let hit = self.scene.closest_hit(ray)?;
         Some(PathVertex::surface(&SurfaceInteraction::new(
             self.scene, ray, &hit,
         )))
@@ -128,7 +128,7 @@ impl PathSpace<'_> {
             let (near, far) = if a.is_at_infinity() { (b, a) } else { (a, b) };
             *rays += 1;
             let ray = crate::integrators::spawn_ray(self.scene, near.p, near.normal, far.normal);
-            return !self.scene.accel.occluded(&ray);
+            return !self.scene.blocked(&ray);
         }
         // Point lights and the lens have no surface to offset from.
         let normal_a = if a.is_point_light() {
@@ -146,7 +146,7 @@ impl PathSpace<'_> {
             return false;
         };
         *rays += 1;
-        !self.scene.accel.occluded(&ray)
+        !self.scene.blocked(&ray)
     }
 
     /// The pixel the path's last edge (from the lens) lands in.
@@ -225,7 +225,7 @@ impl PathSpace<'_> {
                 if area_pdf <= 0.0 {
                     return None;
                 }
-                let emission = self.scene.emission(light.triangle);
+                let emission = self.scene.emission(light.triangle, light.barycentrics);
                 // The light leaves its front side only.
                 let (w_light, _) = direction(&path[0], &path[1])?;
                 if w_light.dot(light.normal) <= 0.0 {
