@@ -54,8 +54,8 @@ pub use render::{
     Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
 };
 pub use scene::{
-    Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight, PunctualLightKind,
-    Scene, SceneDesc, SceneInfo, SunDesc,
+    AlphaMode, Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight,
+    PunctualLightKind, Scene, SceneDesc, SceneInfo, SunDesc, TextureRef,
 };
 pub use texture::{
     MLT_MAX_TEXTURE_SIDE, MLT_MAX_TEXTURE_TEXELS, TexelData, TextureDesc, TextureEncoding,

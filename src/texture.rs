@@ -10,6 +10,7 @@
 use std::sync::OnceLock;
 
 use crate::error::{Error, MLT_STATUS_OUT_OF_MEMORY, Result};
+use std::borrow::Cow;
 
 /// Largest width or height of a texture, in texels.
 pub const MLT_MAX_TEXTURE_SIDE: u32 = 1 << 15;
@@ -18,13 +19,13 @@ pub const MLT_MAX_TEXTURE_SIDE: u32 = 1 << 15;
 pub const MLT_MAX_TEXTURE_TEXELS: u64 = 1 << 28;
 
 /// The texel values of a texture, row-major from the top row of the image to the bottom,
-/// channels interleaved.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// channels interleaved. Borrowed from the host, or owned (a loaded file's images).
+#[derive(Clone, Debug, PartialEq)]
 pub enum TexelData<'a> {
     /// 8-bit values, 255 meaning 1; decoded according to the [`TextureEncoding`].
-    U8(&'a [u8]),
+    U8(Cow<'a, [u8]>),
     /// Linear floats, finite and >= 0 (above 1 is allowed: emission may be HDR).
-    F32(&'a [f32]),
+    F32(Cow<'a, [f32]>),
 }
 
 /// How the colour channels of 8-bit data encode linear values. Alpha (the 4th channel, or
@@ -62,7 +63,7 @@ pub enum TextureFilter {
 }
 
 /// A texture as the host passes it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TextureDesc<'a> {
     pub width: u32,
     pub height: u32,
@@ -160,7 +161,7 @@ impl Texture {
             )));
         }
         let expected = texel_count * channels as u64;
-        let (length, kind) = match desc.data {
+        let (length, kind) = match &desc.data {
             TexelData::U8(values) => (values.len(), "8-bit values"),
             TexelData::F32(values) => (values.len(), "floats"),
         };
@@ -169,9 +170,9 @@ impl Texture {
                 "{name}.data has {length} {kind}, but {width} x {height} texels of {channels} channels need {expected}"
             )));
         }
-        let texels = match desc.data {
+        let texels = match &desc.data {
             TexelData::U8(values) => Texels::U8 {
-                values: copy_texels(values, &name)?,
+                values: copy_texels(values.as_ref(), &name)?,
                 colour_table: match desc.encoding {
                     TextureEncoding::Srgb => srgb_u8_table(),
                     TextureEncoding::Linear => &LINEAR_U8_TO_F32,
@@ -194,7 +195,7 @@ impl Texture {
                         values[i]
                     )));
                 }
-                Texels::F32(copy_texels(values, &name)?)
+                Texels::F32(copy_texels(values.as_ref(), &name)?)
             }
         };
         Ok(Texture {
@@ -378,7 +379,7 @@ mod tests {
             let texture = Texture::new(
                 &TextureDesc {
                     filter,
-                    ..desc(2, 2, 1, TexelData::F32(&data))
+                    ..desc(2, 2, 1, TexelData::F32(Cow::Borrowed(&data)))
                 },
                 0,
             )
@@ -396,7 +397,7 @@ mod tests {
         let texture = Texture::new(
             &TextureDesc {
                 encoding: TextureEncoding::Srgb,
-                ..desc(4, 1, 1, TexelData::U8(&data))
+                ..desc(4, 1, 1, TexelData::U8(Cow::Borrowed(&data)))
             },
             0,
         )
@@ -419,7 +420,7 @@ mod tests {
             let texture = Texture::new(
                 &TextureDesc {
                     encoding: TextureEncoding::Srgb,
-                    ..desc(1, 1, channels, TexelData::U8(data))
+                    ..desc(1, 1, channels, TexelData::U8(Cow::Borrowed(data)))
                 },
                 0,
             )
@@ -432,7 +433,7 @@ mod tests {
     #[test]
     fn linear_bytes_divide_by_255() {
         let data = [0, 128, 255];
-        let texture = Texture::new(&desc(3, 1, 1, TexelData::U8(&data)), 0).unwrap();
+        let texture = Texture::new(&desc(3, 1, 1, TexelData::U8(Cow::Borrowed(&data))), 0).unwrap();
         assert_eq!(texture.sample([0.5 / 3.0, 0.5]), grey(0.0));
         assert_eq!(texture.sample([1.5 / 3.0, 0.5]), grey(128.0 / 255.0));
         assert_eq!(texture.sample([2.5 / 3.0, 0.5]), grey(1.0));
@@ -459,7 +460,7 @@ mod tests {
                     &TextureDesc {
                         wrap_u: mode,
                         filter,
-                        ..desc(2, 1, 1, TexelData::F32(&data))
+                        ..desc(2, 1, 1, TexelData::F32(Cow::Borrowed(&data)))
                     },
                     0,
                 )
@@ -468,7 +469,7 @@ mod tests {
                     &TextureDesc {
                         wrap_v: mode,
                         filter,
-                        ..desc(1, 2, 1, TexelData::F32(&data))
+                        ..desc(1, 2, 1, TexelData::F32(Cow::Borrowed(&data)))
                     },
                     0,
                 )
@@ -503,7 +504,7 @@ mod tests {
                 &TextureDesc {
                     wrap_u: mode,
                     filter: TextureFilter::Bilinear,
-                    ..desc(2, 1, 1, TexelData::F32(&data))
+                    ..desc(2, 1, 1, TexelData::F32(Cow::Borrowed(&data)))
                 },
                 0,
             )
@@ -522,7 +523,7 @@ mod tests {
         let texture = Texture::new(
             &TextureDesc {
                 filter: TextureFilter::Bilinear,
-                ..desc(2, 2, 3, TexelData::F32(&data))
+                ..desc(2, 2, 3, TexelData::F32(Cow::Borrowed(&data)))
             },
             0,
         )
@@ -541,7 +542,7 @@ mod tests {
                 wrap_u: WrapMode::Repeat,
                 wrap_v: WrapMode::MirroredRepeat,
                 filter: TextureFilter::Bilinear,
-                ..desc(4, 4, 4, TexelData::F32(&data))
+                ..desc(4, 4, 4, TexelData::F32(Cow::Borrowed(&data)))
             },
             0,
         )
@@ -566,7 +567,11 @@ mod tests {
         ];
         for (data, expected) in cases {
             let channels = data.len() as u32;
-            let texture = Texture::new(&desc(1, 1, channels, TexelData::F32(data)), 0).unwrap();
+            let texture = Texture::new(
+                &desc(1, 1, channels, TexelData::F32(Cow::Borrowed(data))),
+                0,
+            )
+            .unwrap();
             assert_eq!(texture.sample([0.5, 0.5]), expected, "{channels} channels");
         }
     }
@@ -585,7 +590,7 @@ mod tests {
                         wrap_u: mode,
                         wrap_v: mode,
                         filter,
-                        ..desc(3, 1, 1, TexelData::F32(&data))
+                        ..desc(3, 1, 1, TexelData::F32(Cow::Borrowed(&data)))
                     },
                     0,
                 )
@@ -614,7 +619,7 @@ mod tests {
         let texture = Texture::new(
             &TextureDesc {
                 wrap_u: WrapMode::Repeat,
-                ..desc(3, 1, 1, TexelData::F32(&data))
+                ..desc(3, 1, 1, TexelData::F32(Cow::Borrowed(&data)))
             },
             0,
         )
@@ -636,15 +641,20 @@ mod tests {
             );
         };
         check(
-            desc(0, 1, 1, TexelData::U8(&bytes)),
+            desc(0, 1, 1, TexelData::U8(Cow::Borrowed(&bytes))),
             "desc.textures[3].width is 0",
         );
         check(
-            desc(1, 0, 1, TexelData::U8(&bytes)),
+            desc(1, 0, 1, TexelData::U8(Cow::Borrowed(&bytes))),
             "desc.textures[3].height is 0",
         );
         check(
-            desc(1, MLT_MAX_TEXTURE_SIDE + 1, 1, TexelData::U8(&bytes)),
+            desc(
+                1,
+                MLT_MAX_TEXTURE_SIDE + 1,
+                1,
+                TexelData::U8(Cow::Borrowed(&bytes)),
+            ),
             "desc.textures[3].height is 32769",
         );
         check(
@@ -652,44 +662,44 @@ mod tests {
                 MLT_MAX_TEXTURE_SIDE,
                 MLT_MAX_TEXTURE_SIDE / 2,
                 1,
-                TexelData::U8(&bytes),
+                TexelData::U8(Cow::Borrowed(&bytes)),
             ),
             "desc.textures[3] is 32768 x 16384 texels",
         );
         check(
-            desc(2, 2, 0, TexelData::U8(&bytes)),
+            desc(2, 2, 0, TexelData::U8(Cow::Borrowed(&bytes))),
             "desc.textures[3].channels is 0",
         );
         check(
-            desc(2, 2, 5, TexelData::U8(&bytes)),
+            desc(2, 2, 5, TexelData::U8(Cow::Borrowed(&bytes))),
             "desc.textures[3].channels is 5",
         );
         check(
-            desc(2, 2, 3, TexelData::U8(&bytes)),
+            desc(2, 2, 3, TexelData::U8(Cow::Borrowed(&bytes))),
             "desc.textures[3].data has 16 8-bit values, but 2 x 2 texels of 3 channels need 12",
         );
         check(
             TextureDesc {
                 encoding: TextureEncoding::Srgb,
-                ..desc(2, 2, 4, TexelData::F32(&floats))
+                ..desc(2, 2, 4, TexelData::F32(Cow::Borrowed(&floats)))
             },
             "desc.textures[3].encoding is Srgb",
         );
         let mut bad = floats;
         bad[7] = -0.5;
         check(
-            desc(2, 2, 4, TexelData::F32(&bad)),
+            desc(2, 2, 4, TexelData::F32(Cow::Borrowed(&bad))),
             "desc.textures[3].data[7] (row 0, column 1, channel 3) is -0.5",
         );
         bad[7] = f32::NAN;
         check(
-            desc(2, 2, 4, TexelData::F32(&bad)),
+            desc(2, 2, 4, TexelData::F32(Cow::Borrowed(&bad))),
             "desc.textures[3].data[7] (row 0, column 1, channel 3) is NaN",
         );
         bad[7] = 0.0;
         bad[13] = f32::INFINITY;
         check(
-            desc(2, 2, 4, TexelData::F32(&bad)),
+            desc(2, 2, 4, TexelData::F32(Cow::Borrowed(&bad))),
             "desc.textures[3].data[13] (row 1, column 1, channel 1) is inf",
         );
     }

@@ -346,16 +346,21 @@ fn run(args: &Args) -> Result<(), String> {
 
     let load_start = Instant::now();
     let data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let framed = data.camera.is_none() && args.camera.is_none();
     let camera_file = match &args.camera {
         Some(path) => mlt::io::load_camera_json(path).map_err(|e| e.to_string())?,
-        None => data.camera.ok_or_else(|| {
-            format!(
-                "{} has no camera (for an OBJ, put one in {}); pass --camera FILE.json",
-                args.scene.display(),
-                args.scene.with_extension("camera.json").display()
-            )
-        })?,
+        None => data.camera.unwrap_or_else(|| {
+            let (min, max) = data.bounds();
+            CameraFile::framing(min, max)
+        }),
     };
+    if framed {
+        eprintln!(
+            "mlt-render: {} has no camera; framing its bounds with this one (save it as a file, edit it and pass it with --camera FILE.json):\n{}",
+            args.scene.display(),
+            camera_file.to_json()
+        );
+    }
     let backend = match args.backend {
         BackendArg::Bvh => mlt::Backend::Bvh,
         BackendArg::Embree => mlt::Backend::Embree,

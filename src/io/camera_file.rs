@@ -6,10 +6,10 @@
 use super::scene_data::{CameraFile, IoError};
 use crate::Camera;
 use crate::render::MLT_MAX_IMAGE_SIDE;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct CameraJson {
     eye: [f32; 3],
@@ -62,4 +62,46 @@ pub fn load_camera_json(path: &Path) -> Result<CameraFile, IoError> {
         width: json.width,
         height: json.height,
     })
+}
+
+impl CameraFile {
+    /// A camera framing the box `[min, max]` (a scene without a camera of its own): from
+    /// the front (+Z, where glTF assets face) and a little above, looking at the box's
+    /// centre with a 40° field of view, far enough back that its bounding sphere fits;
+    /// 512 × 512.
+    pub fn framing(min: [f32; 3], max: [f32; 3]) -> CameraFile {
+        let (min, max) = (glam::Vec3::from(min), glam::Vec3::from(max));
+        let center = (min + max) * 0.5;
+        let radius = ((max - min).length() * 0.5).max(1e-3);
+        let fov_y_deg = 40.0f32;
+        let distance = radius / (fov_y_deg.to_radians() * 0.5).sin() * 1.05;
+        let eye = center + glam::Vec3::new(0.0, 0.3, 1.0).normalize() * distance;
+        CameraFile {
+            camera: Camera {
+                eye: eye.to_array(),
+                target: center.to_array(),
+                up: [0.0, 1.0, 0.0],
+                fov_y_deg,
+                ..Camera::default()
+            },
+            width: 512,
+            height: 512,
+        }
+    }
+
+    /// The camera as a sidecar file's JSON (what `load_camera_json` reads).
+    pub fn to_json(&self) -> String {
+        let c = &self.camera;
+        serde_json::to_string_pretty(&CameraJson {
+            eye: c.eye,
+            target: c.target,
+            up: c.up,
+            fov_y_deg: c.fov_y_deg,
+            width: self.width,
+            height: self.height,
+            lens_radius: c.lens_radius,
+            focus_distance: c.focus_distance,
+        })
+        .expect("a camera serializes")
+    }
 }

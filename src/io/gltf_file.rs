@@ -2,11 +2,13 @@
 //! [`super::load_scene`].
 
 use super::scene_data::{CameraFile, GLTF_DEFAULT_HEIGHT, IoError, SceneData};
-use crate::scene::PunctualLight;
+use crate::scene::{AlphaMode, MaterialKind, PunctualLight, TextureRef};
+use crate::texture::{TexelData, TextureDesc, TextureEncoding, TextureFilter, WrapMode};
 use crate::{Camera, Material};
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::mesh::Mode;
-use glam::{Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec3};
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -34,11 +36,36 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         .or_else(|| document.scenes().next())
         .ok_or_else(|| fail("it defines no scene".into()))?;
 
+    let images = if document.textures().next().is_some() {
+        ::gltf::import_images(&document, Some(base), &buffers)
+            .map_err(|e| fail(format!("cannot load its images: {e}")))?
+    } else {
+        Vec::new()
+    };
+    let triangle_primitives = || {
+        document
+            .meshes()
+            .flat_map(|m| m.primitives())
+            .filter(|p| p.mode() == Mode::Triangles)
+    };
+    use ::gltf::Semantic;
+    let attributes = Attributes {
+        normals: triangle_primitives().any(|p| p.get(&Semantic::Normals).is_some()),
+        texcoords: triangle_primitives().any(|p| p.get(&Semantic::TexCoords(0)).is_some()),
+        colors: triangle_primitives().any(|p| p.get(&Semantic::Colors(0)).is_some()),
+        tangents: triangle_primitives().next().is_some()
+            && triangle_primitives().all(|p| {
+                p.get(&Semantic::Tangents).is_some() && p.get(&Semantic::Normals).is_some()
+            }),
+    };
     let mut loader = Loader {
         path,
         buffers: &buffers,
+        images: &images,
+        attributes,
         data: SceneData::default(),
         material_map: HashMap::new(),
+        texture_map: HashMap::new(),
     };
     for node in scene.nodes() {
         loader.visit(&node, Mat4::IDENTITY)?;
@@ -46,12 +73,29 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     Ok(loader.data)
 }
 
+/// Which per-vertex attributes the scene carries: each is given for every vertex or none.
+struct Attributes {
+    /// Some primitive has normals (the others get their flat face normals).
+    normals: bool,
+    /// Some primitive has TEXCOORD_0 (the others get (0, 0)).
+    texcoords: bool,
+    /// Some primitive has COLOR_0 (the others get white).
+    colors: bool,
+    /// Every primitive has tangents and normals (else MikkTSpace computes them all).
+    tangents: bool,
+}
+
 struct Loader<'a> {
     path: &'a Path,
     buffers: &'a [::gltf::buffer::Data],
+    images: &'a [::gltf::image::Data],
+    attributes: Attributes,
     data: SceneData,
     /// glTF material index (None: the default material) → index in `data.materials`.
     material_map: HashMap<Option<usize>, u32>,
+    /// (glTF texture index, sRGB) → index in `data.textures`: an image used both as colour
+    /// and as data becomes two textures.
+    texture_map: HashMap<(usize, bool), u32>,
 }
 
 impl Loader<'_> {
@@ -256,14 +300,119 @@ impl Loader<'_> {
             )));
         }
 
-        let material = self.material(&primitive.material());
+        let material = self.material(&primitive.material())?;
+        let attribute = |what_attribute: &str| {
+            self.fail(format!(
+                "the {what_attribute} data of {what} lies outside its buffer or has the wrong length"
+            ))
+        };
+        let normals: Option<Vec<[f32; 3]>> = match primitive.get(&::gltf::Semantic::Normals) {
+            Some(_) => Some(
+                reader
+                    .read_normals()
+                    .ok_or_else(|| attribute("NORMAL"))?
+                    .collect(),
+            ),
+            None => None,
+        };
+        let texcoords: Option<Vec<[f32; 2]>> = match reader.read_tex_coords(0) {
+            Some(read) => Some(read.into_f32().collect()),
+            None => None,
+        };
+        let colors: Option<Vec<[f32; 4]>> = match reader.read_colors(0) {
+            Some(read) => Some(read.into_rgba_f32().collect()),
+            None => None,
+        };
+        let tangents: Option<Vec<[f32; 4]>> = match reader.read_tangents() {
+            Some(read) if self.attributes.tangents => Some(read.collect()),
+            _ => None,
+        };
+        for (name, count) in [
+            ("NORMAL", normals.as_ref().map(Vec::len)),
+            ("TEXCOORD_0", texcoords.as_ref().map(Vec::len)),
+            ("COLOR_0", colors.as_ref().map(Vec::len)),
+            ("TANGENT", tangents.as_ref().map(Vec::len)),
+        ] {
+            if count.is_some_and(|n| n != vertex_count) {
+                return Err(attribute(name));
+            }
+        }
+
+        // Without normals of its own in a scene that has them elsewhere, the primitive is
+        // flat-shaded (glTF's rule): each triangle gets its own corners with its face normal.
+        let flat = self.attributes.normals && normals.is_none();
+        let corners: Vec<u32> = if flat {
+            indices.clone()
+        } else {
+            (0..vertex_count as u32).collect()
+        };
+        let indices: Vec<u32> = if flat {
+            (0..indices.len() as u32).collect()
+        } else {
+            indices
+        };
+
+        let linear = Mat3::from_mat4(world);
+        let normal_matrix = linear.inverse().transpose();
+        // A mirroring transform turns counter-clockwise into clockwise (swap two corners)
+        // and flips the bitangent's handedness.
+        let flip = world.determinant() < 0.0;
         let base = (self.data.positions.len() / 3) as u32;
-        for p in positions {
-            let p = world.transform_point3(Vec3::from(p));
+        for &c in &corners {
+            let p = world.transform_point3(Vec3::from(positions[c as usize]));
             self.data.positions.extend_from_slice(&p.to_array());
         }
-        // A mirroring transform turns counter-clockwise into clockwise: swap two corners.
-        let flip = world.determinant() < 0.0;
+        if self.attributes.normals {
+            match &normals {
+                Some(normals) => {
+                    for &c in &corners {
+                        let n = (normal_matrix * Vec3::from(normals[c as usize]))
+                            .try_normalize()
+                            .ok_or_else(|| {
+                                self.fail(format!(
+                                    "the normal of vertex {c} of {what} has no direction"
+                                ))
+                            })?;
+                        self.data.normals.extend_from_slice(&n.to_array());
+                    }
+                }
+                None => {
+                    for triangle in corners.chunks_exact(3) {
+                        let [a, b, c] = [0, 1, 2].map(|k| {
+                            world.transform_point3(Vec3::from(positions[triangle[k] as usize]))
+                        });
+                        let mut n = (b - a).cross(c - a).normalize_or(Vec3::Y);
+                        if flip {
+                            // The corners are swapped below: the front side stays this one.
+                            n = -n;
+                        }
+                        for _ in 0..3 {
+                            self.data.normals.extend_from_slice(&n.to_array());
+                        }
+                    }
+                }
+            }
+        }
+        if self.attributes.texcoords {
+            for &c in &corners {
+                let uv = texcoords.as_ref().map_or([0.0; 2], |t| t[c as usize]);
+                self.data.texcoords.extend_from_slice(&uv);
+            }
+        }
+        if self.attributes.colors {
+            for &c in &corners {
+                let color = colors.as_ref().map_or([1.0; 4], |t| t[c as usize]);
+                self.data.colors.extend_from_slice(&color);
+            }
+        }
+        if let Some(tangents) = &tangents {
+            for &c in &corners {
+                let [x, y, z, w] = tangents[c as usize];
+                let t = (linear * Vec3::new(x, y, z)).normalize_or(Vec3::X);
+                let w = if flip { -w.signum() } else { w.signum() };
+                self.data.tangents.extend_from_slice(&[t.x, t.y, t.z, w]);
+            }
+        }
         let triangles = indices.len() / 3;
         for tri in indices.chunks_exact(3) {
             let (b, c) = if flip {
@@ -281,26 +430,168 @@ impl Loader<'_> {
         Ok(())
     }
 
-    fn material(&mut self, material: &::gltf::Material) -> u32 {
+    /// The index in `data.textures` of glTF texture `info` decoded as sRGB or linear, with
+    /// its `KHR_texture_transform`.
+    fn texture_ref(
+        &mut self,
+        texture: ::gltf::texture::Texture,
+        transform: Option<::gltf::texture::TextureTransform>,
+        srgb: bool,
+    ) -> Result<TextureRef, IoError> {
+        let index = match self.texture_map.get(&(texture.index(), srgb)) {
+            Some(&index) => index,
+            None => {
+                let desc = self.texture(&texture, srgb)?;
+                self.data.textures.push(desc);
+                let index = (self.data.textures.len() - 1) as u32;
+                self.texture_map.insert((texture.index(), srgb), index);
+                index
+            }
+        };
+        let mut reference = TextureRef::new(index);
+        if let Some(transform) = transform {
+            reference.offset = transform.offset();
+            reference.rotation = transform.rotation();
+            reference.scale = transform.scale();
+        }
+        Ok(reference)
+    }
+
+    /// A glTF texture's image and sampler as a texture: 8-bit images stay 8-bit (sRGB or
+    /// linear), 16-bit ones become linear floats (sRGB decoded here), float ones stay floats.
+    fn texture(
+        &self,
+        texture: &::gltf::texture::Texture,
+        srgb: bool,
+    ) -> Result<TextureDesc<'static>, IoError> {
+        use ::gltf::image::Format;
+        use ::gltf::texture::{MagFilter, WrappingMode};
+        let image = &self.images[texture.source().index()];
+        let (channels, bytes_per_channel) = match image.format {
+            Format::R8 => (1, 1),
+            Format::R8G8 => (2, 1),
+            Format::R8G8B8 => (3, 1),
+            Format::R8G8B8A8 => (4, 1),
+            Format::R16 => (1, 2),
+            Format::R16G16 => (2, 2),
+            Format::R16G16B16 => (3, 2),
+            Format::R16G16B16A16 => (4, 2),
+            Format::R32G32B32FLOAT => (3, 4),
+            Format::R32G32B32A32FLOAT => (4, 4),
+        };
+        let colour_channels = if channels % 2 == 0 {
+            channels - 1
+        } else {
+            channels
+        };
+        let (data, encoding) = match bytes_per_channel {
+            1 => (
+                TexelData::U8(Cow::Owned(image.pixels.clone())),
+                if srgb {
+                    TextureEncoding::Srgb
+                } else {
+                    TextureEncoding::Linear
+                },
+            ),
+            2 => {
+                let floats = image
+                    .pixels
+                    .chunks_exact(2)
+                    .enumerate()
+                    .map(|(i, b)| {
+                        let value = u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0;
+                        if srgb && i % channels < colour_channels {
+                            srgb_to_linear(value)
+                        } else {
+                            value
+                        }
+                    })
+                    .collect();
+                (TexelData::F32(Cow::Owned(floats)), TextureEncoding::Linear)
+            }
+            _ => {
+                let floats = image
+                    .pixels
+                    .chunks_exact(4)
+                    .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                    .collect();
+                (TexelData::F32(Cow::Owned(floats)), TextureEncoding::Linear)
+            }
+        };
+        let wrap = |mode| match mode {
+            WrappingMode::Repeat => WrapMode::Repeat,
+            WrappingMode::ClampToEdge => WrapMode::ClampToEdge,
+            WrappingMode::MirroredRepeat => WrapMode::MirroredRepeat,
+        };
+        let sampler = texture.sampler();
+        Ok(TextureDesc {
+            width: image.width,
+            height: image.height,
+            channels: channels as u32,
+            data,
+            encoding,
+            wrap_u: wrap(sampler.wrap_s()),
+            wrap_v: wrap(sampler.wrap_t()),
+            filter: match sampler.mag_filter() {
+                Some(MagFilter::Nearest) => TextureFilter::Nearest,
+                _ => TextureFilter::Bilinear,
+            },
+        })
+    }
+
+    fn material(&mut self, material: &::gltf::Material) -> Result<u32, IoError> {
         if let Some(&id) = self.material_map.get(&material.index()) {
-            return id;
+            return Ok(id);
         }
         let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, _] = pbr.base_color_factor();
+        let [r, g, b, a] = pbr.base_color_factor();
         let emission = material
             .emissive_factor()
             .map(|e| e * material.emissive_strength().unwrap_or(1.0));
-        let transmission = material
-            .transmission()
-            .map_or(0.0, |t| t.transmission_factor());
-        let converted = if transmission > 0.0 {
-            Material::dielectric(material.ior().unwrap_or(1.5))
-        } else if pbr.metallic_factor() == 1.0 && pbr.roughness_factor() == 0.0 {
-            Material::mirror([r, g, b])
-        } else {
-            Material::diffuse([r, g, b])
+        let mut converted = Material {
+            kind: MaterialKind::MetallicRoughness,
+            alpha: a,
+            ior: material.ior().unwrap_or(1.5),
+            transmission: material
+                .transmission()
+                .map_or(0.0, |t| t.transmission_factor()),
+            alpha_mode: match material.alpha_mode() {
+                ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                // Blending is rendered as a cut-out at the cutoff (0.5 by default).
+                ::gltf::material::AlphaMode::Mask | ::gltf::material::AlphaMode::Blend => {
+                    AlphaMode::Mask
+                }
+            },
+            alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
+            ..Material::metallic_roughness([r, g, b], pbr.metallic_factor(), pbr.roughness_factor())
         }
         .with_emission(emission);
+        if let Some(info) = pbr.base_color_texture() {
+            converted.base_color_texture =
+                Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
+        }
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            converted.metallic_roughness_texture =
+                Some(self.texture_ref(info.texture(), info.texture_transform(), false)?);
+        }
+        if let Some(normal) = material.normal_texture() {
+            converted.normal_texture = Some(self.texture_ref(normal.texture(), None, false)?);
+            converted.normal_scale = normal.scale();
+        }
+        if let Some(info) = material.emissive_texture() {
+            converted.emission_texture =
+                Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
+        }
+        if converted.has_textures() && !self.attributes.texcoords {
+            // Without texture coordinates every lookup would read one texel; glTF files
+            // with textures always carry them, so this is a broken file.
+            return Err(self.fail(format!(
+                "material {} has textures but no primitive has TEXCOORD_0",
+                material
+                    .index()
+                    .map_or("(default)".into(), |i| i.to_string())
+            )));
+        }
         let name = match (material.name(), material.index()) {
             (Some(name), _) => name.to_owned(),
             (None, Some(i)) => format!("material {i}"),
@@ -308,6 +599,15 @@ impl Loader<'_> {
         };
         let id = self.data.push_material(name, converted);
         self.material_map.insert(material.index(), id);
-        id
+        Ok(id)
+    }
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1), for 16-bit colour images.
+fn srgb_to_linear(value: f32) -> f32 {
+    if value <= 0.04045 {
+        value / 12.92
+    } else {
+        ((value + 0.055) / 1.055).powf(2.4)
     }
 }

@@ -3,8 +3,11 @@
 use super::camera_file::load_camera_json;
 use super::scene_data::{DEFAULT_ALBEDO, IoError, SceneData};
 use crate::Material;
+use crate::scene::{MaterialKind, TextureRef};
+use crate::texture::{TexelData, TextureDesc, TextureEncoding, TextureFilter, WrapMode};
+use std::borrow::Cow;
 use std::cell::RefCell;
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 pub(super) fn load_obj(path: &Path) -> Result<SceneData, IoError> {
@@ -58,22 +61,40 @@ pub(super) fn load_obj(path: &Path) -> Result<SceneData, IoError> {
     check_material_names(&bytes, &materials, path)?;
 
     let mut data = SceneData::default();
+    let mut images = TextureFiles {
+        directory,
+        loaded: HashMap::new(),
+    };
     for material in &materials {
-        let converted = convert_material(material).map_err(|problem| {
+        let invalid = |problem: String| {
             IoError::new(format!(
                 "material '{}' used by {} is invalid: {problem}",
                 material.name,
                 path.display()
             ))
-        })?;
+        };
+        let mut converted = convert_material(material).map_err(invalid)?;
+        add_textures(material, &mut converted, &mut images, &mut data.textures).map_err(invalid)?;
         data.push_material(material.name.clone(), converted);
     }
+    // Normals and texture coordinates are per corner in OBJ (`f v/vt/vn`): a scene that has
+    // some gets them for every corner, each triangle with corners of its own (flat face
+    // normals and (0, 0) where a mesh has none).
+    let per_corner = models
+        .iter()
+        .any(|m| !m.mesh.normals.is_empty() || !m.mesh.texcoords.is_empty());
+    let any_normals = models.iter().any(|m| !m.mesh.normals.is_empty());
+    let any_texcoords = models.iter().any(|m| !m.mesh.texcoords.is_empty());
     let mut default_material = None;
     for model in &models {
         let mesh = &model.mesh;
         let base = (data.positions.len() / 3) as u32;
-        data.positions.extend_from_slice(&mesh.positions);
-        data.indices.extend(mesh.indices.iter().map(|&i| base + i));
+        if per_corner {
+            add_corners(mesh, any_normals, any_texcoords, &mut data);
+        } else {
+            data.positions.extend_from_slice(&mesh.positions);
+            data.indices.extend(mesh.indices.iter().map(|&i| base + i));
+        }
         let material = match mesh.material_id {
             Some(id) => id as u32,
             None => *default_material.get_or_insert_with(|| {
@@ -84,6 +105,12 @@ pub(super) fn load_obj(path: &Path) -> Result<SceneData, IoError> {
             .extend(std::iter::repeat_n(material, mesh.indices.len() / 3));
     }
 
+    if data.materials.iter().any(Material::has_textures) && data.texcoords.is_empty() {
+        return Err(IoError::new(format!(
+            "{} has textured materials but no texture coordinates (vt)",
+            path.display()
+        )));
+    }
     let sidecar = path.with_extension("camera.json");
     if sidecar.is_file() {
         data.camera = Some(load_camera_json(&sidecar)?);
@@ -103,16 +130,356 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
     };
     let illum = m.illumination_model;
     let transmits = transmission.is_some_and(|t| t.iter().any(|&c| c != 0.0));
+    let number = |key: &str| -> Result<Option<f32>, String> {
+        match m.unknown_param.get(key) {
+            None => Ok(None),
+            Some(text) => text
+                .trim()
+                .parse::<f32>()
+                .map(Some)
+                .map_err(|_| format!("{key} '{text}' is not a number")),
+        }
+    };
+    let (roughness, metallic) = (number("Pr")?, number("Pm")?);
+    let pbr = roughness.is_some()
+        || metallic.is_some()
+        || m.unknown_param.contains_key("map_Pr")
+        || m.unknown_param.contains_key("map_Pm");
+    let glossy = matches!(illum, None | Some(2))
+        && m.shininess.is_some()
+        && m.specular.is_some_and(|ks| ks.iter().any(|&c| c > 0.0));
+    let diffuse = m.diffuse.unwrap_or(DEFAULT_ALBEDO);
     let material = if illum == Some(7) || (transmits && m.optical_density.is_some()) {
         let mut glass = Material::dielectric(m.optical_density.unwrap_or(1.5));
         glass.color = transmission.unwrap_or([1.0; 3]);
         glass
     } else if matches!(illum, Some(3) | Some(5)) {
         Material::mirror(m.specular.unwrap_or([1.0; 3]))
+    } else if pbr {
+        Material {
+            ior: m.optical_density.unwrap_or(1.5),
+            ..Material::metallic_roughness(
+                diffuse,
+                metallic.unwrap_or(0.0),
+                roughness.unwrap_or(1.0),
+            )
+        }
+    } else if glossy {
+        Material {
+            ior: m.optical_density.unwrap_or(1.5),
+            ..Material::metallic_roughness(
+                diffuse,
+                0.0,
+                phong_roughness(m.shininess.unwrap_or(0.0)),
+            )
+        }
     } else {
-        Material::diffuse(m.diffuse.unwrap_or(DEFAULT_ALBEDO))
+        Material::diffuse(diffuse)
     };
     Ok(material.with_emission(m.emissive.unwrap_or([0.0; 3])))
+}
+
+/// The GGX roughness that matches a Phong exponent `Ns`: Walter et al. 2007's Beckmann
+/// equivalent α = sqrt(2 / (Ns + 2)), and glTF's α = roughness².
+fn phong_roughness(shininess: f32) -> f32 {
+    (2.0 / (shininess.max(0.0) + 2.0)).sqrt().sqrt()
+}
+
+/// Texture images of a material library, each decoded once per encoding.
+struct TextureFiles<'a> {
+    directory: &'a Path,
+    /// (file, sRGB) → index in the scene's textures.
+    loaded: HashMap<(PathBuf, bool), u32>,
+}
+
+/// An MTL texture statement (`map_Kd -clamp on -s 2 2 file.png`): the file and the options
+/// mlt uses (`-bm` scale, `-o` offset, `-s` scale, `-clamp`); the others are skipped.
+struct TextureStatement {
+    file: String,
+    bump_scale: f32,
+    offset: [f32; 2],
+    scale: [f32; 2],
+    clamp: bool,
+}
+
+fn parse_texture_statement(text: &str) -> Result<TextureStatement, String> {
+    let mut statement = TextureStatement {
+        file: String::new(),
+        bump_scale: 1.0,
+        offset: [0.0; 2],
+        scale: [1.0; 2],
+        clamp: false,
+    };
+    let words: Vec<&str> = text.split_whitespace().collect();
+    let mut i = 0;
+    let parse = |w: Option<&&str>| -> Result<f32, String> {
+        w.and_then(|w| w.parse().ok())
+            .ok_or_else(|| format!("texture options '{text}' are malformed"))
+    };
+    while i < words.len() {
+        let option = words[i];
+        let numbers_after = |from: usize| {
+            words[from..]
+                .iter()
+                .take(3)
+                .take_while(|w| w.parse::<f32>().is_ok())
+                .count()
+        };
+        match option {
+            "-bm" => {
+                statement.bump_scale = parse(words.get(i + 1))?;
+                i += 2;
+            }
+            "-o" | "-s" => {
+                let n = numbers_after(i + 1);
+                let u = parse(words.get(i + 1))?;
+                let v = if n >= 2 { parse(words.get(i + 2))? } else { u };
+                if option == "-o" {
+                    statement.offset = [u, v];
+                } else {
+                    statement.scale = [u, v];
+                }
+                i += 1 + n.max(1);
+            }
+            "-t" | "-mm" => i += 1 + numbers_after(i + 1).max(1),
+            "-clamp" => {
+                statement.clamp = words.get(i + 1) == Some(&"on");
+                i += 2;
+            }
+            "-blendu" | "-blendv" | "-boost" | "-texres" | "-imfchan" | "-type" | "-cc" => i += 2,
+            _ => {
+                // The file name is the rest of the line (it may contain spaces).
+                statement.file = words[i..].join(" ");
+                break;
+            }
+        }
+    }
+    if statement.file.is_empty() {
+        return Err(format!("texture statement '{text}' names no file"));
+    }
+    Ok(statement)
+}
+
+/// Reads an image file as 8-bit texels (its channel count kept) or linear floats (HDR).
+fn read_texture_image(
+    path: &Path,
+    srgb: bool,
+    clamp: bool,
+) -> Result<TextureDesc<'static>, String> {
+    let image =
+        image::open(path).map_err(|e| format!("cannot read texture {}: {e}", path.display()))?;
+    let (width, height) = (image.width(), image.height());
+    use image::DynamicImage as Image;
+    let (channels, data, encoding) = match image {
+        Image::ImageLuma8(i) => (1, TexelData::U8(Cow::Owned(i.into_raw())), None),
+        Image::ImageLumaA8(i) => (2, TexelData::U8(Cow::Owned(i.into_raw())), None),
+        Image::ImageRgb8(i) => (3, TexelData::U8(Cow::Owned(i.into_raw())), None),
+        Image::ImageRgba8(i) => (4, TexelData::U8(Cow::Owned(i.into_raw())), None),
+        Image::ImageRgb32F(i) => (
+            3,
+            TexelData::F32(Cow::Owned(i.into_raw())),
+            Some(TextureEncoding::Linear),
+        ),
+        Image::ImageRgba32F(i) => (
+            4,
+            TexelData::F32(Cow::Owned(i.into_raw())),
+            Some(TextureEncoding::Linear),
+        ),
+        other => (
+            4,
+            TexelData::U8(Cow::Owned(other.into_rgba8().into_raw())),
+            None,
+        ),
+    };
+    let wrap = if clamp {
+        WrapMode::ClampToEdge
+    } else {
+        WrapMode::Repeat
+    };
+    Ok(TextureDesc {
+        width,
+        height,
+        channels,
+        data,
+        encoding: encoding.unwrap_or(if srgb {
+            TextureEncoding::Srgb
+        } else {
+            TextureEncoding::Linear
+        }),
+        wrap_u: wrap,
+        wrap_v: wrap,
+        filter: TextureFilter::Bilinear,
+    })
+}
+
+impl TextureFiles<'_> {
+    /// The texture of `statement`'s file, decoded as sRGB colour or linear data.
+    fn reference(
+        &mut self,
+        statement: &TextureStatement,
+        srgb: bool,
+        textures: &mut Vec<TextureDesc<'static>>,
+    ) -> Result<TextureRef, String> {
+        let file = self.directory.join(statement.file.replace('\\', "/"));
+        let index = match self.loaded.get(&(file.clone(), srgb)) {
+            Some(&index) => index,
+            None => {
+                textures.push(read_texture_image(&file, srgb, statement.clamp)?);
+                let index = (textures.len() - 1) as u32;
+                self.loaded.insert((file, srgb), index);
+                index
+            }
+        };
+        // OBJ's v grows upwards, glTF's (the kernel's) downwards: v' = 1 − v, applied
+        // to the coordinates when loading them. In those coordinates OBJ's v ↦ s·v + o
+        // becomes v' ↦ s·v' + (1 − s − o).
+        let [s, o] = [statement.scale[1], statement.offset[1]];
+        Ok(TextureRef {
+            offset: [statement.offset[0], 1.0 - s - o],
+            scale: statement.scale,
+            ..TextureRef::new(index)
+        })
+    }
+}
+
+/// The textures of an MTL material: `map_Kd` (base colour, sRGB), `norm` / `map_Bump` /
+/// `bump` (a tangent-space normal map; a grey image is a height map, which is skipped),
+/// `map_Ke` (emission, sRGB), and `map_Pr` / `map_Pm` (roughness and metalness, combined
+/// into one texture as glTF's green and blue channels; they must have the same size).
+fn add_textures(
+    m: &tobj::Material,
+    material: &mut Material,
+    files: &mut TextureFiles,
+    textures: &mut Vec<TextureDesc<'static>>,
+) -> Result<(), String> {
+    if let Some(text) = &m.diffuse_texture {
+        let statement = parse_texture_statement(text)?;
+        material.base_color_texture = Some(files.reference(&statement, true, textures)?);
+    }
+    if let Some(text) = m.unknown_param.get("map_Ke") {
+        let statement = parse_texture_statement(text)?;
+        material.emission_texture = Some(files.reference(&statement, true, textures)?);
+        if !material.is_emissive() {
+            // map_Ke alone means emission as the texture says.
+            material.emission = [1.0; 3];
+        }
+    }
+    let normal_map = m.unknown_param.get("norm").or(m.normal_texture.as_ref());
+    if let Some(text) = normal_map {
+        let statement = parse_texture_statement(text)?;
+        let reference = files.reference(&statement, false, textures)?;
+        if textures[reference.texture as usize].channels >= 3 {
+            material.normal_texture = Some(reference);
+            material.normal_scale = statement.bump_scale;
+        }
+    }
+    let roughness = m.unknown_param.get("map_Pr");
+    let metalness = m.unknown_param.get("map_Pm");
+    if (roughness.is_some() || metalness.is_some())
+        && material.kind == MaterialKind::MetallicRoughness
+    {
+        let read = |text: &String| -> Result<TextureDesc<'static>, String> {
+            let statement = parse_texture_statement(text)?;
+            read_texture_image(
+                &files.directory.join(&statement.file),
+                false,
+                statement.clamp,
+            )
+        };
+        let roughness = roughness.map(read).transpose()?;
+        let metalness = metalness.map(read).transpose()?;
+        let (width, height) = roughness
+            .as_ref()
+            .or(metalness.as_ref())
+            .map(|t| (t.width, t.height))
+            .unwrap_or((1, 1));
+        for t in roughness.iter().chain(&metalness) {
+            if (t.width, t.height) != (width, height) {
+                return Err("map_Pr and map_Pm images have different sizes".into());
+            }
+        }
+        let first_channel = |t: &Option<TextureDesc<'static>>, i: usize| -> u8 {
+            match t {
+                None => 255,
+                Some(t) => match &t.data {
+                    TexelData::U8(v) => v[i * t.channels as usize],
+                    TexelData::F32(v) => {
+                        (v[i * t.channels as usize].clamp(0.0, 1.0) * 255.0).round() as u8
+                    }
+                },
+            }
+        };
+        let texels = (0..(width * height) as usize)
+            .flat_map(|i| {
+                [
+                    0,
+                    first_channel(&roughness, i),
+                    first_channel(&metalness, i),
+                ]
+            })
+            .collect();
+        textures.push(TextureDesc {
+            width,
+            height,
+            channels: 3,
+            data: TexelData::U8(Cow::Owned(texels)),
+            encoding: TextureEncoding::Linear,
+            wrap_u: WrapMode::Repeat,
+            wrap_v: WrapMode::Repeat,
+            filter: TextureFilter::Bilinear,
+        });
+        material.metallic_roughness_texture = Some(TextureRef::new((textures.len() - 1) as u32));
+        // The maps replace the factors (glTF multiplies them).
+        material.roughness = 1.0;
+        material.metallic = 1.0;
+    }
+    Ok(())
+}
+
+/// Appends `mesh` with corners of their own: positions, the normals (the face's where the
+/// mesh has none) and texture coordinates (v flipped to glTF's convention; (0, 0) where the
+/// mesh has none).
+fn add_corners(mesh: &tobj::Mesh, normals: bool, texcoords: bool, data: &mut SceneData) {
+    let vertex = |i: u32| {
+        let i = i as usize * 3;
+        glam::Vec3::new(
+            mesh.positions[i],
+            mesh.positions[i + 1],
+            mesh.positions[i + 2],
+        )
+    };
+    for (triangle, corners) in mesh.indices.chunks_exact(3).enumerate() {
+        let face_normal = (vertex(corners[1]) - vertex(corners[0]))
+            .cross(vertex(corners[2]) - vertex(corners[0]))
+            .normalize_or(glam::Vec3::Y);
+        for (k, &corner) in corners.iter().enumerate() {
+            let at = triangle * 3 + k;
+            data.indices.push((data.positions.len() / 3) as u32);
+            data.positions.extend_from_slice(&vertex(corner).to_array());
+            if normals {
+                let normal = match mesh.normal_indices.get(at) {
+                    Some(&n) if !mesh.normals.is_empty() => {
+                        let n = n as usize * 3;
+                        glam::Vec3::from_slice(&mesh.normals[n..n + 3])
+                            .try_normalize()
+                            .unwrap_or(face_normal)
+                    }
+                    _ => face_normal,
+                };
+                data.normals.extend_from_slice(&normal.to_array());
+            }
+            if texcoords {
+                let uv = match mesh.texcoord_indices.get(at) {
+                    Some(&t) if !mesh.texcoords.is_empty() => {
+                        let t = t as usize * 2;
+                        [mesh.texcoords[t], 1.0 - mesh.texcoords[t + 1]]
+                    }
+                    _ => [0.0; 2],
+                };
+                data.texcoords.extend_from_slice(&uv);
+            }
+        }
+    }
 }
 
 /// `Tf r g b` or `Tf v` (grey).

@@ -60,6 +60,13 @@ pub struct SceneData {
     pub camera: Option<CameraFile>,
     /// The glTF's `KHR_lights_punctual` lights, placed by its node hierarchy.
     pub punctual_lights: Vec<crate::scene::PunctualLight>,
+    /// Per-vertex attributes, each empty or complete (see [`SceneDesc`]).
+    pub normals: Vec<f32>,
+    pub texcoords: Vec<f32>,
+    pub tangents: Vec<f32>,
+    pub colors: Vec<f32>,
+    /// The textures the materials refer to, with their texels.
+    pub textures: Vec<crate::texture::TextureDesc<'static>>,
 }
 
 impl SceneData {
@@ -75,8 +82,28 @@ impl SceneData {
                 ..Default::default()
             },
             backend,
-            ..Default::default()
+            normals: &self.normals,
+            texcoords: &self.texcoords,
+            tangents: &self.tangents,
+            colors: &self.colors,
+            textures: &self.textures,
         }
+    }
+
+    /// The box around every vertex (zero for no vertices).
+    pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+        let mut min = [f32::INFINITY; 3];
+        let mut max = [f32::NEG_INFINITY; 3];
+        for p in self.positions.chunks_exact(3) {
+            for k in 0..3 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        if self.positions.is_empty() {
+            return ([0.0; 3], [0.0; 3]);
+        }
+        (min, max)
     }
 
     pub fn triangle_count(&self) -> usize {
