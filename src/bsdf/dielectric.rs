@@ -85,7 +85,7 @@ pub(super) fn sample(
 /// `wo` refracted through the surface (`side_normal` on wo's side, cos_i = wo · side_normal,
 /// eta = η_i/η_t), below the critical angle.
 #[inline]
-fn refract(wo: Vec3A, side_normal: Vec3A, cos_i: f32, eta: f32) -> Vec3A {
+pub(super) fn refract(wo: Vec3A, side_normal: Vec3A, cos_i: f32, eta: f32) -> Vec3A {
     let sin_t2 = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
     let cos_t = (1.0 - sin_t2).max(0.0).sqrt();
     (-wo * eta + side_normal * (eta * cos_i - cos_t)).normalize()

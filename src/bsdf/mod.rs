@@ -10,6 +10,8 @@
 //! kind; the free functions below are its arithmetic, one `match` per operation.
 
 mod dielectric;
+mod metallic_roughness;
+mod microfacet;
 mod scattering;
 
 pub use dielectric::fresnel_dielectric;

@@ -1,5 +1,7 @@
 //! Random numbers, distributions and warps used by every integrator.
 
+#[cfg(test)]
+pub(crate) mod chi_square;
 mod distribution;
 mod normal;
 mod rng;

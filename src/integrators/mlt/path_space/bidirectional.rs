@@ -395,6 +395,9 @@ mod tests {
     use super::*;
     use crate::accel::Backend;
     use crate::integrators::mlt::acceptance;
+    use crate::sampling::chi_square::{
+        Z_999, Z_9999, quantile as chi_square_quantile, statistic as chi_square,
+    };
     use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
     use glam::DVec3;
     use std::f64::consts::PI;
@@ -851,38 +854,6 @@ mod tests {
             nodes
         }
     }
-
-    /// Pearson's statistic of `counts` against the probabilities `expected` (which sum to at
-    /// most 1; the rest is one more cell, "anything else", counted in `rest`).
-    fn chi_square(counts: &[u64], rest: u64, expected: &[f64]) -> f64 {
-        let total = (counts.iter().sum::<u64>() + rest) as f64;
-        let rest_expected = 1.0 - expected.iter().sum::<f64>();
-        let term = |c: u64, p: f64| {
-            if p <= 0.0 {
-                if c == 0 { 0.0 } else { f64::INFINITY }
-            } else {
-                (c as f64 - total * p).powi(2) / (total * p)
-            }
-        };
-        counts
-            .iter()
-            .zip(expected)
-            .map(|(&c, &p)| term(c, p))
-            .sum::<f64>()
-            + term(rest, rest_expected)
-    }
-
-    /// Upper quantile of the chi-square distribution with `df` degrees of freedom at the
-    /// normal quantile `z` (Wilson–Hilferty).
-    fn chi_square_quantile(df: usize, z: f64) -> f64 {
-        let k = df as f64;
-        let a = 2.0 / (9.0 * k);
-        k * (1.0 - a + z * a.sqrt()).powi(3)
-    }
-
-    /// Normal quantiles: 99.9% and 99.99%.
-    const Z_999: f64 = 3.090_232;
-    const Z_9999: f64 = 3.719_016;
 
     /// The first rays of a light side from a point light, a spot light and a light at
     /// infinity have the densities `unweighted_contribution` divides by: directions

@@ -801,6 +801,9 @@ mod tests {
 
     use super::super::test_geometry::Rect;
     use crate::integrators::mlt::acceptance;
+    use crate::sampling::chi_square::{
+        Z_999, quantile as chi_square_quantile, statistic as chi_square,
+    };
     use glam::DVec3;
 
     const FLOOR: Rect = Rect {
@@ -826,8 +829,6 @@ mod tests {
     const CELLS: usize = 4;
     /// Independent chains per run.
     const CHAINS: usize = 10_000;
-    /// The normal quantile of 99.9%.
-    const Z_999: f64 = 3.090_232;
     /// Flawed chains must exceed the correct chains' threshold this many times over.
     const FLAW_MARGIN: f64 = 3.0;
     /// Correct chains must accept at least this share of their steps (a chain that never
@@ -1062,24 +1063,6 @@ mod tests {
         (counts, accepted as f64 / (starts.len() * steps) as f64)
     }
 
-    /// Pearson's statistic of `counts` against the probabilities `expected` (summing to 1).
-    fn chi_square(counts: &[u64], expected: &[f64]) -> f64 {
-        let total = counts.iter().sum::<u64>() as f64;
-        counts
-            .iter()
-            .zip(expected)
-            .map(|(&c, &p)| (c as f64 - total * p).powi(2) / (total * p))
-            .sum()
-    }
-
-    /// Upper quantile of the chi-square distribution with `df` degrees of freedom at the
-    /// normal quantile `z` (Wilson–Hilferty).
-    fn chi_square_quantile(df: usize, z: f64) -> f64 {
-        let k = df as f64;
-        let a = 2.0 / (9.0 * k);
-        k * (1.0 - a + z * a.sqrt()).powi(3)
-    }
-
     /// Which ratio a chain uses: the perturbation's, or one without a factor.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     enum Flaw {
@@ -1107,7 +1090,7 @@ mod tests {
         let df = target.len() - 1;
         let threshold = chi_square_quantile(df, Z_999);
         let (counts, accepted) = run(None);
-        let stat = chi_square(&counts, target);
+        let stat = chi_square(&counts, 0, target);
         let n = counts.iter().sum::<u64>() as f64;
         println!(
             "{name}: chi-square {stat:.1} (df {df}, 99.9% quantile {threshold:.1}), \
@@ -1122,7 +1105,7 @@ mod tests {
         assert!(accepted > MIN_ACCEPTED, "{name}: accepted {accepted}");
         for &flaw in flaws {
             let (counts, accepted) = run(Some(flaw));
-            let stat = chi_square(&counts, target);
+            let stat = chi_square(&counts, 0, target);
             println!("{name}, {flaw:?}: chi-square {stat:.1}, accepted {accepted:.2}");
             assert!(
                 stat > FLAW_MARGIN * threshold,

@@ -1,0 +1,231 @@
+//! The isotropic Trowbridge–Reitz (GGX) microfacet distribution in a local frame whose z
+//! axis is the macro-surface normal: the normal distribution D, Smith's masking (Λ, G1 and
+//! the height-correlated G2 of Heitz 2014), and sampling of the normals visible from a
+//! direction (Heitz 2018, in the spherical-cap form of Dupuy and Benyoub 2023).
+
+use glam::Vec3A;
+use std::f32::consts::{FRAC_1_PI, PI};
+
+/// The smallest roughness α used: at α = 1e-4 the peak of D, 1 / (π α²) ≈ 3·10⁷, and the
+/// densities built from it stay well inside f32, and the lobe (≈ 1e-4 rad wide) is still
+/// wider than the rounding of f32 directions (≈ 1e-7 rad).
+pub(crate) const MIN_ALPHA: f32 = 1e-4;
+
+/// A GGX distribution of roughness α (the slopes' scale; α = perceptual roughness²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TrowbridgeReitz {
+    alpha: f32,
+}
+
+#[cfg_attr(not(test), allow(dead_code))]
+impl TrowbridgeReitz {
+    /// The distribution of roughness `alpha`, raised to [`MIN_ALPHA`].
+    #[inline]
+    pub fn new(alpha: f32) -> Self {
+        TrowbridgeReitz {
+            alpha: alpha.max(MIN_ALPHA),
+        }
+    }
+
+    /// Density of microfacet normals `m` (unit) per projected solid angle of the macro
+    /// surface: ∫ D(m) m.z dω = 1. Zero below the surface.
+    #[inline]
+    pub fn d(self, m: Vec3A) -> f32 {
+        if m.z <= 0.0 {
+            return 0.0;
+        }
+        // 1 / (π α² cos⁴θ (1 + tan²θ / α²)²) written with sin²θ = x² + y², which keeps its
+        // precision near the normal where 1 − z² would not.
+        let a2 = self.alpha * self.alpha;
+        let t = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
+        FRAC_1_PI / (a2 * t * t)
+    }
+
+    /// Smith's Λ for direction `w` (either side; only its angle to the normal counts).
+    #[inline]
+    pub fn lambda(self, w: Vec3A) -> f32 {
+        let z2 = w.z * w.z;
+        if z2 == 0.0 {
+            return f32::INFINITY;
+        }
+        let a2_tan2 = self.alpha * self.alpha * (w.x * w.x + w.y * w.y) / z2;
+        0.5 * ((1.0 + a2_tan2).sqrt() - 1.0)
+    }
+
+    /// Smith's masking of direction `w`.
+    #[inline]
+    pub fn g1(self, w: Vec3A) -> f32 {
+        1.0 / (1.0 + self.lambda(w))
+    }
+
+    /// Height-correlated masking-shadowing of the pair (Heitz 2014, eq. 99).
+    #[inline]
+    pub fn g2(self, wo: Vec3A, wi: Vec3A) -> f32 {
+        1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
+    }
+
+    /// A microfacet normal distributed as the normals visible from `wo`,
+    /// D_wo(m) = G1(wo) max(0, wo·m) D(m) / |wo.z|. For `wo` below the surface the
+    /// distribution is mirrored (m.z < 0): the surface is seen from its back.
+    #[inline]
+    pub fn sample_visible_normal(self, wo: Vec3A, u: [f32; 2]) -> Vec3A {
+        let flip = wo.z < 0.0;
+        let wo = if flip {
+            Vec3A::new(wo.x, wo.y, -wo.z)
+        } else {
+            wo
+        };
+        // In the stretched space where α = 1 the visible normals are the points of a
+        // spherical cap around wo, offset by wo; stretching back gives GGX's.
+        let stretched = Vec3A::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
+        let phi = 2.0 * PI * u[0];
+        let z = (1.0 - u[1]) * (1.0 + stretched.z) - stretched.z;
+        let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let h = Vec3A::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + stretched;
+        let m = Vec3A::new(self.alpha * h.x, self.alpha * h.y, h.z.max(0.0)).normalize();
+        if flip { Vec3A::new(m.x, m.y, -m.z) } else { m }
+    }
+
+    /// The density of [`Self::sample_visible_normal`] over solid angle of `m`.
+    #[inline]
+    pub fn visible_normal_pdf(self, wo: Vec3A, m: Vec3A) -> f32 {
+        if wo.z == 0.0 || wo.z * m.z <= 0.0 {
+            return 0.0;
+        }
+        let mirrored = Vec3A::new(m.x, m.y, m.z.abs());
+        self.g1(wo) * wo.dot(m).max(0.0) * self.d(mirrored) / wo.z.abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+    use crate::sampling::chi_square::{
+        Z_1E6, pooled_statistic, quantile, sphere_cell_probabilities,
+    };
+
+    /// A direction at polar angle θ (from +z) in the xz plane, tilted slightly out of it.
+    fn direction(theta_deg: f32) -> Vec3A {
+        let (s, c) = theta_deg.to_radians().sin_cos();
+        Vec3A::new(s * 0.96, s * 0.28, c).normalize()
+    }
+
+    /// ∫ f(m) dω over the unit sphere by the midpoint rule over (cos θ, φ).
+    fn integrate_sphere(f: impl Fn(Vec3A) -> f64, n_theta: usize, n_phi: usize) -> f64 {
+        let mut sum = 0.0;
+        for i in 0..n_theta {
+            let z = -1.0 + 2.0 * (i as f64 + 0.5) / n_theta as f64;
+            let r = (1.0 - z * z).sqrt();
+            for j in 0..n_phi {
+                let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / n_phi as f64;
+                sum += f(Vec3A::new(
+                    (r * phi.cos()) as f32,
+                    (r * phi.sin()) as f32,
+                    z as f32,
+                ));
+            }
+        }
+        sum * 4.0 * std::f64::consts::PI / (n_theta * n_phi) as f64
+    }
+
+    /// D is normalized over projected area, and D_wo over solid angle (which is what makes
+    /// G1 Smith's for GGX).
+    #[test]
+    fn distribution_and_visible_normals_are_normalized() {
+        for alpha in [0.1f32, 0.3, 0.7, 1.0] {
+            let dist = TrowbridgeReitz::new(alpha);
+            let projected = integrate_sphere(|m| (dist.d(m) * m.z.max(0.0)) as f64, 4000, 64);
+            assert!(
+                (projected - 1.0).abs() < 2e-3,
+                "α {alpha}: ∫ D cos = {projected}"
+            );
+            for theta in [0.0, 45.0, 80.0, 130.0] {
+                let wo = direction(theta);
+                let visible =
+                    integrate_sphere(|m| dist.visible_normal_pdf(wo, m) as f64, 4000, 128);
+                assert!(
+                    (visible - 1.0).abs() < 3e-3,
+                    "α {alpha} θ {theta}: ∫ D_wo = {visible}"
+                );
+            }
+        }
+    }
+
+    /// G2 ≤ G1(wo)·G1(wi) ≤ 1 and Λ vanishes at the normal.
+    #[test]
+    fn masking_is_bounded() {
+        let dist = TrowbridgeReitz::new(0.5);
+        assert_eq!(dist.lambda(Vec3A::Z), 0.0);
+        for (a, b) in [(10.0, 20.0), (60.0, 85.0), (89.0, 5.0)] {
+            let (wo, wi) = (direction(a), direction(b));
+            let g2 = dist.g2(wo, wi);
+            assert!(g2 > 0.0 && g2 >= dist.g1(wo) * dist.g1(wi) - 1e-6 && g2 <= 1.0);
+        }
+    }
+
+    /// Histogram of sampled visible normals over (θ, φ) cells against D_wo integrated
+    /// over each cell; the companion with the density of a 5% rougher distribution fails.
+    /// The 1 − 10⁻⁶ quantile (Bonferroni) keeps the family of this and the BSDF's ~250 χ²
+    /// tests at a false-failure rate below 10⁻³: at 99.99% one case here failed with
+    /// p ≈ 5·10⁻⁵, and passed with ten times the samples.
+    #[test]
+    fn visible_normal_samples_follow_their_density() {
+        const N_THETA: usize = 24;
+        const N_PHI: usize = 32;
+        const SAMPLES: usize = 400_000;
+        // θ (not cos θ) uniform: the cells near the pole stay narrow enough for the
+        // midpoint rule at small α.
+        let cell = |m: Vec3A| {
+            let theta = m.z.clamp(-1.0, 1.0).acos();
+            let i = ((theta / PI * N_THETA as f32) as usize).min(N_THETA - 1);
+            let phi = m.y.atan2(m.x).rem_euclid(2.0 * PI);
+            let j = ((phi / (2.0 * PI) * N_PHI as f32) as usize).min(N_PHI - 1);
+            i * N_PHI + j
+        };
+        let expected = |dist: TrowbridgeReitz, wo: Vec3A| {
+            sphere_cell_probabilities(N_THETA, N_PHI, |theta, phi| {
+                let (s, c) = theta.sin_cos();
+                let m = Vec3A::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
+                dist.visible_normal_pdf(wo, m) as f64
+            })
+        };
+        let mut rng = Rng::new(7, 11);
+        for alpha in [0.2f32, 0.5, 1.0] {
+            for theta in [0.0, 50.0, 60.0, 85.0, 120.0] {
+                let dist = TrowbridgeReitz::new(alpha);
+                let wo = direction(theta);
+                let mut counts = vec![0u64; N_THETA * N_PHI];
+                for _ in 0..SAMPLES {
+                    let m = dist.sample_visible_normal(wo, rng.uniform2());
+                    assert!((m.length() - 1.0).abs() < 1e-4 && m.dot(wo) >= -1e-4);
+                    counts[cell(m)] += 1;
+                }
+                let check = |p: &[f64]| {
+                    let (stat, df) = pooled_statistic(&counts, SAMPLES as u64, p);
+                    (stat, quantile(df, Z_1E6))
+                };
+                let p = expected(dist, wo);
+                let (stat, threshold) = check(&p);
+                let mut worst: Vec<_> = (0..p.len())
+                    .map(|k| {
+                        let e = p[k] * SAMPLES as f64;
+                        ((counts[k] as f64 - e).powi(2) / e.max(1.0), k, counts[k], e)
+                    })
+                    .collect();
+                worst.sort_by(|a, b| b.0.total_cmp(&a.0));
+                worst.truncate(5);
+                assert!(
+                    stat < threshold,
+                    "α {alpha} θ {theta}: χ² {stat} ≥ {threshold} {worst:?}"
+                );
+                let (stat, threshold) = check(&expected(TrowbridgeReitz::new(alpha * 1.05), wo));
+                assert!(
+                    stat > threshold,
+                    "α {alpha} θ {theta}: flaw passes, χ² {stat}"
+                );
+            }
+        }
+    }
+}
