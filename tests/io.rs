@@ -224,14 +224,22 @@ fn sky_spheres_scene_files_are_what_the_generator_writes() {
     );
     let data = io::load_scene(&gltf_path).unwrap();
     assert!(data.camera.is_some());
-    let kinds: Vec<MaterialKind> = data.materials.iter().map(|m| m.kind).collect();
+    // glTF materials are metallic-roughness: (metallic, roughness, transmission, ior).
+    let parameters: Vec<_> = data
+        .materials
+        .iter()
+        .map(|m| {
+            assert_eq!(m.kind, MaterialKind::MetallicRoughness);
+            (m.metallic, m.roughness, m.transmission, m.ior)
+        })
+        .collect();
     assert_eq!(
-        kinds,
+        parameters,
         [
-            MaterialKind::Diffuse,
-            MaterialKind::Diffuse,
-            MaterialKind::Mirror,
-            MaterialKind::Dielectric
+            (0.0, 1.0, 0.0, 1.5),
+            (0.0, 1.0, 0.0, 1.5),
+            (1.0, 0.0, 0.0, 1.5),
+            (0.0, 0.0, 1.0, 1.5)
         ]
     );
     assert_eq!(data.triangle_count(), 2 + 3 * (24 * 48 * 2 - 2 * 48));
@@ -606,12 +614,16 @@ fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
 fn check_gltf_scene(data: &SceneData) {
     assert_eq!(data.triangle_count(), 4);
     assert_eq!(data.materials.len(), 2);
+    // glTF's defaults: metallic 1, roughness 1 (the "glass" gives no pbrMetallicRoughness,
+    // so it is a rough metal whose transmission has no dielectric part to apply to).
     let (lamp_id, lamp) = material_named(data, "lamp");
-    assert_eq!(lamp.kind, MaterialKind::Diffuse);
+    assert_eq!(lamp.kind, MaterialKind::MetallicRoughness);
+    assert_eq!((lamp.metallic, lamp.roughness), (1.0, 1.0));
     assert_eq!(lamp.color, [0.2, 0.3, 0.4]);
     assert_eq!(lamp.emission, [4.0, 2.0, 1.0]);
     let (glass_id, glass) = material_named(data, "glass");
-    assert_eq!((glass.kind, glass.ior), (MaterialKind::Dielectric, 1.33));
+    assert_eq!(glass.kind, MaterialKind::MetallicRoughness);
+    assert_eq!((glass.ior, glass.transmission), (1.33, 1.0));
     assert_eq!(glass.emission, [0.0; 3]);
     assert_eq!(data.material_ids, [lamp_id, lamp_id, glass_id, glass_id]);
 

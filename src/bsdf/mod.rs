@@ -21,6 +21,7 @@ use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf
 use crate::scene::{Material, MaterialKind};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
+use metallic_roughness::MetallicRoughness;
 use std::f32::consts::FRAC_1_PI;
 
 /// The classes of lobes a BSDF has: what integrators decide by, so a new material only has
@@ -79,6 +80,8 @@ pub(crate) enum BsdfModel {
     Mirror(Spectrum),
     /// A smooth dielectric interface: index of refraction inside (the back side), tint.
     Dielectric { ior: f32, tint: Spectrum },
+    /// glTF's metallic-roughness model.
+    MetallicRoughness(MetallicRoughness),
 }
 
 impl BsdfModel {
@@ -88,9 +91,31 @@ impl BsdfModel {
         BsdfModel::with_color(material, Spectrum::from(material.color))
     }
 
-    /// The model of `material` with its colour replaced by `color` (textured).
+    /// The model of `material` with its colour replaced by `color` and, for the
+    /// metallic-roughness model, its metalness and roughness by `metallic` and `roughness`
+    /// (textured).
     #[inline]
-    pub fn with_color(material: &Material, color: Spectrum) -> BsdfModel {
+    pub fn textured(
+        material: &Material,
+        color: Spectrum,
+        metallic: f32,
+        roughness: f32,
+    ) -> BsdfModel {
+        match material.kind {
+            MaterialKind::MetallicRoughness => BsdfModel::MetallicRoughness(MetallicRoughness {
+                base_color: color,
+                metallic,
+                roughness,
+                ior: material.ior,
+                transmission: material.transmission,
+            }),
+            _ => BsdfModel::with_color(material, color),
+        }
+    }
+
+    /// The model of `material` with its colour replaced by `color`.
+    #[inline]
+    fn with_color(material: &Material, color: Spectrum) -> BsdfModel {
         match material.kind {
             MaterialKind::Diffuse => BsdfModel::Diffuse(color),
             MaterialKind::Mirror => BsdfModel::Mirror(color),
@@ -98,9 +123,9 @@ impl BsdfModel {
                 ior: material.ior,
                 tint: color,
             },
-            // Until the metallic-roughness BSDF lands, scenes with it are refused at
-            // construction (see `Scene::new`); this arm is never reached.
-            MaterialKind::MetallicRoughness => BsdfModel::Diffuse(color),
+            MaterialKind::MetallicRoughness => {
+                BsdfModel::textured(material, color, material.metallic, material.roughness)
+            }
         }
     }
 
@@ -110,6 +135,7 @@ impl BsdfModel {
         match self {
             BsdfModel::Diffuse(_) => BsdfLobes::DIFFUSE,
             BsdfModel::Mirror(_) | BsdfModel::Dielectric { .. } => BsdfLobes::SPECULAR,
+            BsdfModel::MetallicRoughness(m) => m.lobes(),
         }
     }
 }
@@ -225,7 +251,7 @@ impl Bsdf {
     /// wo is.
     #[inline]
     pub fn eval(&self, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Spectrum {
-        let f = eval(&self.model, self.normal, wo, wi);
+        let f = eval(&self.model, self.normal, wo, wi, mode);
         if !self.shading_normal_differs || f.is_black() {
             return f;
         }
@@ -306,13 +332,16 @@ fn sample(
         BsdfModel::Dielectric { ior, tint } => {
             dielectric::sample(ior, tint, normal, wo, u_lobe, mode)
         }
+        BsdfModel::MetallicRoughness(m) => m.sample(normal, wo, u, u_lobe, mode),
     }
 }
 
-/// BSDF value f(wo, wi) (without the cosine) for non-specular models; zero otherwise.
+/// BSDF value f(wo, wi) (without the cosine) of the non-specular lobes, for the quantity
+/// `mode` carries (refraction is not symmetric); zero for specular models.
 #[inline]
-fn eval(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectrum {
+fn eval(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Spectrum {
     match *model {
+        BsdfModel::MetallicRoughness(m) => m.eval(normal, wo, wi, mode),
         BsdfModel::Diffuse(albedo) => {
             if wo.dot(normal) * wi.dot(normal) > 0.0 {
                 albedo * FRAC_1_PI
@@ -328,6 +357,7 @@ fn eval(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Spectrum {
 #[inline]
 fn pdf(model: &BsdfModel, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
     match model {
+        BsdfModel::MetallicRoughness(m) => m.pdf(normal, wo, wi),
         BsdfModel::Diffuse(_) => {
             let cos_i = wi.dot(normal);
             if wo.dot(normal) * cos_i > 0.0 {
@@ -369,6 +399,7 @@ fn scatter(
             specular: true,
         }),
         BsdfModel::Dielectric { ior, tint } => dielectric::scatter(ior, tint, normal, wo, wi, mode),
+        BsdfModel::MetallicRoughness(m) => m.scatter(normal, wo, wi, mode),
     }
 }
 
@@ -407,6 +438,7 @@ fn specular_direction(
         (BsdfModel::Dielectric { ior, .. }, SpecularLobe::Refraction) => {
             dielectric::refracted(ior, normal, wo)
         }
+        (BsdfModel::MetallicRoughness(m), lobe) => m.specular_direction(normal, wo, lobe),
         _ => None,
     }
 }
@@ -452,7 +484,7 @@ mod tests {
             )
             .unwrap();
             let cos = s.wi.dot(n).abs();
-            let f = eval(&m, n, wo, s.wi);
+            let f = eval(&m, n, wo, s.wi, TransportMode::Radiance);
             let p = pdf(&m, n, wo, s.wi);
             assert!((p - s.pdf).abs() < 1e-3 * p.max(1.0));
             let expected = f * cos / p;

@@ -70,9 +70,12 @@ struct Vertex {
     triangle: u32,
     /// Barycentrics of the point on `triangle`, where its BSDF is evaluated.
     barycentrics: [f32; 2],
-    /// Scattering here is a Dirac delta (mirror, glass): no connection can end here. A
-    /// surface's BSDF with a diffuse or glossy lobe is connectible.
+    /// The subpath scattered here through a Dirac delta (mirror, glass, a smooth coat): no
+    /// other strategy generates that scattering, so MIS leaves it out.
     specular: bool,
+    /// A connection may end here: the BSDF has a diffuse or glossy lobe (a smooth coat over
+    /// a diffuse base has both kinds, and is connectible whichever its subpath sampled).
+    connectible: bool,
 }
 
 impl Vertex {
@@ -87,12 +90,13 @@ impl Vertex {
         triangle: 0,
         barycentrics: [0.0; 2],
         specular: false,
+        connectible: true,
     };
 
     /// Whether a connection may end at this vertex.
     #[inline]
     fn connectible(&self) -> bool {
-        !self.specular
+        self.connectible
     }
 
     /// Whether the vertex is a direction at infinity.
@@ -290,6 +294,7 @@ impl Bdpt<'_> {
                 barycentrics: si.uv,
                 // Known from the BSDF's lobes, so a subpath cut short here is marked too.
                 specular: bsdf.lobes().is_specular(),
+                connectible: bsdf.lobes().has_non_specular(),
             };
             vertex.pdf_forward = to_area(pdf_solid_angle, &path[count - 1], &vertex);
             path[count] = vertex;

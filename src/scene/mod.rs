@@ -290,6 +290,29 @@ impl Scene {
         self.surface_point(triangle, barycentrics).bsdf(normal)
     }
 
+    /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
+    /// somewhere (metallic-roughness at roughness 0 with a dielectric part: a smooth coat
+    /// over a diffuse base), which path-space MLT and ERPT do not explore correctly.
+    pub(crate) fn mixed_lobe_material(&self) -> Option<usize> {
+        self.materials.iter().position(|m| {
+            if m.kind != MaterialKind::MetallicRoughness {
+                return false;
+            }
+            let texture_min = |channel| {
+                m.metallic_roughness_texture.map_or(1.0, |t| {
+                    self.textures[t.texture as usize].channel_min(channel)
+                })
+            };
+            let (roughness, metallic) = (m.roughness * texture_min(1), m.metallic * texture_min(2));
+            let smoothest =
+                crate::bsdf::BsdfModel::textured(m, Spectrum::from(m.color), metallic, 0.0);
+            roughness == 0.0 && {
+                let lobes = smoothest.lobes();
+                lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
+            }
+        })
+    }
+
     /// Whether a candidate hit at barycentrics (u, v) of internal triangle `triangle` is a
     /// surface: false where an alpha cut-out removes it.
     #[inline]
@@ -488,14 +511,6 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
             return Err(Error::invalid(format!(
                 "desc.materials[{i}] has textures but desc.texcoords is empty; textured materials need texture coordinates"
             )));
-        }
-        if material.kind == MaterialKind::MetallicRoughness {
-            return Err(Error::new(
-                crate::error::MltStatus::MLT_STATUS_UNSUPPORTED,
-                format!(
-                    "desc.materials[{i}] is a metallic-roughness material, which this build cannot render yet"
-                ),
-            ));
         }
     }
     Ok(())

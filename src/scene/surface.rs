@@ -302,7 +302,15 @@ impl SurfacePoint<'_> {
             );
         }
         let base = self.base_color();
-        let model = BsdfModel::with_color(self.material, Spectrum::new(base.x, base.y, base.z));
+        let color = Spectrum::new(base.x, base.y, base.z);
+        let m = self.material;
+        let (mut metallic, mut roughness) = (m.metallic, m.roughness);
+        if let Some(texture) = &m.metallic_roughness_texture {
+            let texel = lookup(self.textures, texture, self.texcoord());
+            roughness *= texel.y;
+            metallic *= texel.z;
+        }
+        let model = BsdfModel::textured(m, color, metallic, roughness);
         Bsdf::new(
             model,
             self.shading_normal(geometric_normal),

@@ -9,18 +9,24 @@
 
 use serde_json::json;
 
-/// A UV sphere: (positions, indices) with `rings` × `segments` quads, wound outward.
-fn sphere(center: [f32; 3], radius: f32, rings: u32, segments: u32) -> (Vec<[f32; 3]>, Vec<u32>) {
+/// A mesh: positions, normals (smooth shading), indices.
+type MeshArrays = (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<u32>);
+
+/// A UV sphere with `rings` × `segments` quads, wound outward, with its exact normals.
+fn sphere(center: [f32; 3], radius: f32, rings: u32, segments: u32) -> MeshArrays {
     let mut positions = Vec::new();
+    let mut normals = Vec::new();
     for i in 0..=rings {
         let theta = std::f32::consts::PI * i as f32 / rings as f32;
         for j in 0..=segments {
             let phi = 2.0 * std::f32::consts::PI * j as f32 / segments as f32;
-            positions.push([
-                center[0] + radius * theta.sin() * phi.cos(),
-                center[1] + radius * theta.cos(),
-                center[2] - radius * theta.sin() * phi.sin(),
-            ]);
+            let normal = [
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            ];
+            positions.push([0, 1, 2].map(|k| center[k] + radius * normal[k]));
+            normals.push(normal);
         }
     }
     let at = |i: u32, j: u32| i * (segments + 1) + j;
@@ -37,14 +43,15 @@ fn sphere(center: [f32; 3], radius: f32, rings: u32, segments: u32) -> (Vec<[f32
             }
         }
     }
-    (positions, indices)
+    (positions, normals, indices)
 }
 
-/// The meshes: ground, then the three spheres, each (positions, indices).
-fn meshes() -> Vec<(Vec<[f32; 3]>, Vec<u32>)> {
+/// The meshes: ground, then the three spheres.
+fn meshes() -> Vec<MeshArrays> {
     let h = 10.0;
     let ground = (
         vec![[-h, 0.0, -h], [-h, 0.0, h], [h, 0.0, h], [h, 0.0, -h]],
+        vec![[0.0, 1.0, 0.0]; 4],
         vec![0, 1, 2, 0, 2, 3],
     );
     vec![
@@ -55,7 +62,7 @@ fn meshes() -> Vec<(Vec<[f32; 3]>, Vec<u32>)> {
     ]
 }
 
-/// The binary buffer (positions then indices of each mesh) and the glTF JSON text.
+/// The binary buffer (positions, normals and indices of each mesh) and the glTF JSON text.
 pub fn files() -> (Vec<u8>, String) {
     let mut bin = Vec::new();
     let mut buffer_views = Vec::new();
@@ -80,7 +87,7 @@ pub fn files() -> (Vec<u8>, String) {
             "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1.0}, "KHR_materials_ior": {"ior": 1.5}}}),
         ),
     ];
-    for (index, (positions, indices)) in meshes().iter().enumerate() {
+    for (index, (positions, normals, indices)) in meshes().iter().enumerate() {
         let mut min = [f32::INFINITY; 3];
         let mut max = [f32::NEG_INFINITY; 3];
         let offset = bin.len();
@@ -94,13 +101,19 @@ pub fn files() -> (Vec<u8>, String) {
         buffer_views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": positions.len() * 12, "target": 34962}));
         accessors.push(json!({"bufferView": buffer_views.len() - 1, "componentType": 5126, "count": positions.len(), "type": "VEC3", "min": min, "max": max}));
         let offset = bin.len();
+        for n in normals.iter().flatten() {
+            bin.extend_from_slice(&n.to_le_bytes());
+        }
+        buffer_views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": normals.len() * 12, "target": 34962}));
+        accessors.push(json!({"bufferView": buffer_views.len() - 1, "componentType": 5126, "count": normals.len(), "type": "VEC3"}));
+        let offset = bin.len();
         for i in indices {
             bin.extend_from_slice(&i.to_le_bytes());
         }
         buffer_views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": indices.len() * 4, "target": 34963}));
         accessors.push(json!({"bufferView": buffer_views.len() - 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"}));
         meshes_json.push(json!({"name": materials[index].0, "primitives": [{
-            "attributes": {"POSITION": accessors.len() - 2}, "indices": accessors.len() - 1, "material": index}]}));
+            "attributes": {"POSITION": accessors.len() - 3, "NORMAL": accessors.len() - 2}, "indices": accessors.len() - 1, "material": index}]}));
     }
     let gltf = json!({
         "asset": {"version": "2.0", "generator": "mlt tests/common/sky_spheres.rs"},

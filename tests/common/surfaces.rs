@@ -1,7 +1,8 @@
-//! The surfaces scene, built in code: the canonical Cornell box with a smooth-shaded sphere
-//! (per-vertex normals on a coarse icosphere, so shading and geometric normals differ by
-//! up to ~18°) standing on the short block, a floor whose colour is a checker texture, and
-//! a lamp whose emission a 2 × 2 texture modulates. It is where the algorithms must agree
+//! The surfaces scene, built in code: the canonical Cornell box with glTF
+//! metallic-roughness materials — a rough gold tall block, a glossy plastic short block,
+//! and on it a smooth-shaded rough glass sphere (per-vertex normals on a coarse icosphere,
+//! so shading and geometric normals differ by up to ~18°) — a floor whose colour is a
+//! checker texture, and a lamp whose emission a 2 × 2 texture modulates. It is where the algorithms must agree
 //! once BSDFs are evaluated in a shading frame that is not the triangle's (light tracing
 //! and path tracing see the non-symmetric BSDF of shading normals from opposite ends) and
 //! once colour and emission vary across a triangle.
@@ -84,6 +85,17 @@ pub fn surfaces_mesh() -> SurfacesMesh {
         }),
         ..Material::diffuse([0.9; 3])
     });
+    // Rough gold and glossy plastic blocks.
+    let metal = scene.mesh.materials.len() as u32;
+    scene
+        .mesh
+        .materials
+        .push(Material::metallic_roughness([1.0, 0.78, 0.34], 1.0, 0.3));
+    let plastic = metal + 1;
+    scene
+        .mesh
+        .materials
+        .push(Material::metallic_roughness([0.2, 0.35, 0.7], 0.0, 0.4));
     // The lamp's emission, modulated across it by the 2 × 2 pattern.
     let lamp = box_mesh
         .materials
@@ -119,6 +131,11 @@ pub fn surfaces_mesh() -> SurfacesMesh {
         let planar = |p: [f32; 3], (x0, x1, z0, z1): (f32, f32, f32, f32)| {
             [(p[0] - x0) / (x1 - x0), (p[2] - z0) / (z1 - z0)]
         };
+        if (10..20).contains(&triangle) {
+            material = plastic;
+        } else if (20..30).contains(&triangle) {
+            material = metal;
+        }
         let texcoords: Vec<f32> = if triangle < 2 {
             material = floor_material;
             [a, b, c]
@@ -136,13 +153,13 @@ pub fn surfaces_mesh() -> SurfacesMesh {
         };
         scene.append(&positions, &normals, &texcoords, &[0, 1, 2], material);
     }
-    // A smooth, off-white sphere on the short block (top at y = 165, centre near
-    // x = 185, z = 169).
+    // A smooth-shaded rough glass sphere on the short block (top at y = 165, centre
+    // near x = 185, z = 169).
     let sphere_material = scene.mesh.materials.len() as u32;
-    scene
-        .mesh
-        .materials
-        .push(Material::diffuse([0.8, 0.75, 0.7]));
+    scene.mesh.materials.push(Material {
+        transmission: 1.0,
+        ..Material::metallic_roughness([1.0; 3], 0.0, 0.25)
+    });
     let (radius, center) = (70.0f32, [185.0f32, 165.0 + 70.0, 169.0]);
     let (unit, inward) = super::inward_icosphere(1, 1.0);
     let outward: Vec<u32> = inward
