@@ -236,12 +236,34 @@ fn sky_spheres_scene_files_are_what_the_generator_writes() {
     assert_eq!(
         parameters,
         [
-            (0.0, 1.0, 0.0, 1.5),
-            (0.0, 1.0, 0.0, 1.5),
-            (1.0, 0.0, 0.0, 1.5),
+            (0.0, 0.8, 0.0, 1.5),
+            (0.0, 0.6, 0.0, 1.5),
+            (1.0, 0.15, 0.0, 1.5),
             (0.0, 0.0, 1.0, 1.5)
         ]
     );
+    // The ground's checker (sRGB, nearest, repeated at half scale) and the clay's bumps
+    // (linear, clamped in v), each vertex with a normal and texture coordinates.
+    let ground = &data.materials[0];
+    let checker = ground.base_color_texture.expect("the checker");
+    assert_eq!(checker.scale, [0.5, 0.5]);
+    let texture = &data.textures[checker.texture as usize];
+    assert_eq!((texture.width, texture.height, texture.channels), (2, 2, 3));
+    assert_eq!(texture.encoding, mlt::TextureEncoding::Srgb);
+    assert_eq!(texture.filter, mlt::TextureFilter::Nearest);
+    assert!(matches!(&texture.data, mlt::TexelData::U8(t) if t[..3] == [200, 190, 170]));
+    let bumps = data.materials[1].normal_texture.expect("the normal map");
+    let texture = &data.textures[bumps.texture as usize];
+    assert_eq!((texture.width, texture.height), (128, 64));
+    assert_eq!(texture.encoding, mlt::TextureEncoding::Linear);
+    assert_eq!(
+        (texture.wrap_u, texture.wrap_v),
+        (mlt::WrapMode::Repeat, mlt::WrapMode::ClampToEdge)
+    );
+    let vertices = data.positions.len() / 3;
+    assert_eq!(data.normals.len(), vertices * 3);
+    assert_eq!(data.texcoords.len(), vertices * 2);
+    assert!(data.tangents.is_empty() && data.colors.is_empty());
     assert_eq!(data.triangle_count(), 2 + 3 * (24 * 48 * 2 - 2 * 48));
 }
 
