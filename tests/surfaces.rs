@@ -9,7 +9,11 @@ mod common;
 
 use common::surfaces::surfaces_mesh;
 use common::{Estimate, assert_estimates_agree, cached_estimate, canonical_camera, render_image};
-use mlt::{Algorithm, Backend, RenderSettings};
+use mlt::{
+    Algorithm, AlphaMode, Backend, Material, RenderSettings, Scene, SceneDesc, TexelData,
+    TextureDesc, TextureEncoding, TextureFilter, TextureRef, WrapMode,
+};
+use std::borrow::Cow;
 
 const SIZE: u32 = 32;
 const MAX_DEPTH: u32 = 4;
@@ -115,4 +119,183 @@ fn write_surfaces_image() {
     let image = render_image(&scene, &canonical_camera("cornell-box"), &settings);
     let path = std::path::Path::new(&dir).join("surfaces.png");
     mlt::io::write_png(&path, 256, 256, &image).unwrap();
+}
+
+/// A 2 × 2 m quad in the plane z = 0 facing +z, with texture coordinates running over
+/// it once ((0, 0) at its top-left corner seen from +z), and a lamp behind it.
+fn quad_before_a_lamp() -> (Vec<f32>, Vec<u32>, Vec<f32>) {
+    #[rustfmt::skip]
+    let positions = vec![
+        -1.0, 1.0, 0.0,  1.0, 1.0, 0.0,  1.0, -1.0, 0.0,  -1.0, -1.0, 0.0,
+        -3.0, 3.0, -1.0,  3.0, 3.0, -1.0,  3.0, -3.0, -1.0,  -3.0, -3.0, -1.0,
+    ];
+    let indices = vec![0, 3, 2, 0, 2, 1, 4, 7, 6, 4, 6, 5];
+    #[rustfmt::skip]
+    let texcoords = vec![
+        0.0, 0.0,  1.0, 0.0,  1.0, 1.0,  0.0, 1.0,
+        0.0, 0.0,  0.0, 0.0,  0.0, 0.0,  0.0, 0.0,
+    ];
+    (positions, indices, texcoords)
+}
+
+/// A pinhole at z = 1 whose 90° view just covers the quad.
+fn quad_camera() -> mlt::Camera {
+    mlt::Camera {
+        eye: [0.0, 0.0, 1.0],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 90.0,
+        ..Default::default()
+    }
+}
+
+/// An alpha cut-out lets camera rays through where its texture's alpha is below the
+/// cutoff, in every backend: a black quad whose 2 × 2 alpha texture opens its top-left
+/// and bottom-right quarters shows the lamp behind exactly there. Without the cut-out (or
+/// with the texture's orientation wrong) whole quarters would be black or lit.
+#[test]
+fn alpha_cut_outs_let_rays_through_in_every_backend() {
+    let (positions, indices, texcoords) = quad_before_a_lamp();
+    // Grey + alpha, 8-bit: alpha 0 (a hole) on the diagonal.
+    let texture = TextureDesc {
+        width: 2,
+        height: 2,
+        channels: 2,
+        data: TexelData::U8(Cow::Owned(vec![255, 0, 255, 255, 255, 255, 255, 0])),
+        encoding: TextureEncoding::Linear,
+        wrap_u: WrapMode::ClampToEdge,
+        wrap_v: WrapMode::ClampToEdge,
+        filter: TextureFilter::Nearest,
+    };
+    let materials = [
+        Material {
+            alpha_mode: AlphaMode::Mask,
+            base_color_texture: Some(TextureRef::new(0)),
+            ..Material::diffuse([0.0; 3])
+        },
+        Material::diffuse([0.0; 3]).with_emission([1.0; 3]),
+    ];
+    for backend in [Backend::Bvh, Backend::Embree] {
+        if !backend.is_available() {
+            continue;
+        }
+        let scene = Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &indices,
+            material_ids: &[0, 0, 1, 1],
+            materials: &materials,
+            texcoords: &texcoords,
+            textures: std::slice::from_ref(&texture),
+            backend,
+            ..Default::default()
+        })
+        .unwrap();
+        let settings = RenderSettings {
+            width: 8,
+            height: 8,
+            algorithm: Algorithm::Path,
+            samples_per_pixel: 4,
+            max_depth: 2,
+            ..Default::default()
+        };
+        let image = render_image(&scene, &quad_camera(), &settings);
+        // Pixels away from the quarters' edges (columns and rows 3 and 4).
+        for y in [0usize, 1, 2, 5, 6, 7] {
+            for x in [0usize, 1, 2, 5, 6, 7] {
+                let hole = (x < 4) == (y < 4);
+                let value = image[(y * 8 + x) * 3];
+                let expected = if hole { 1.0 } else { 0.0 };
+                assert!(
+                    (value - expected).abs() < 1e-4,
+                    "{backend:?}: pixel ({x}, {y}) is {value}, expected {expected}"
+                );
+            }
+        }
+    }
+}
+
+/// A normal map bends the shading normal exactly as normals baked into the vertices
+/// would: the quad with a one-texel normal map (and given tangents) renders as the quad
+/// whose vertex normals are that texel's normal in world space, under a sun at a grazing
+/// angle that makes shading depend strongly on the normal; and differs from the flat quad.
+#[test]
+fn a_normal_map_shades_like_its_normal_baked_into_the_vertices() {
+    let (positions, indices, texcoords) = quad_before_a_lamp();
+    let positions = positions[..12].to_vec();
+    let indices = indices[..6].to_vec();
+    let texcoords = texcoords[..8].to_vec();
+    let texel = [200u8, 90, 220];
+    // Tangent space: x along +u (world +x), y up the image (world +y: v grows downwards,
+    // towards −y), z the normal (+z).
+    let [x, y, z] = texel.map(|c| c as f32 / 255.0 * 2.0 - 1.0);
+    let length = (x * x + y * y + z * z).sqrt();
+    let baked = [x / length, y / length, z / length];
+    let tangents: Vec<f32> = [1.0, 0.0, 0.0, 1.0].repeat(4);
+    let normal_map = TextureDesc {
+        width: 1,
+        height: 1,
+        channels: 3,
+        data: TexelData::U8(Cow::Owned(texel.to_vec())),
+        encoding: TextureEncoding::Linear,
+        wrap_u: WrapMode::Repeat,
+        wrap_v: WrapMode::Repeat,
+        filter: TextureFilter::Nearest,
+    };
+    let mapped = [Material {
+        normal_texture: Some(TextureRef::new(0)),
+        ..Material::diffuse([0.8; 3])
+    }];
+    let plain = [Material::diffuse([0.8; 3])];
+    let lights = mlt::LightsDesc {
+        sun: Some(mlt::SunDesc {
+            direction: [-1.0, 0.3, 0.4],
+            angular_radius_degrees: 0.0,
+            irradiance: [1.0; 3],
+        }),
+        ..Default::default()
+    };
+    let settings = RenderSettings {
+        width: 8,
+        height: 8,
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 4,
+        max_depth: 1,
+        ..Default::default()
+    };
+    let render =
+        |desc: SceneDesc| render_image(&Scene::new(&desc).unwrap(), &quad_camera(), &settings);
+    let base = SceneDesc {
+        positions: &positions,
+        indices: &indices,
+        lights,
+        ..Default::default()
+    };
+    let normal_mapped = render(SceneDesc {
+        materials: &mapped,
+        texcoords: &texcoords,
+        tangents: &tangents,
+        textures: std::slice::from_ref(&normal_map),
+        ..base
+    });
+    let baked_normals: Vec<f32> = baked.repeat(4);
+    let baked = render(SceneDesc {
+        materials: &plain,
+        normals: &baked_normals,
+        ..base
+    });
+    let flat = render(SceneDesc {
+        materials: &plain,
+        ..base
+    });
+    for (i, (m, b)) in normal_mapped.iter().zip(&baked).enumerate() {
+        assert!(
+            (m - b).abs() <= 1e-4 * b.abs().max(1.0),
+            "float {i}: mapped {m}, baked {b}"
+        );
+    }
+    let (mapped_mean, flat_mean) = (common::mean(&normal_mapped)[0], common::mean(&flat)[0]);
+    assert!(
+        (mapped_mean - flat_mean).abs() > 0.2 * flat_mean,
+        "the map changes nothing: {mapped_mean} against {flat_mean} flat"
+    );
 }
