@@ -756,3 +756,44 @@ fn bad_light_flags_are_one_line_errors() {
     assert!(!never.exists());
     std::fs::remove_dir_all(obj.parent().unwrap()).unwrap();
 }
+
+/// A scene without a camera (here an OBJ without its sidecar) renders through a camera
+/// framing its bounds, and the camera is printed as sidecar JSON that loads back.
+#[test]
+fn a_scene_without_a_camera_is_framed_and_the_camera_printed() {
+    let dir = temp_path("framed");
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("quad.obj");
+    std::fs::write(
+        &obj,
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let out = dir.join("quad.pfm");
+    let output = mlt_render(&[
+        &obj,
+        &"--algorithm",
+        &"path",
+        &"--spp",
+        &"1",
+        &"--width",
+        &"8",
+        &"--height",
+        &"8",
+        &"--background",
+        &"1,1,1",
+        &"--out",
+        &out,
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("has no camera"), "{stderr}");
+    let json = &stderr[stderr.find('{').expect("the camera's JSON")..];
+    let sidecar = dir.join("framed.camera.json");
+    std::fs::write(&sidecar, &json[..=json.rfind('}').unwrap()]).unwrap();
+    let camera = mlt::io::load_camera_json(&sidecar).unwrap();
+    // Looking at the quad's centre from the front (+z), far enough to see all of it.
+    assert_eq!(camera.camera.target, [0.0; 3]);
+    assert!(camera.camera.eye[2] > 2.0, "{:?}", camera.camera.eye);
+    assert!(out.is_file());
+}

@@ -929,3 +929,80 @@ fn environment_map_errors_name_the_file() {
     );
     std::fs::remove_file(&negative).unwrap();
 }
+
+/// OBJ's per-corner normals and texture coordinates (v flipped to glTF's convention, each
+/// triangle with corners of its own), `map_Kd` with `-s`, a Phong `Ns` with a non-black
+/// `Ks` as a GGX roughness, and the PBR keys `Pr` / `Pm`.
+#[test]
+fn obj_maps_texture_coordinates_normals_textures_and_pbr_keys() {
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        &[255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255],
+        2,
+        2,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    let obj = b"mtllib t.mtl
+v 0 0 0
+v 1 0 0
+v 0 1 0
+vt 0 0
+vt 1 0
+vt 0 1
+vn 0 0 2
+usemtl textured
+f 1/1/1 2/2/1 3/3/1
+usemtl glossy
+f 1/1/1 2/2/1 3/3/1
+usemtl pbr
+f 1 2 3
+";
+    let mtl = b"newmtl textured
+Kd 1 1 1
+map_Kd -s 2 2 checker.png
+newmtl glossy
+Kd 0.5 0.5 0.5
+Ks 0.5 0.5 0.5
+Ns 98
+illum 2
+newmtl pbr
+Kd 0.9 0.1 0.1
+Pr 0.3
+Pm 1
+";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl), ("checker.png", &png)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    assert_eq!(data.triangle_count(), 3);
+    // Corners of their own; the face without vn gets its face normal.
+    assert_eq!(data.positions.len(), 9 * 3);
+    assert_eq!(&data.texcoords[..6], &[0.0, 1.0, 1.0, 1.0, 0.0, 0.0]);
+    assert_eq!(data.texcoords.len(), 9 * 2);
+    assert_eq!(&data.normals[..3], &[0.0, 0.0, 1.0]);
+    assert_eq!(&data.normals[18..21], &[0.0, 0.0, 1.0]);
+
+    let (_, textured) = material_named(&data, "textured");
+    assert_eq!(textured.kind, MaterialKind::Diffuse);
+    let checker = textured.base_color_texture.expect("map_Kd");
+    // OBJ's v ↦ 2v becomes v' ↦ 2v' − 1 in glTF's flipped coordinates.
+    assert_eq!((checker.scale, checker.offset), ([2.0, 2.0], [0.0, -1.0]));
+    let texture = &data.textures[checker.texture as usize];
+    assert_eq!((texture.width, texture.height, texture.channels), (2, 2, 3));
+    assert_eq!(texture.encoding, mlt::TextureEncoding::Srgb);
+
+    let (_, glossy) = material_named(&data, "glossy");
+    assert_eq!(glossy.kind, MaterialKind::MetallicRoughness);
+    // α = sqrt(2 / (98 + 2)) = 0.1414, roughness = sqrt(α) = 0.3761.
+    assert!(
+        (glossy.roughness - 0.376_06).abs() < 1e-4,
+        "{}",
+        glossy.roughness
+    );
+    assert_eq!((glossy.metallic, glossy.color), (0.0, [0.5; 3]));
+
+    let (_, pbr) = material_named(&data, "pbr");
+    assert_eq!(pbr.kind, MaterialKind::MetallicRoughness);
+    assert_eq!((pbr.roughness, pbr.metallic), (0.3, 1.0));
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
