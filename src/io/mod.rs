@@ -17,19 +17,34 @@
 //! - `illum 7`, or a non-zero `Tf` together with `Ni`: a smooth dielectric with index of
 //!   refraction `Ni` (1.5 if absent), tinted by `Tf` (white if absent);
 //! - `illum 3` or `illum 5`: a perfect mirror reflecting `Ks` (white if absent);
+//! - the PBR extension's `Pr` (roughness, 1 if absent), `Pm` (metalness, 0 if absent),
+//!   `map_Pr`, `map_Pm`: glTF's metallic-roughness model with base colour `Kd` and index of
+//!   refraction `Ni` (1.5); the two maps are combined into one texture (same size needed);
+//! - `Ns` with a non-black `Ks` (`illum 2` or none): metallic-roughness with metalness 0,
+//!   base colour `Kd` and the GGX roughness matching the Phong exponent,
+//!   roughness = (2 / (Ns + 2))^¼ (Walter et al. 2007's α = sqrt(2 / (Ns + 2)), and glTF's
+//!   α = roughness²); `Ks`'s colour itself is not used (the dielectric's Fresnel is);
 //! - anything else: Lambertian with albedo `Kd` (0.8 grey if absent);
 //! - `Ke` on any material makes its triangles area lights.
+//!
+//! Textures: `map_Kd` (base colour, sRGB), `map_Ke` (emission, sRGB; emission 1 if `Ke` is
+//! absent), `norm`, `map_Bump` or `bump` (a tangent-space normal map with `-bm` as its scale;
+//! a grey image is a height map and is skipped). The options `-s` and `-o` (u and v) become
+//! a texture transform and `-clamp on` clamps; other options are skipped. Images are PNG,
+//! JPEG, TGA or Radiance HDR, relative to the material library.
 //!
 //! Colors are passed through unchanged: the kernel validates them and names the material
 //! index in its error. Faces without a material (no `usemtl`) get an extra white diffuse
 //! material (albedo 0.8) appended after the file's materials. A `usemtl` naming a
 //! material no library defines, or a material library that cannot be read, is an error.
-//! Normals and texture coordinates are ignored.
+//! Normals (`vn`) and texture coordinates (`vt`, v flipped to glTF's downward convention)
+//! are kept when the file has them: then every triangle gets corners of its own (a face
+//! without `vn` gets its face normal).
 //!
 //! ## glTF mapping
 //! See [`load_scene`]: meshes of the default scene (or the first scene) with node transforms
-//! applied, the first perspective camera, and materials reduced to the kernel's three kinds.
-//! Textures are ignored.
+//! applied, the first perspective camera, and glTF's metallic-roughness materials with
+//! their textures.
 
 mod camera_file;
 mod environment_file;
@@ -55,11 +70,19 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   first perspective camera met walking the nodes depth-first: eye at the node's world
 ///   position, looking down its -Z with +Y up, `yfov` converted to degrees; the image is
 ///   512 pixels high and `round(height × aspectRatio)` wide, or square
-///   when no aspect ratio is given. Materials: emission = `emissiveFactor` ×
-///   `KHR_materials_emissive_strength`; `KHR_materials_transmission` factor > 0 → dielectric
-///   with `KHR_materials_ior` (1.5 if absent); metallic 1 and roughness 0 → mirror with the
-///   base color; else diffuse with the base color. Primitives without a material get the glTF
-///   default material (white diffuse). Textures, normals and other attributes are ignored.
+///   when no aspect ratio is given. Materials are glTF's metallic-roughness model
+///   ([`crate::MaterialKind::MetallicRoughness`]): base colour and alpha, metallic and
+///   roughness factors and textures, `normalTexture` with its scale, emission =
+///   `emissiveFactor` × `KHR_materials_emissive_strength` × `emissiveTexture`,
+///   `KHR_materials_transmission` (factor; its texture is ignored), `KHR_materials_ior`,
+///   `KHR_texture_transform`, alpha modes (`BLEND` is rendered as `MASK` at the cutoff).
+///   Images (PNG, JPEG; embedded, data URIs or files) become textures: base colour and
+///   emission decoded as sRGB, the others linear, with the sampler's wrap modes and nearest
+///   or bilinear filtering. Attributes: `NORMAL`, `TEXCOORD_0` (other sets are ignored),
+///   `COLOR_0` and `TANGENT` (used when every primitive has it; else MikkTSpace computes
+///   them); a primitive without normals in a scene that has some is flat-shaded.
+///   Primitives without a material get the glTF default material (white, metallic 1,
+///   roughness 1). Occlusion textures are ignored.
 ///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into
 ///   [`SceneData::punctual_lights`]: at their node's world origin, pointing along its world
 ///   −Z, with `color × intensity / 683` (candela and lux over 683 lm/W, Blender's factor:
