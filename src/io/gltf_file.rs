@@ -315,14 +315,12 @@ impl Loader<'_> {
             ),
             None => None,
         };
-        let texcoords: Option<Vec<[f32; 2]>> = match reader.read_tex_coords(0) {
-            Some(read) => Some(read.into_f32().collect()),
-            None => None,
-        };
-        let colors: Option<Vec<[f32; 4]>> = match reader.read_colors(0) {
-            Some(read) => Some(read.into_rgba_f32().collect()),
-            None => None,
-        };
+        let texcoords: Option<Vec<[f32; 2]>> = reader
+            .read_tex_coords(0)
+            .map(|read| read.into_f32().collect());
+        let colors: Option<Vec<[f32; 4]>> = reader
+            .read_colors(0)
+            .map(|read| read.into_rgba_f32().collect());
         let tangents: Option<Vec<[f32; 4]>> = match reader.read_tangents() {
             Some(read) if self.attributes.tangents => Some(read.collect()),
             _ => None,
