@@ -429,7 +429,8 @@ typedef struct MltMaterial {
    */
   int32_t kind;
   /**
-   * Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+   * Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour;
+   * linear RGB, each in [0, 1].
    */
   float color[3];
   /**
@@ -445,7 +446,8 @@ typedef struct MltMaterial {
   float ior;
   /**
    * Metalness in [0, 1]: 0 a dielectric, 1 a metal whose reflectance is `color`. Used by
-   * `MLT_MATERIAL_METALLIC_ROUGHNESS`; validated for every kind. Default 0.
+   * `MLT_MATERIAL_METALLIC_ROUGHNESS` only, but this field and the ones below are
+   * validated for every kind. Default 0.
    */
   float metallic;
   /**

@@ -156,7 +156,8 @@ pub struct MltMaterial {
     pub struct_size: u32,
     /// One of `MLT_MATERIAL_*`.
     pub kind: i32,
-    /// Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+    /// Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour;
+    /// linear RGB, each in [0, 1].
     pub color: [f32; 3],
     /// Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
     /// Any material may emit: its triangles become area lights.
@@ -168,7 +169,8 @@ pub struct MltMaterial {
     // A header before the fields below (mlt 0.2's) ends the struct here; mlt gives such a
     // host's materials the defaults of everything that follows.
     /// Metalness in [0, 1]: 0 a dielectric, 1 a metal whose reflectance is `color`. Used by
-    /// `MLT_MATERIAL_METALLIC_ROUGHNESS`; validated for every kind. Default 0.
+    /// `MLT_MATERIAL_METALLIC_ROUGHNESS` only, but this field and the ones below are
+    /// validated for every kind. Default 0.
     pub metallic: f32,
     /// Perceptual roughness in [0, 1] (GGX alpha = roughness^2); metallic-roughness only.
     /// Default 1.
