@@ -69,6 +69,81 @@
 #define MLT_MATERIAL_DIELECTRIC 2
 
 /**
+ * `MltMaterial.kind`: glTF 2.0's metallic-roughness model (its specification's appendix
+ * B): base colour `color`, `metallic`, `roughness` (GGX with alpha = roughness^2; 0 is a
+ * perfectly smooth surface), dielectric Fresnel from `ior` (1.5 is glTF's), and
+ * `transmission` (`KHR_materials_transmission`) through the back side.
+ */
+#define MLT_MATERIAL_METALLIC_ROUGHNESS 3
+
+/**
+ * `MltMaterial.alpha_mode`: alpha is ignored, the surface is solid (glTF `OPAQUE`).
+ */
+#define MLT_ALPHA_OPAQUE 0
+
+/**
+ * `MltMaterial.alpha_mode`: a cut-out (glTF `MASK`): where alpha (`alpha` × the base
+ * colour texture's alpha × the vertex colour's alpha) is below `alpha_cutoff` there is no
+ * surface, and every ray passes through.
+ */
+#define MLT_ALPHA_MASK 1
+
+/**
+ * `MltTextureRef.texture` of a material slot without a texture.
+ */
+#define MLT_NO_TEXTURE -1
+
+/**
+ * `MltTexture.texel_type`: 8-bit values (`uint8_t`), 255 meaning 1, decoded by `encoding`.
+ */
+#define MLT_TEXEL_U8 0
+
+/**
+ * `MltTexture.texel_type`: linear `float` values, each finite and >= 0 (above 1 is
+ * allowed: emission may be HDR).
+ */
+#define MLT_TEXEL_F32 1
+
+/**
+ * `MltTexture.encoding`: the colour channels of 8-bit texels use the sRGB transfer function
+ * (IEC 61966-2-1), as glTF base colour and emissive images do; alpha stays linear. Only
+ * with `MLT_TEXEL_U8`. The default.
+ */
+#define MLT_TEXTURE_SRGB 0
+
+/**
+ * `MltTexture.encoding`: values are linear (value / 255 for 8-bit texels), as glTF
+ * normal and metallic-roughness images are; the only encoding of `MLT_TEXEL_F32`.
+ */
+#define MLT_TEXTURE_LINEAR 1
+
+/**
+ * `MltTexture.wrap_u` / `wrap_v`: the image tiles the plane (glTF's default, the default).
+ */
+#define MLT_WRAP_REPEAT 0
+
+/**
+ * `MltTexture.wrap_u` / `wrap_v`: the edge texels extend outwards.
+ */
+#define MLT_WRAP_CLAMP_TO_EDGE 1
+
+/**
+ * `MltTexture.wrap_u` / `wrap_v`: the image tiles with period 2, mirrored on every odd tile.
+ */
+#define MLT_WRAP_MIRRORED_REPEAT 2
+
+/**
+ * `MltTexture.filter`: the texel containing the point.
+ */
+#define MLT_FILTER_NEAREST 0
+
+/**
+ * `MltTexture.filter`: the four texels around the point, weighted by distance, on linear
+ * values (the default).
+ */
+#define MLT_FILTER_BILINEAR 1
+
+/**
  * `MltPunctualLight.kind`: radiates `intensity` equally in every direction from `position`.
  */
 #define MLT_LIGHT_POINT 0
@@ -306,7 +381,42 @@ typedef enum MltStatus {
 typedef struct MltScene MltScene;
 
 /**
+ * A material's use of a texture: which one, and glTF's `KHR_texture_transform` applied to
+ * the surface's texture coordinates before the lookup (scale, then rotate, then offset).
+ * Plain data inside `MltMaterial` (it has no `struct_size` of its own); the material's
+ * initializer sets every slot to no texture with the identity transform.
+ */
+typedef struct MltTextureRef {
+  /**
+   * Index into `MltSceneDesc.textures`, below `textures_len`; `MLT_NO_TEXTURE` (-1, the
+   * default) for none (the transform is then ignored).
+   */
+  int32_t texture;
+  /**
+   * Added to the (scaled, rotated) coordinates, u then v; finite. Default 0.
+   */
+  float offset[2];
+  /**
+   * Radians, counter-clockwise in uv space as `KHR_texture_transform` defines it;
+   * finite. Default 0.
+   */
+  float rotation;
+  /**
+   * Multiplies u and v first; finite. Default 1.
+   */
+  float scale[2];
+} MltTextureRef;
+
+/**
  * A material. Initialize with `mlt_material_default`.
+ *
+ * Textures are looked up at the surface's texture coordinates (`MltSceneDesc.texcoords`,
+ * which a scene with a textured material must have), each through its `MltTextureRef`:
+ * `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
+ * `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
+ * by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
+ * normal map; `emission_texture` multiplies `emission`. Per-vertex colours
+ * (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
  */
 typedef struct MltMaterial {
   /**
@@ -319,7 +429,8 @@ typedef struct MltMaterial {
    */
   int32_t kind;
   /**
-   * Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+   * Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour;
+   * linear RGB, each in [0, 1].
    */
   float color[3];
   /**
@@ -328,11 +439,125 @@ typedef struct MltMaterial {
    */
   float emission[3];
   /**
-   * Index of refraction of a dielectric (> 0; the outside is vacuum). Must be finite for
-   * every kind; only dielectrics use it.
+   * Index of refraction of a dielectric and of a metallic-roughness material's
+   * dielectric part (> 0; the outside is vacuum). Must be finite for every kind; only
+   * those two use it.
    */
   float ior;
+  /**
+   * Metalness in [0, 1]: 0 a dielectric, 1 a metal whose reflectance is `color`. Used by
+   * `MLT_MATERIAL_METALLIC_ROUGHNESS` only, but this field and the ones below are
+   * validated for every kind. Default 0.
+   */
+  float metallic;
+  /**
+   * Perceptual roughness in [0, 1] (GGX alpha = roughness^2); metallic-roughness only.
+   * Default 1.
+   */
+  float roughness;
+  /**
+   * The fraction of the non-metallic base that is transmitted rather than diffusely
+   * reflected, in [0, 1] (`KHR_materials_transmission`); metallic-roughness only.
+   * Default 0.
+   */
+  float transmission;
+  /**
+   * Coverage in [0, 1], multiplied by the base colour texture's alpha and the vertex
+   * colour's; used by `MLT_ALPHA_MASK`. Default 1.
+   */
+  float alpha;
+  /**
+   * One of `MLT_ALPHA_*`, for every kind. Default `MLT_ALPHA_OPAQUE`.
+   */
+  int32_t alpha_mode;
+  /**
+   * `MLT_ALPHA_MASK` cuts the surface out where alpha < `alpha_cutoff`; finite, >= 0.
+   * Default 0.5 (glTF's).
+   */
+  float alpha_cutoff;
+  /**
+   * Linear RGBA: multiplies `color` and `alpha`. Its texture is usually 8-bit sRGB
+   * (glTF's base colour images are); its alpha is linear.
+   */
+  struct MltTextureRef base_color_texture;
+  /**
+   * Green multiplies `roughness`, blue multiplies `metallic` (glTF's packing; usually an
+   * `MLT_TEXTURE_LINEAR` texture).
+   */
+  struct MltTextureRef metallic_roughness_texture;
+  /**
+   * A tangent-space normal map (glTF's convention): RGB in [0, 1] encodes the normal as
+   * 2 × value − 1, with x along the tangent (+u), y along the bitangent, pointing to
+   * +Y up in the image (towards decreasing v), and z along the surface normal. Usually
+   * an `MLT_TEXTURE_LINEAR` texture. The tangents are `MltSceneDesc.tangents`, or computed
+   * with MikkTSpace when that is empty.
+   */
+  struct MltTextureRef normal_texture;
+  /**
+   * Linear RGB: multiplies `emission` (an sRGB texture, in glTF). A triangle with
+   * emission emits only where the texture is not black.
+   */
+  struct MltTextureRef emission_texture;
+  /**
+   * Scales the normal map's x and y (glTF's `normalTexture.scale`); finite. Default 1.
+   */
+  float normal_scale;
 } MltMaterial;
+
+/**
+ * A texture the materials refer to by index (`MltSceneDesc.textures`). Initialize with
+ * `mlt_texture_default` (8-bit sRGB, repeat, bilinear, no texels), then set `width`,
+ * `height`, `channels` and `texels`.
+ *
+ * Coordinates follow glTF: uv (0, 0) is the top-left corner of the image (the first texel
+ * of the first row), u grows to the right and v downwards; texel (column i, row j) covers
+ * [i/w, (i+1)/w] × [j/h, (j+1)/h]. One channel is grey (read as RGB = g, A = 1), two grey
+ * and alpha, three RGB (A = 1), four RGBA.
+ */
+typedef struct MltTexture {
+  /**
+   * sizeof(MltTexture) of the header the host was built with: set by `mlt_texture_default`, do not change
+   * it. An older header's smaller struct is read as far as it goes (the rest defaults).
+   */
+  uint32_t struct_size;
+  /**
+   * Texels per row and rows, each in [1, `MLT_MAX_TEXTURE_SIDE`], at most
+   * `MLT_MAX_TEXTURE_TEXELS` together.
+   */
+  uint32_t width;
+  uint32_t height;
+  /**
+   * Values per texel: 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA). Default 4.
+   */
+  uint32_t channels;
+  /**
+   * One of `MLT_TEXEL_*`: what `texels` points to. Default `MLT_TEXEL_U8`.
+   */
+  int32_t texel_type;
+  /**
+   * width × height × channels values of `texel_type` (`uint8_t` or `float`, aligned
+   * for it), rows from the top of the image down, channels interleaved. Copied by
+   * `mlt_scene_create`; the host may free them once it returns.
+   */
+  const void *texels;
+  /**
+   * One of `MLT_TEXTURE_*`: how 8-bit colour channels encode linear values.
+   * `MLT_TEXTURE_SRGB` (the default) only with `MLT_TEXEL_U8`; `MLT_TEXEL_F32` texels
+   * must be `MLT_TEXTURE_LINEAR`.
+   */
+  int32_t encoding;
+  /**
+   * One of `MLT_WRAP_*`: what a coordinate outside [0, 1] reads, along u (glTF
+   * `wrapS`) and along v (`wrapT`). Default `MLT_WRAP_REPEAT`.
+   */
+  int32_t wrap_u;
+  int32_t wrap_v;
+  /**
+   * One of `MLT_FILTER_*`: how a point between texel centres is read. Default
+   * `MLT_FILTER_BILINEAR`.
+   */
+  int32_t filter;
+} MltTexture;
 
 /**
  * An environment: radiance arriving from infinitely far away, seen by every ray that
@@ -506,6 +731,58 @@ typedef struct MltSceneDesc {
    * Number of entries in `punctual_lights`, at most `MLT_MAX_PUNCTUAL_LIGHTS`.
    */
   size_t punctual_lights_len;
+  /**
+   * Per-vertex shading normals, x y z per vertex, or NULL with a length of 0 (the default)
+   * for flat triangles. Each finite, of any nonzero length (normalized on use);
+   * interpolated across each triangle. A normal on the back side of its triangle is
+   * turned to the front.
+   */
+  const float *normals;
+  /**
+   * Number of floats in `normals`: 0 or 3 × the vertex count.
+   */
+  size_t normals_len;
+  /**
+   * Per-vertex texture coordinates, u v per vertex, or NULL with 0. Each finite. glTF's
+   * convention: (0, 0) is the top-left corner of a texture, u grows to the right and v
+   * downwards (a texture repeats outside [0, 1] unless its wrap modes say otherwise).
+   * Needed by every textured material.
+   */
+  const float *texcoords;
+  /**
+   * Number of floats in `texcoords`: 0 or 2 × the vertex count.
+   */
+  size_t texcoords_len;
+  /**
+   * Per-vertex tangents for normal maps, x y z w per vertex, or NULL with 0: then mlt
+   * computes them with MikkTSpace (as glTF asks) where a material has a normal map.
+   * x y z (finite, nonzero) point along +u on the surface; w = +1 or -1 is the
+   * bitangent's sign: bitangent = w × cross(normal, tangent) (glTF's convention), which
+   * must point up the image (towards decreasing v), where a normal map's +Y points.
+   */
+  const float *tangents;
+  /**
+   * Number of floats in `tangents`: 0 or 4 × the vertex count.
+   */
+  size_t tangents_len;
+  /**
+   * Per-vertex linear RGBA colours, each in [0, 1], multiplying the material's `color`
+   * and `alpha` (glTF `COLOR_0`), or NULL with 0.
+   */
+  const float *colors;
+  /**
+   * Number of floats in `colors`: 0 or 4 × the vertex count.
+   */
+  size_t colors_len;
+  /**
+   * The textures the materials' `MltTextureRef`s index, each initialized by
+   * `mlt_texture_default`; may be NULL with a length of 0 (the default).
+   */
+  const struct MltTexture *textures;
+  /**
+   * Number of entries in `textures`.
+   */
+  size_t textures_len;
 } MltSceneDesc;
 
 /**
@@ -866,8 +1143,9 @@ MLT_API const char *mlt_last_error_message(void);
 MLT_API bool mlt_backend_supported(int32_t backend);
 
 /**
- * Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics) and
- * `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
+ * Fills `out` with a light grey (0.8) diffuse, non-emissive material (ior 1.5; metallic 0,
+ * roughness 1, transmission 0, alpha 1, `MLT_ALPHA_OPAQUE` with cutoff 0.5, no textures
+ * (`MLT_NO_TEXTURE` with the identity transform), normal scale 1) and `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
  * passes the host's `sizeof(MltMaterial)`; the other `*_init` functions likewise.
  *
  * # Safety
@@ -876,7 +1154,18 @@ MLT_API bool mlt_backend_supported(int32_t backend);
 MLT_API enum MltStatus mlt_material_init(struct MltMaterial *out, size_t struct_size);
 
 /**
- * Fills `out` with an empty description (no arrays, BVH backend).
+ * Fills `out` with an empty texture: no texels (set `width`, `height` and `texels`), 4
+ * channels of `MLT_TEXEL_U8` in `MLT_TEXTURE_SRGB`, `MLT_WRAP_REPEAT` both ways,
+ * `MLT_FILTER_BILINEAR`.
+ *
+ * # Safety
+ * `out` must be NULL or point to `struct_size` writable bytes.
+ */
+MLT_API enum MltStatus mlt_texture_init(struct MltTexture *out, size_t struct_size);
+
+/**
+ * Fills `out` with an empty description (no arrays, no lights, no surface attributes or
+ * textures, BVH backend).
  *
  * # Safety
  * `out` must be NULL or point to `struct_size` writable bytes.
@@ -1053,6 +1342,9 @@ static inline MltStatus mlt_sun_default(MltSun *out) {
 }
 static inline MltStatus mlt_punctual_light_default(MltPunctualLight *out) {
     return mlt_punctual_light_init(out, sizeof(MltPunctualLight));
+}
+static inline MltStatus mlt_texture_default(MltTexture *out) {
+    return mlt_texture_init(out, sizeof(MltTexture));
 }
 /* A constant environment of radiance rgb[0..3]: a 1 x 1 map whose pixel is rgb, which must
  * stay valid until mlt_scene_create returns (it is copied then). */

@@ -79,6 +79,42 @@ pub struct TextureDesc<'a> {
     pub filter: TextureFilter,
 }
 
+impl TextureDesc<'_> {
+    /// Checks a texture's size (reported as `desc.textures[index]`): each side in [1,
+    /// [`MLT_MAX_TEXTURE_SIDE`]], at most [`MLT_MAX_TEXTURE_TEXELS`] texels, 1 to 4 channels.
+    /// Returns the number of values its data must hold (width × height × channels, at
+    /// most 2^30), so a host's array can be sized before it is read.
+    pub fn value_count(width: u32, height: u32, channels: u32, index: usize) -> Result<usize> {
+        let name = format!("desc.textures[{index}]");
+        for (field, side) in [("width", width), ("height", height)] {
+            if side == 0 {
+                return Err(Error::invalid(format!(
+                    "{name}.{field} is 0; a texture needs at least 1 x 1 texels"
+                )));
+            }
+            if side > MLT_MAX_TEXTURE_SIDE {
+                return Err(Error::invalid(format!(
+                    "{name}.{field} is {side}; each side may be at most {MLT_MAX_TEXTURE_SIDE} texels"
+                )));
+            }
+        }
+        let texel_count = width as u64 * height as u64;
+        if texel_count > MLT_MAX_TEXTURE_TEXELS {
+            return Err(Error::invalid(format!(
+                "{name} is {width} x {height} texels; a texture may have at most {MLT_MAX_TEXTURE_TEXELS}"
+            )));
+        }
+        if !(1..=4).contains(&channels) {
+            return Err(Error::invalid(format!(
+                "{name}.channels is {channels}; it must be 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)"
+            )));
+        }
+        // At most 2^28 texels of 4 channels: fits any usize of 32 bits or more.
+        usize::try_from(texel_count * channels as u64)
+            .map_err(|_| Error::invalid(format!("{name} is too large for this platform")))
+    }
+}
+
 /// The texels, kept at the host's precision: an 8-bit texture takes a quarter of the
 /// memory floats would.
 #[derive(Clone, Debug)]
@@ -137,30 +173,7 @@ impl Texture {
     pub(crate) fn new(desc: &TextureDesc, index: usize) -> Result<Texture> {
         let name = format!("desc.textures[{index}]");
         let (width, height, channels) = (desc.width, desc.height, desc.channels);
-        for (field, side) in [("width", width), ("height", height)] {
-            if side == 0 {
-                return Err(Error::invalid(format!(
-                    "{name}.{field} is 0; a texture needs at least 1 x 1 texels"
-                )));
-            }
-            if side > MLT_MAX_TEXTURE_SIDE {
-                return Err(Error::invalid(format!(
-                    "{name}.{field} is {side}; each side may be at most {MLT_MAX_TEXTURE_SIDE} texels"
-                )));
-            }
-        }
-        let texel_count = width as u64 * height as u64;
-        if texel_count > MLT_MAX_TEXTURE_TEXELS {
-            return Err(Error::invalid(format!(
-                "{name} is {width} x {height} texels; a texture may have at most {MLT_MAX_TEXTURE_TEXELS}"
-            )));
-        }
-        if !(1..=4).contains(&channels) {
-            return Err(Error::invalid(format!(
-                "{name}.channels is {channels}; it must be 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA)"
-            )));
-        }
-        let expected = texel_count * channels as u64;
+        let expected = TextureDesc::value_count(width, height, channels, index)? as u64;
         let (length, kind) = match &desc.data {
             TexelData::U8(values) => (values.len(), "8-bit values"),
             TexelData::F32(values) => (values.len(), "floats"),

@@ -6,7 +6,11 @@ use crate::accel::Backend;
 use crate::error::*;
 use crate::integrators::mlt::driver::MutationWeights;
 use crate::render::{Algorithm, RenderSettings};
-use crate::scene::{Camera, MaterialKind, PunctualLight, PunctualLightKind, SunDesc};
+use crate::scene::{
+    AlphaMode, Camera, Material, MaterialKind, PunctualLight, PunctualLightKind, SunDesc,
+    TextureRef,
+};
+use crate::texture::{TextureEncoding, TextureFilter, WrapMode};
 use glam::Vec3A;
 
 pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
@@ -14,10 +18,133 @@ pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
         MLT_MATERIAL_DIFFUSE => Ok(MaterialKind::Diffuse),
         MLT_MATERIAL_MIRROR => Ok(MaterialKind::Mirror),
         MLT_MATERIAL_DIELECTRIC => Ok(MaterialKind::Dielectric),
+        MLT_MATERIAL_METALLIC_ROUGHNESS => Ok(MaterialKind::MetallicRoughness),
         other => Err(Error::invalid(format!(
-            "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1) or MLT_MATERIAL_DIELECTRIC (2)"
+            "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1), MLT_MATERIAL_DIELECTRIC (2) or MLT_MATERIAL_METALLIC_ROUGHNESS (3)"
         ))),
     }
+}
+
+/// The host's material `index`; its values are validated with the scene (`Material::validate`),
+/// its enums and texture indices below -1 here.
+pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
+    let name = format!("desc.materials[{index}]");
+    let alpha_mode = match m.alpha_mode {
+        MLT_ALPHA_OPAQUE => AlphaMode::Opaque,
+        MLT_ALPHA_MASK => AlphaMode::Mask,
+        other => {
+            return Err(Error::invalid(format!(
+                "{name}.alpha_mode is {other}; use MLT_ALPHA_OPAQUE (0) or MLT_ALPHA_MASK (1)"
+            )));
+        }
+    };
+    let slot = |field: &str, r: &MltTextureRef| texture_ref(r, &format!("{name}.{field}"));
+    Ok(Material {
+        kind: material_kind(m.kind, index)?,
+        color: m.color,
+        emission: m.emission,
+        ior: m.ior,
+        metallic: m.metallic,
+        roughness: m.roughness,
+        transmission: m.transmission,
+        alpha: m.alpha,
+        alpha_mode,
+        alpha_cutoff: m.alpha_cutoff,
+        base_color_texture: slot("base_color_texture", &m.base_color_texture)?,
+        metallic_roughness_texture: slot(
+            "metallic_roughness_texture",
+            &m.metallic_roughness_texture,
+        )?,
+        normal_texture: slot("normal_texture", &m.normal_texture)?,
+        normal_scale: m.normal_scale,
+        emission_texture: slot("emission_texture", &m.emission_texture)?,
+    })
+}
+
+/// A texture slot: `MLT_NO_TEXTURE` is none; an index at or past the texture count is
+/// refused by the scene's validation (`TextureRef::validate`), one below -1 here.
+fn texture_ref(r: &MltTextureRef, name: &str) -> Result<Option<TextureRef>> {
+    match r.texture {
+        MLT_NO_TEXTURE => Ok(None),
+        index if index < 0 => Err(Error::invalid(format!(
+            "{name}.texture is {index}; use an index into desc.textures, or MLT_NO_TEXTURE (-1) for none"
+        ))),
+        index => Ok(Some(TextureRef {
+            texture: index as u32,
+            offset: r.offset,
+            rotation: r.rotation,
+            scale: r.scale,
+        })),
+    }
+}
+
+/// The enums of the host's texture `index`, and the pairing of sRGB with 8-bit texels,
+/// checked before its texels are read.
+pub(super) fn texture_modes(
+    t: &MltTexture,
+    index: usize,
+) -> Result<(TextureEncoding, WrapMode, WrapMode, TextureFilter)> {
+    let name = format!("desc.textures[{index}]");
+    if !matches!(t.texel_type, MLT_TEXEL_U8 | MLT_TEXEL_F32) {
+        return Err(Error::invalid(format!(
+            "{name}.texel_type is {}; use MLT_TEXEL_U8 (0) or MLT_TEXEL_F32 (1)",
+            t.texel_type
+        )));
+    }
+    let encoding = match t.encoding {
+        MLT_TEXTURE_SRGB if t.texel_type == MLT_TEXEL_F32 => {
+            return Err(Error::invalid(format!(
+                "{name}.encoding is MLT_TEXTURE_SRGB (0) but texel_type is MLT_TEXEL_F32; sRGB applies to 8-bit texels only (float texels are linear: use MLT_TEXTURE_LINEAR)"
+            )));
+        }
+        MLT_TEXTURE_SRGB => TextureEncoding::Srgb,
+        MLT_TEXTURE_LINEAR => TextureEncoding::Linear,
+        other => {
+            return Err(Error::invalid(format!(
+                "{name}.encoding is {other}; use MLT_TEXTURE_SRGB (0) or MLT_TEXTURE_LINEAR (1)"
+            )));
+        }
+    };
+    let wrap = |value: i32, field: &str| match value {
+        MLT_WRAP_REPEAT => Ok(WrapMode::Repeat),
+        MLT_WRAP_CLAMP_TO_EDGE => Ok(WrapMode::ClampToEdge),
+        MLT_WRAP_MIRRORED_REPEAT => Ok(WrapMode::MirroredRepeat),
+        other => Err(Error::invalid(format!(
+            "{name}.{field} is {other}; use MLT_WRAP_REPEAT (0), MLT_WRAP_CLAMP_TO_EDGE (1) or MLT_WRAP_MIRRORED_REPEAT (2)"
+        ))),
+    };
+    let filter = match t.filter {
+        MLT_FILTER_NEAREST => TextureFilter::Nearest,
+        MLT_FILTER_BILINEAR => TextureFilter::Bilinear,
+        other => {
+            return Err(Error::invalid(format!(
+                "{name}.filter is {other}; use MLT_FILTER_NEAREST (0) or MLT_FILTER_BILINEAR (1)"
+            )));
+        }
+    };
+    Ok((
+        encoding,
+        wrap(t.wrap_u, "wrap_u")?,
+        wrap(t.wrap_v, "wrap_v")?,
+        filter,
+    ))
+}
+
+/// Float texels must be finite and >= 0; named by the C field (`texels`), with the texel's
+/// row, column and channel.
+pub(super) fn check_float_texels(values: &[f32], t: &MltTexture, index: usize) -> Result<()> {
+    if let Some(i) = values.iter().position(|v| !(*v >= 0.0 && v.is_finite())) {
+        let channels = t.channels as usize;
+        let texel = i / channels;
+        return Err(Error::invalid(format!(
+            "desc.textures[{index}].texels[{i}] (row {}, column {}, channel {}) is {}; float texels must be finite and >= 0",
+            texel / t.width as usize,
+            texel % t.width as usize,
+            i % channels,
+            values[i]
+        )));
+    }
+    Ok(())
 }
 
 pub(super) fn punctual_light(light: &MltPunctualLight, index: usize) -> Result<PunctualLight> {

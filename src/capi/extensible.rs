@@ -16,7 +16,7 @@ use super::marshal::check_pointer;
 use super::types::*;
 use crate::error::*;
 use crate::render::RenderSettings;
-use crate::scene::{Camera, PunctualLight};
+use crate::scene::{Camera, Material, PunctualLight};
 use std::mem::{align_of, offset_of, size_of};
 
 /// A C struct that begins with `struct_size: u32` and only grows by appending fields, all
@@ -197,14 +197,55 @@ pub(super) unsafe fn init_host<T: Extensible>(out: *mut T, struct_size: usize) -
 impl Extensible for MltMaterial {
     const TYPE_NAME: &'static str = "MltMaterial";
     const INITIALIZER: &'static str = "mlt_material_default";
-    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    /// Before the metallic-roughness model and textures (mlt 0.2's header): 36 bytes.
+    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltMaterial, metallic)];
     fn defaults() -> Self {
+        let d = Material::diffuse([0.8; 3]);
         MltMaterial {
             struct_size: size_of::<Self>() as u32,
             kind: MLT_MATERIAL_DIFFUSE,
-            color: [0.8; 3],
-            emission: [0.0; 3],
-            ior: 1.5,
+            color: d.color,
+            emission: d.emission,
+            ior: d.ior,
+            metallic: d.metallic,
+            roughness: d.roughness,
+            transmission: d.transmission,
+            alpha: d.alpha,
+            alpha_mode: MLT_ALPHA_OPAQUE,
+            alpha_cutoff: d.alpha_cutoff,
+            base_color_texture: NO_TEXTURE,
+            metallic_roughness_texture: NO_TEXTURE,
+            normal_texture: NO_TEXTURE,
+            emission_texture: NO_TEXTURE,
+            normal_scale: d.normal_scale,
+        }
+    }
+}
+
+/// A material's texture slot without a texture: index -1, the identity transform.
+const NO_TEXTURE: MltTextureRef = MltTextureRef {
+    texture: MLT_NO_TEXTURE,
+    offset: [0.0; 2],
+    rotation: 0.0,
+    scale: [1.0; 2],
+};
+
+impl Extensible for MltTexture {
+    const TYPE_NAME: &'static str = "MltTexture";
+    const INITIALIZER: &'static str = "mlt_texture_default";
+    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    fn defaults() -> Self {
+        MltTexture {
+            struct_size: size_of::<Self>() as u32,
+            width: 0,
+            height: 0,
+            channels: 4,
+            texel_type: MLT_TEXEL_U8,
+            texels: std::ptr::null(),
+            encoding: MLT_TEXTURE_SRGB,
+            wrap_u: MLT_WRAP_REPEAT,
+            wrap_v: MLT_WRAP_REPEAT,
+            filter: MLT_FILTER_BILINEAR,
         }
     }
 }
@@ -212,8 +253,13 @@ impl Extensible for MltMaterial {
 impl Extensible for MltSceneDesc {
     const TYPE_NAME: &'static str = "MltSceneDesc";
     const INITIALIZER: &'static str = "mlt_scene_desc_default";
-    /// Before the lights besides emissive triangles (mlt 0.2's header): no lights.
-    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltSceneDesc, environment)];
+    /// Before the lights besides emissive triangles (mlt 0.2's header, 80 bytes): no
+    /// lights; before the surface attributes and textures (112 bytes): flat triangles, no
+    /// textures.
+    const EARLIER_LAYOUTS: &'static [usize] = &[
+        offset_of!(MltSceneDesc, environment),
+        offset_of!(MltSceneDesc, normals),
+    ];
     fn defaults() -> Self {
         MltSceneDesc {
             struct_size: size_of::<Self>() as u32,
@@ -230,6 +276,16 @@ impl Extensible for MltSceneDesc {
             sun: std::ptr::null(),
             punctual_lights: std::ptr::null(),
             punctual_lights_len: 0,
+            normals: std::ptr::null(),
+            normals_len: 0,
+            texcoords: std::ptr::null(),
+            texcoords_len: 0,
+            tangents: std::ptr::null(),
+            tangents_len: 0,
+            colors: std::ptr::null(),
+            colors_len: 0,
+            textures: std::ptr::null(),
+            textures_len: 0,
         }
     }
 }
@@ -413,6 +469,18 @@ mod tests {
         assert_sizes_grow::<MltEnvironment>();
         assert_sizes_grow::<MltSun>();
         assert_sizes_grow::<MltPunctualLight>();
+        assert_sizes_grow::<MltTexture>();
+    }
+
+    /// The layouts older headers have: mlt 0.2's material ends at `ior`, its scene
+    /// description at `backend`; the one with lights but no surface attributes is 112 bytes.
+    #[test]
+    #[cfg(target_pointer_width = "64")]
+    fn earlier_layouts_have_the_sizes_of_the_older_headers() {
+        assert_eq!(sizes::<MltMaterial>(), [36, 160]);
+        assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192]);
+        assert_eq!(size_of::<MltTexture>(), 48);
+        assert_eq!(size_of::<MltTextureRef>(), 24);
     }
 
     #[test]

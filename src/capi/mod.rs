@@ -26,12 +26,13 @@ use crate::accel::Backend;
 use crate::error::*;
 use crate::render::{self, StopReason};
 use crate::scene::{
-    Camera, EnvironmentDesc, LightsDesc, MLT_MAX_PUNCTUAL_LIGHTS, Material, Scene, SceneDesc,
-    SunDesc,
+    Camera, EnvironmentDesc, LightsDesc, MLT_MAX_PUNCTUAL_LIGHTS, Scene, SceneDesc, SunDesc,
 };
+use crate::texture::{TexelData, TextureDesc};
 use convert::*;
 use extensible::*;
 use marshal::*;
+use std::borrow::Cow;
 use std::ffi::{c_char, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -79,8 +80,9 @@ pub extern "C" fn mlt_backend_supported(backend: i32) -> bool {
     self::backend(backend).is_ok_and(Backend::is_available)
 }
 
-/// Fills `out` with a white diffuse, non-emissive material (ior 1.5 for dielectrics) and
-/// `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
+/// Fills `out` with a light grey (0.8) diffuse, non-emissive material (ior 1.5; metallic 0,
+/// roughness 1, transmission 0, alpha 1, `MLT_ALPHA_OPAQUE` with cutoff 0.5, no textures
+/// (`MLT_NO_TEXTURE` with the identity transform), normal scale 1) and `struct_size`. Call it through the header's inline `mlt_material_default(out)`, which
 /// passes the host's `sizeof(MltMaterial)`; the other `*_init` functions likewise.
 ///
 /// # Safety
@@ -91,7 +93,20 @@ pub unsafe extern "C" fn mlt_material_init(out: *mut MltMaterial, struct_size: u
     guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
 }
 
-/// Fills `out` with an empty description (no arrays, BVH backend).
+/// Fills `out` with an empty texture: no texels (set `width`, `height` and `texels`), 4
+/// channels of `MLT_TEXEL_U8` in `MLT_TEXTURE_SRGB`, `MLT_WRAP_REPEAT` both ways,
+/// `MLT_FILTER_BILINEAR`.
+///
+/// # Safety
+/// `out` must be NULL or point to `struct_size` writable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_texture_init(out: *mut MltTexture, struct_size: usize) -> MltStatus {
+    // SAFETY: forwarded contract.
+    guard(|| unsafe { init_host(out, struct_size) }.map(|()| MLT_STATUS_OK))
+}
+
+/// Fills `out` with an empty description (no arrays, no lights, no surface attributes or
+/// textures, BVH backend).
 ///
 /// # Safety
 /// `out` must be NULL or point to `struct_size` writable bytes.
@@ -227,15 +242,7 @@ pub unsafe extern "C" fn mlt_scene_create(
         let materials = host_materials
             .iter()
             .enumerate()
-            .map(|(i, m)| {
-                Ok(Material {
-                    kind: material_kind(m.kind, i)?,
-                    color: m.color,
-                    emission: m.emission,
-                    ior: m.ior,
-                    ..Material::diffuse(m.color)
-                })
-            })
+            .map(|(i, m)| material(m, i))
             .collect::<Result<Vec<_>>>()?;
         let environment = unsafe { read_environment(desc.environment) }?;
         let sun = if desc.sun.is_null() {
@@ -260,6 +267,12 @@ pub unsafe extern "C" fn mlt_scene_create(
         .enumerate()
         .map(|(i, light)| punctual_light(light, i))
         .collect::<Result<Vec<_>>>()?;
+        let normals = unsafe { host_slice(desc.normals, desc.normals_len, "desc.normals") }?;
+        let texcoords =
+            unsafe { host_slice(desc.texcoords, desc.texcoords_len, "desc.texcoords") }?;
+        let tangents = unsafe { host_slice(desc.tangents, desc.tangents_len, "desc.tangents") }?;
+        let colors = unsafe { host_slice(desc.colors, desc.colors_len, "desc.colors") }?;
+        let textures = unsafe { read_textures(desc.textures, desc.textures_len) }?;
         let scene = Scene::new(&SceneDesc {
             positions,
             indices,
@@ -271,7 +284,11 @@ pub unsafe extern "C" fn mlt_scene_create(
                 punctual: &punctual,
             },
             backend: backend(desc.backend)?,
-            ..Default::default()
+            normals,
+            texcoords,
+            tangents,
+            colors,
+            textures: &textures,
         })?;
         let handle = Box::into_raw(Box::new(MltScene {
             scene,
@@ -308,6 +325,49 @@ unsafe fn read_environment<'a>(
         rotation_degrees: e.rotation_degrees,
         scale: e.scale,
     }))
+}
+
+/// The host's textures, borrowing their texels (the scene copies them): each one's enums
+/// and size checked before its texels are looked at.
+///
+/// # Safety
+/// If `len > 0`, `textures` must point to `len` `MltTexture`s of the layout the first one's
+/// `struct_size` names, each of whose `texels` points to width × height × channels values of
+/// its `texel_type`.
+unsafe fn read_textures<'a>(
+    textures: *const MltTexture,
+    len: usize,
+) -> Result<Vec<TextureDesc<'a>>> {
+    // SAFETY: forwarded contract.
+    let host = unsafe { read_host_array(textures, len, "desc.textures") }?;
+    host.iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let (encoding, wrap_u, wrap_v, filter) = texture_modes(t, i)?;
+            let count = TextureDesc::value_count(t.width, t.height, t.channels, i)?;
+            let name = format!("desc.textures[{i}].texels");
+            let data = if t.texel_type == MLT_TEXEL_F32 {
+                // SAFETY: forwarded contract; `count` is checked small (at most 2^30).
+                let values = unsafe { host_slice(t.texels.cast::<f32>(), count, &name) }?;
+                check_float_texels(values, t, i)?;
+                TexelData::F32(Cow::Borrowed(values))
+            } else {
+                // SAFETY: as above.
+                let values = unsafe { host_slice(t.texels.cast::<u8>(), count, &name) }?;
+                TexelData::U8(Cow::Borrowed(values))
+            };
+            Ok(TextureDesc {
+                width: t.width,
+                height: t.height,
+                channels: t.channels,
+                data,
+                encoding,
+                wrap_u,
+                wrap_v,
+                filter,
+            })
+        })
+        .collect()
 }
 
 /// Releases a scene. NULL is a no-op. The scene must not be in use by another thread.

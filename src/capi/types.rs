@@ -20,6 +20,48 @@ pub const MLT_MATERIAL_DIFFUSE: i32 = 0;
 pub const MLT_MATERIAL_MIRROR: i32 = 1;
 /// `MltMaterial.kind`: smooth dielectric (glass) with index of refraction `ior`, tinted by `color`.
 pub const MLT_MATERIAL_DIELECTRIC: i32 = 2;
+/// `MltMaterial.kind`: glTF 2.0's metallic-roughness model (its specification's appendix
+/// B): base colour `color`, `metallic`, `roughness` (GGX with alpha = roughness^2; 0 is a
+/// perfectly smooth surface), dielectric Fresnel from `ior` (1.5 is glTF's), and
+/// `transmission` (`KHR_materials_transmission`) through the back side.
+pub const MLT_MATERIAL_METALLIC_ROUGHNESS: i32 = 3;
+
+/// `MltMaterial.alpha_mode`: alpha is ignored, the surface is solid (glTF `OPAQUE`).
+pub const MLT_ALPHA_OPAQUE: i32 = 0;
+/// `MltMaterial.alpha_mode`: a cut-out (glTF `MASK`): where alpha (`alpha` × the base
+/// colour texture's alpha × the vertex colour's alpha) is below `alpha_cutoff` there is no
+/// surface, and every ray passes through.
+pub const MLT_ALPHA_MASK: i32 = 1;
+
+/// `MltTextureRef.texture` of a material slot without a texture.
+pub const MLT_NO_TEXTURE: i32 = -1;
+
+/// `MltTexture.texel_type`: 8-bit values (`uint8_t`), 255 meaning 1, decoded by `encoding`.
+pub const MLT_TEXEL_U8: i32 = 0;
+/// `MltTexture.texel_type`: linear `float` values, each finite and >= 0 (above 1 is
+/// allowed: emission may be HDR).
+pub const MLT_TEXEL_F32: i32 = 1;
+
+/// `MltTexture.encoding`: the colour channels of 8-bit texels use the sRGB transfer function
+/// (IEC 61966-2-1), as glTF base colour and emissive images do; alpha stays linear. Only
+/// with `MLT_TEXEL_U8`. The default.
+pub const MLT_TEXTURE_SRGB: i32 = 0;
+/// `MltTexture.encoding`: values are linear (value / 255 for 8-bit texels), as glTF
+/// normal and metallic-roughness images are; the only encoding of `MLT_TEXEL_F32`.
+pub const MLT_TEXTURE_LINEAR: i32 = 1;
+
+/// `MltTexture.wrap_u` / `wrap_v`: the image tiles the plane (glTF's default, the default).
+pub const MLT_WRAP_REPEAT: i32 = 0;
+/// `MltTexture.wrap_u` / `wrap_v`: the edge texels extend outwards.
+pub const MLT_WRAP_CLAMP_TO_EDGE: i32 = 1;
+/// `MltTexture.wrap_u` / `wrap_v`: the image tiles with period 2, mirrored on every odd tile.
+pub const MLT_WRAP_MIRRORED_REPEAT: i32 = 2;
+
+/// `MltTexture.filter`: the texel containing the point.
+pub const MLT_FILTER_NEAREST: i32 = 0;
+/// `MltTexture.filter`: the four texels around the point, weighted by distance, on linear
+/// values (the default).
+pub const MLT_FILTER_BILINEAR: i32 = 1;
 
 /// `MltPunctualLight.kind`: radiates `intensity` equally in every direction from `position`.
 pub const MLT_LIGHT_POINT: i32 = 0;
@@ -78,7 +120,34 @@ pub const MLT_MUTATION_MULTI_CHAIN: i32 = 3;
 /// `MltHit.triangle_id` of a ray that hit nothing.
 pub const MLT_INVALID_ID: u32 = u32::MAX;
 
+/// A material's use of a texture: which one, and glTF's `KHR_texture_transform` applied to
+/// the surface's texture coordinates before the lookup (scale, then rotate, then offset).
+/// Plain data inside `MltMaterial` (it has no `struct_size` of its own); the material's
+/// initializer sets every slot to no texture with the identity transform.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltTextureRef {
+    /// Index into `MltSceneDesc.textures`, below `textures_len`; `MLT_NO_TEXTURE` (-1, the
+    /// default) for none (the transform is then ignored).
+    pub texture: i32,
+    /// Added to the (scaled, rotated) coordinates, u then v; finite. Default 0.
+    pub offset: [f32; 2],
+    /// Radians, counter-clockwise in uv space as `KHR_texture_transform` defines it;
+    /// finite. Default 0.
+    pub rotation: f32,
+    /// Multiplies u and v first; finite. Default 1.
+    pub scale: [f32; 2],
+}
+
 /// A material. Initialize with `mlt_material_default`.
+///
+/// Textures are looked up at the surface's texture coordinates (`MltSceneDesc.texcoords`,
+/// which a scene with a textured material must have), each through its `MltTextureRef`:
+/// `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
+/// `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
+/// by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
+/// normal map; `emission_texture` multiplies `emission`. Per-vertex colours
+/// (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltMaterial {
@@ -87,14 +156,93 @@ pub struct MltMaterial {
     pub struct_size: u32,
     /// One of `MLT_MATERIAL_*`.
     pub kind: i32,
-    /// Diffuse albedo, mirror reflectance or glass tint; linear RGB, each in [0, 1].
+    /// Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour;
+    /// linear RGB, each in [0, 1].
     pub color: [f32; 3],
     /// Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
     /// Any material may emit: its triangles become area lights.
     pub emission: [f32; 3],
-    /// Index of refraction of a dielectric (> 0; the outside is vacuum). Must be finite for
-    /// every kind; only dielectrics use it.
+    /// Index of refraction of a dielectric and of a metallic-roughness material's
+    /// dielectric part (> 0; the outside is vacuum). Must be finite for every kind; only
+    /// those two use it.
     pub ior: f32,
+    // A header before the fields below (mlt 0.2's) ends the struct here; mlt gives such a
+    // host's materials the defaults of everything that follows.
+    /// Metalness in [0, 1]: 0 a dielectric, 1 a metal whose reflectance is `color`. Used by
+    /// `MLT_MATERIAL_METALLIC_ROUGHNESS` only, but this field and the ones below are
+    /// validated for every kind. Default 0.
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1] (GGX alpha = roughness^2); metallic-roughness only.
+    /// Default 1.
+    pub roughness: f32,
+    /// The fraction of the non-metallic base that is transmitted rather than diffusely
+    /// reflected, in [0, 1] (`KHR_materials_transmission`); metallic-roughness only.
+    /// Default 0.
+    pub transmission: f32,
+    /// Coverage in [0, 1], multiplied by the base colour texture's alpha and the vertex
+    /// colour's; used by `MLT_ALPHA_MASK`. Default 1.
+    pub alpha: f32,
+    /// One of `MLT_ALPHA_*`, for every kind. Default `MLT_ALPHA_OPAQUE`.
+    pub alpha_mode: i32,
+    /// `MLT_ALPHA_MASK` cuts the surface out where alpha < `alpha_cutoff`; finite, >= 0.
+    /// Default 0.5 (glTF's).
+    pub alpha_cutoff: f32,
+    /// Linear RGBA: multiplies `color` and `alpha`. Its texture is usually 8-bit sRGB
+    /// (glTF's base colour images are); its alpha is linear.
+    pub base_color_texture: MltTextureRef,
+    /// Green multiplies `roughness`, blue multiplies `metallic` (glTF's packing; usually an
+    /// `MLT_TEXTURE_LINEAR` texture).
+    pub metallic_roughness_texture: MltTextureRef,
+    /// A tangent-space normal map (glTF's convention): RGB in [0, 1] encodes the normal as
+    /// 2 × value − 1, with x along the tangent (+u), y along the bitangent, pointing to
+    /// +Y up in the image (towards decreasing v), and z along the surface normal. Usually
+    /// an `MLT_TEXTURE_LINEAR` texture. The tangents are `MltSceneDesc.tangents`, or computed
+    /// with MikkTSpace when that is empty.
+    pub normal_texture: MltTextureRef,
+    /// Linear RGB: multiplies `emission` (an sRGB texture, in glTF). A triangle with
+    /// emission emits only where the texture is not black.
+    pub emission_texture: MltTextureRef,
+    /// Scales the normal map's x and y (glTF's `normalTexture.scale`); finite. Default 1.
+    pub normal_scale: f32,
+}
+
+/// A texture the materials refer to by index (`MltSceneDesc.textures`). Initialize with
+/// `mlt_texture_default` (8-bit sRGB, repeat, bilinear, no texels), then set `width`,
+/// `height`, `channels` and `texels`.
+///
+/// Coordinates follow glTF: uv (0, 0) is the top-left corner of the image (the first texel
+/// of the first row), u grows to the right and v downwards; texel (column i, row j) covers
+/// [i/w, (i+1)/w] × [j/h, (j+1)/h]. One channel is grey (read as RGB = g, A = 1), two grey
+/// and alpha, three RGB (A = 1), four RGBA.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltTexture {
+    /// sizeof(MltTexture) of the header the host was built with: set by `mlt_texture_default`, do not change
+    /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
+    pub struct_size: u32,
+    /// Texels per row and rows, each in [1, `MLT_MAX_TEXTURE_SIDE`], at most
+    /// `MLT_MAX_TEXTURE_TEXELS` together.
+    pub width: u32,
+    pub height: u32,
+    /// Values per texel: 1 (grey), 2 (grey, alpha), 3 (RGB) or 4 (RGBA). Default 4.
+    pub channels: u32,
+    /// One of `MLT_TEXEL_*`: what `texels` points to. Default `MLT_TEXEL_U8`.
+    pub texel_type: i32,
+    /// width × height × channels values of `texel_type` (`uint8_t` or `float`, aligned
+    /// for it), rows from the top of the image down, channels interleaved. Copied by
+    /// `mlt_scene_create`; the host may free them once it returns.
+    pub texels: *const c_void,
+    /// One of `MLT_TEXTURE_*`: how 8-bit colour channels encode linear values.
+    /// `MLT_TEXTURE_SRGB` (the default) only with `MLT_TEXEL_U8`; `MLT_TEXEL_F32` texels
+    /// must be `MLT_TEXTURE_LINEAR`.
+    pub encoding: i32,
+    /// One of `MLT_WRAP_*`: what a coordinate outside [0, 1] reads, along u (glTF
+    /// `wrapS`) and along v (`wrapT`). Default `MLT_WRAP_REPEAT`.
+    pub wrap_u: i32,
+    pub wrap_v: i32,
+    /// One of `MLT_FILTER_*`: how a point between texel centres is read. Default
+    /// `MLT_FILTER_BILINEAR`.
+    pub filter: i32,
 }
 
 /// An environment: radiance arriving from infinitely far away, seen by every ray that
@@ -213,6 +361,40 @@ pub struct MltSceneDesc {
     pub punctual_lights: *const MltPunctualLight,
     /// Number of entries in `punctual_lights`, at most `MLT_MAX_PUNCTUAL_LIGHTS`.
     pub punctual_lights_len: usize,
+    // A header before the surface attributes below ends the struct here: such a host's
+    // scenes have flat triangles and no textures.
+    /// Per-vertex shading normals, x y z per vertex, or NULL with a length of 0 (the default)
+    /// for flat triangles. Each finite, of any nonzero length (normalized on use);
+    /// interpolated across each triangle. A normal on the back side of its triangle is
+    /// turned to the front.
+    pub normals: *const f32,
+    /// Number of floats in `normals`: 0 or 3 × the vertex count.
+    pub normals_len: usize,
+    /// Per-vertex texture coordinates, u v per vertex, or NULL with 0. Each finite. glTF's
+    /// convention: (0, 0) is the top-left corner of a texture, u grows to the right and v
+    /// downwards (a texture repeats outside [0, 1] unless its wrap modes say otherwise).
+    /// Needed by every textured material.
+    pub texcoords: *const f32,
+    /// Number of floats in `texcoords`: 0 or 2 × the vertex count.
+    pub texcoords_len: usize,
+    /// Per-vertex tangents for normal maps, x y z w per vertex, or NULL with 0: then mlt
+    /// computes them with MikkTSpace (as glTF asks) where a material has a normal map.
+    /// x y z (finite, nonzero) point along +u on the surface; w = +1 or -1 is the
+    /// bitangent's sign: bitangent = w × cross(normal, tangent) (glTF's convention), which
+    /// must point up the image (towards decreasing v), where a normal map's +Y points.
+    pub tangents: *const f32,
+    /// Number of floats in `tangents`: 0 or 4 × the vertex count.
+    pub tangents_len: usize,
+    /// Per-vertex linear RGBA colours, each in [0, 1], multiplying the material's `color`
+    /// and `alpha` (glTF `COLOR_0`), or NULL with 0.
+    pub colors: *const f32,
+    /// Number of floats in `colors`: 0 or 4 × the vertex count.
+    pub colors_len: usize,
+    /// The textures the materials' `MltTextureRef`s index, each initialized by
+    /// `mlt_texture_default`; may be NULL with a length of 0 (the default).
+    pub textures: *const MltTexture,
+    /// Number of entries in `textures`.
+    pub textures_len: usize,
 }
 
 /// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with
