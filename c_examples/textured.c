@@ -6,12 +6,9 @@
  * texels top-left and bottom-right, white ones top-right and bottom-left), under a uniform
  * white sky of radiance 1, seen from straight above and path traced. Texture coordinates
  * follow glTF: uv (0, 0) is the texture's top-left texel, v grows downwards; here they are
- * laid out so that the texture appears upright in the image. The program prints which
- * material it rendered with and the mean of each quarter of the image, and writes the image
+ * laid out so that the texture appears upright in the image. The program prints the mean
+ * of each quarter of the image, and writes the image
  * as PFM (see minimal.c for the conventions every mlt call follows, and for write_pfm).
- *
- * A library that cannot render metallic-roughness materials yet refuses the scene with
- * MLT_STATUS_UNSUPPORTED; the program then renders the same texture on a diffuse material.
  *
  * Usage:  textured [out.pfm] [width height samples-per-pixel]   (defaults: textured.pfm 32 32 16)
  *
@@ -96,7 +93,6 @@ int main(int argc, char **argv) {
     MltScene *scene = NULL;
     MltCamera camera;
     MltRenderSettings settings;
-    MltStatus status;
     float *image = NULL;
     size_t image_len;
     uint32_t x, y, w, h;
@@ -148,17 +144,7 @@ int main(int argc, char **argv) {
     desc.materials = &surface;
     desc.materials_len = 1;
     desc.environment = &environment;
-    status = mlt_scene_create(&desc, &scene);
-    if (status == MLT_STATUS_UNSUPPORTED) {
-        printf("this library cannot render metallic-roughness materials yet (%s); "
-               "using a diffuse material with the same texture\n",
-               mlt_last_error_message());
-        surface.kind = MLT_MATERIAL_DIFFUSE;
-        status = mlt_scene_create(&desc, &scene);
-    }
-    if (!check(status, "mlt_scene_create")) return 1;
-    printf("material: %s\n",
-           surface.kind == MLT_MATERIAL_METALLIC_ROUGHNESS ? "metallic-roughness" : "diffuse");
+    if (!check(mlt_scene_create(&desc, &scene), "mlt_scene_create")) return 1;
 
     /* Straight down at the square, which fills the image, with -z up in the image. */
     if (!check(mlt_camera_default(&camera), "mlt_camera_default")) goto done;
