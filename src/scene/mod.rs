@@ -15,7 +15,7 @@ pub use light_desc::{
 pub use lights::AreaLight;
 pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 
-use crate::accel::{Accel, Backend, Hit, Ray};
+use crate::accel::{Accel, Backend, Filtering, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::spectrum::Spectrum;
 use crate::texture::{Texture, TextureDesc};
@@ -172,7 +172,16 @@ impl Scene {
             bounds_max = Vec3A::ZERO;
         }
 
-        let accel = Accel::build(desc.backend, &kept_vertices)?;
+        let has_cutouts = desc
+            .materials
+            .iter()
+            .any(|m| m.alpha_mode == AlphaMode::Mask);
+        let filtering = if has_cutouts {
+            Filtering::Filtered
+        } else {
+            Filtering::Unfiltered
+        };
+        let accel = Accel::build(desc.backend, &kept_vertices, filtering)?;
         let order = accel.internal_to_build_order();
 
         let material_of = |id: u32| {
@@ -261,10 +270,7 @@ impl Scene {
         Ok(Scene {
             accel,
             shading,
-            has_cutouts: desc
-                .materials
-                .iter()
-                .any(|m| m.alpha_mode == AlphaMode::Mask),
+            has_cutouts,
             attributes,
             textures,
             materials: desc.materials.to_vec(),
@@ -411,7 +417,7 @@ impl Scene {
         self.info
     }
 
-    /// Closest hit in the host's triangle ids; `None` on a miss.
+    /// Closest hit in the host's triangle ids, through alpha cut-outs; `None` on a miss.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.closest_hit(ray).map(|hit| Hit {
             triangle: self.internal_to_input[hit.triangle as usize],
@@ -419,7 +425,8 @@ impl Scene {
         })
     }
 
-    /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax].
+    /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax], through
+    /// alpha cut-outs.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.blocked(ray)
     }
