@@ -3108,7 +3108,10 @@ fn the_surfaces_scene_through_the_c_abi_renders_as_through_rust() {
             ..Default::default()
         };
         let rust_image = common::render_image(&rust_scene, &camera, &rust_settings);
-        assert!(c_image.iter().any(|&v| v > 0.0), "{algorithm:?}: a black image");
+        assert!(
+            c_image.iter().any(|&v| v > 0.0),
+            "{algorithm:?}: a black image"
+        );
         assert!(
             c_image
                 .iter()
