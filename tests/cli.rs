@@ -441,14 +441,6 @@ fn invalid_settings_and_arguments_are_one_line_errors() {
     let line = assert_one_line_error(&output);
     assert!(line.contains("width"), "{line}");
 
-    // A scene without any camera.
-    let obj = temp_path("nocamera.obj");
-    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    let output = mlt_render(&[&obj, &"--out", &temp_path("never.pfm")]);
-    let line = assert_one_line_error(&output);
-    assert!(line.contains("camera"), "{line}");
-    std::fs::remove_file(&obj).unwrap();
-
     // clap's own errors are folded into one line too.
     let output = mlt_render(&[
         &scene("cornell-box.obj"),

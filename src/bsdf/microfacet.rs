@@ -87,6 +87,36 @@ impl TrowbridgeReitz {
         if flip { Vec3A::new(m.x, m.y, -m.z) } else { m }
     }
 
+    /// The coordinates `u` for which [`Self::sample_visible_normal`] gives `m`: its
+    /// inverse, for perturbations that step in the sampling's coordinates. `None` if `m` is
+    /// not visible from `wo`.
+    #[inline]
+    pub fn visible_normal_coordinates(self, wo: Vec3A, m: Vec3A) -> Option<[f32; 2]> {
+        if wo.z == 0.0 || wo.z * m.z <= 0.0 || wo.dot(m) <= 0.0 {
+            return None;
+        }
+        let flip = |w: Vec3A| {
+            if wo.z < 0.0 {
+                Vec3A::new(w.x, w.y, -w.z)
+            } else {
+                w
+            }
+        };
+        let (wo, m) = (flip(wo), flip(m));
+        let stretched = Vec3A::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
+        // In the stretched space h = c + stretched lies along m unstretched, with c on the
+        // unit sphere: h = t d with |t d − stretched| = 1, so t = 2 d·stretched.
+        let d = Vec3A::new(m.x / self.alpha, m.y / self.alpha, m.z).normalize();
+        let t = 2.0 * d.dot(stretched);
+        if t <= 0.0 {
+            return None;
+        }
+        let c = d * t - stretched;
+        let u0 = (c.y.atan2(c.x) / (2.0 * PI)).rem_euclid(1.0);
+        let u1 = 1.0 - (c.z + stretched.z) / (1.0 + stretched.z);
+        Some([u0.min(1.0 - f32::EPSILON / 2.0), u1.clamp(0.0, 1.0)])
+    }
+
     /// The density of [`Self::sample_visible_normal`] over solid angle of `m`.
     #[inline]
     pub fn visible_normal_pdf(self, wo: Vec3A, m: Vec3A) -> f32 {
@@ -149,6 +179,30 @@ mod tests {
                     (visible - 1.0).abs() < 3e-3,
                     "α {alpha} θ {theta}: ∫ D_wo = {visible}"
                 );
+            }
+        }
+    }
+
+    /// Coordinates and visible normals invert each other, seen from either side.
+    #[test]
+    fn visible_normal_coordinates_invert_the_sampling() {
+        let mut rng = Rng::new(3, 5);
+        for alpha in [0.01f32, 0.2, 0.7, 1.0] {
+            let dist = TrowbridgeReitz::new(alpha);
+            for theta in [0.0, 30.0, 75.0, 89.0, 120.0, 170.0] {
+                let wo = direction(theta);
+                for _ in 0..500 {
+                    let u = [rng.uniform(), rng.uniform() * 0.999];
+                    let m = dist.sample_visible_normal(wo, u);
+                    let Some(back) = dist.visible_normal_coordinates(wo, m) else {
+                        panic!("α {alpha} θ {theta}: {u:?} → {m:?} has no coordinates");
+                    };
+                    let again = dist.sample_visible_normal(wo, back);
+                    assert!(
+                        (again - m).length() < 2e-3,
+                        "α {alpha} θ {theta}: {u:?} → {m:?} → {back:?} → {again:?}"
+                    );
+                }
             }
         }
     }

@@ -15,60 +15,14 @@ mod microfacet;
 mod scattering;
 
 pub use dielectric::fresnel_dielectric;
+pub(crate) use metallic_roughness::MetallicRoughness;
+pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
-use crate::scene::{Material, MaterialKind};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
-use metallic_roughness::MetallicRoughness;
 use std::f32::consts::FRAC_1_PI;
-
-/// The classes of lobes a BSDF has: what integrators decide by, so a new material only has
-/// to report its lobes here.
-///
-/// - Diffuse and glossy lobes have a density over directions: a connection (next-event
-///   estimation, a BDPT or bidirectional-mutation connection) can end at them, and in Veach's
-///   path classification (`D`/`S`) both are `D`. No material has a glossy lobe yet.
-/// - A specular lobe is a Dirac delta: only sampling the BSDF can follow it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct BsdfLobes(u8);
-
-// The constants are `pub(crate)`, not `pub`: cbindgen exports `pub` associated constants
-// to include/mlt.h whatever the type's visibility.
-impl BsdfLobes {
-    pub(crate) const DIFFUSE: BsdfLobes = BsdfLobes(1);
-    pub(crate) const GLOSSY: BsdfLobes = BsdfLobes(2);
-    pub(crate) const SPECULAR: BsdfLobes = BsdfLobes(4);
-
-    /// Whether all of `other`'s lobes are among these.
-    #[inline]
-    #[cfg_attr(not(test), allow(dead_code))]
-    pub fn contains(self, other: BsdfLobes) -> bool {
-        self.0 & other.0 == other.0
-    }
-
-    /// Whether some lobe has a density over directions (diffuse or glossy): then a
-    /// connection can end here, and Veach's classification calls the vertex `D`.
-    #[inline]
-    pub fn has_non_specular(self) -> bool {
-        self.0 & (BsdfLobes::DIFFUSE.0 | BsdfLobes::GLOSSY.0) != 0
-    }
-
-    /// Whether every lobe is a Dirac delta: no connection can end here (Veach's `S`).
-    #[inline]
-    pub fn is_specular(self) -> bool {
-        !self.has_non_specular()
-    }
-}
-
-impl std::ops::BitOr for BsdfLobes {
-    type Output = BsdfLobes;
-    #[inline]
-    fn bitor(self, other: BsdfLobes) -> BsdfLobes {
-        BsdfLobes(self.0 | other.0)
-    }
-}
 
 /// The scattering model at a surface point, with its parameters evaluated there (textures
 /// and vertex colours applied).
@@ -85,50 +39,6 @@ pub(crate) enum BsdfModel {
 }
 
 impl BsdfModel {
-    /// The model of an untextured `material`.
-    #[inline]
-    pub fn of(material: &Material) -> BsdfModel {
-        BsdfModel::with_color(material, Spectrum::from(material.color))
-    }
-
-    /// The model of `material` with its colour replaced by `color` and, for the
-    /// metallic-roughness model, its metalness and roughness by `metallic` and `roughness`
-    /// (textured).
-    #[inline]
-    pub fn textured(
-        material: &Material,
-        color: Spectrum,
-        metallic: f32,
-        roughness: f32,
-    ) -> BsdfModel {
-        match material.kind {
-            MaterialKind::MetallicRoughness => BsdfModel::MetallicRoughness(MetallicRoughness {
-                base_color: color,
-                metallic,
-                roughness,
-                ior: material.ior,
-                transmission: material.transmission,
-            }),
-            _ => BsdfModel::with_color(material, color),
-        }
-    }
-
-    /// The model of `material` with its colour replaced by `color`.
-    #[inline]
-    fn with_color(material: &Material, color: Spectrum) -> BsdfModel {
-        match material.kind {
-            MaterialKind::Diffuse => BsdfModel::Diffuse(color),
-            MaterialKind::Mirror => BsdfModel::Mirror(color),
-            MaterialKind::Dielectric => BsdfModel::Dielectric {
-                ior: material.ior,
-                tint: color,
-            },
-            MaterialKind::MetallicRoughness => {
-                BsdfModel::textured(material, color, material.metallic, material.roughness)
-            }
-        }
-    }
-
     /// The classes of its lobes.
     #[inline]
     pub fn lobes(&self) -> BsdfLobes {
@@ -403,25 +313,6 @@ fn scatter(
     }
 }
 
-/// The lobe of a specular scattering: whether `wi` stays on `wo`'s side of the surface.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SpecularLobe {
-    Reflection,
-    Refraction,
-}
-
-impl SpecularLobe {
-    /// The lobe that scatters `wo` into `wi` at a surface with normal `normal`.
-    #[inline]
-    pub fn of(normal: Vec3A, wo: Vec3A, wi: Vec3A) -> SpecularLobe {
-        if wo.dot(normal) * wi.dot(normal) > 0.0 {
-            SpecularLobe::Reflection
-        } else {
-            SpecularLobe::Refraction
-        }
-    }
-}
-
 /// The direction a specular model scatters `wo` into through `lobe`, or `None` if it has
 /// no such lobe (a mirror's refraction, total internal reflection).
 #[inline]
@@ -447,16 +338,17 @@ fn specular_direction(
 mod tests {
     use super::*;
     use crate::sampling::Rng;
+    use crate::scene::Material;
 
     /// Today's materials: diffuse is connectible (D), mirror and glass are Dirac (S); a
     /// glossy lobe counts as non-specular, alone or next to a specular one.
     #[test]
     fn lobes_classify_materials() {
-        let diffuse = BsdfModel::of(&Material::diffuse([0.5; 3])).lobes();
+        let diffuse = Material::diffuse([0.5; 3]).bsdf_model().lobes();
         assert!(diffuse.has_non_specular() && !diffuse.is_specular());
         assert!(diffuse.contains(BsdfLobes::DIFFUSE));
         for m in [Material::mirror([1.0; 3]), Material::dielectric(1.5)] {
-            let lobes = BsdfModel::of(&m).lobes();
+            let lobes = m.bsdf_model().lobes();
             assert!(lobes.is_specular() && !lobes.has_non_specular());
             assert!(lobes.contains(BsdfLobes::SPECULAR));
         }
@@ -469,7 +361,7 @@ mod tests {
     /// equals the material's color for diffuse, and the pdf matches eval/cos for diffuse.
     #[test]
     fn diffuse_sample_is_consistent_with_eval_and_pdf() {
-        let m = BsdfModel::of(&Material::diffuse([0.5, 0.25, 0.75]));
+        let m = Material::diffuse([0.5, 0.25, 0.75]).bsdf_model();
         let n = Vec3A::new(0.0, 0.6, 0.8);
         let wo = Vec3A::new(0.3, -0.5, -0.8).normalize();
         let mut rng = Rng::new(1, 2);

@@ -1,6 +1,8 @@
 //! Surface materials: what a triangle does with light.
 
+use crate::bsdf::{BsdfModel, MetallicRoughness};
 use crate::error::{Error, Result, check_finite, check_finite3};
+use crate::spectrum::Spectrum;
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -263,5 +265,40 @@ impl Material {
             }
         }
         Ok(())
+    }
+}
+
+impl Material {
+    /// The scattering model of the untextured material.
+    #[inline]
+    pub(crate) fn bsdf_model(&self) -> BsdfModel {
+        self.textured_bsdf_model(Spectrum::from(self.color), self.metallic, self.roughness)
+    }
+
+    /// The scattering model with the colour replaced by `color` and, for the
+    /// metallic-roughness model, its metalness and roughness by `metallic` and `roughness`
+    /// (textured).
+    #[inline]
+    pub(crate) fn textured_bsdf_model(
+        &self,
+        color: Spectrum,
+        metallic: f32,
+        roughness: f32,
+    ) -> BsdfModel {
+        match self.kind {
+            MaterialKind::Diffuse => BsdfModel::Diffuse(color),
+            MaterialKind::Mirror => BsdfModel::Mirror(color),
+            MaterialKind::Dielectric => BsdfModel::Dielectric {
+                ior: self.ior,
+                tint: color,
+            },
+            MaterialKind::MetallicRoughness => BsdfModel::MetallicRoughness(MetallicRoughness {
+                base_color: color,
+                metallic,
+                roughness,
+                ior: self.ior,
+                transmission: self.transmission,
+            }),
+        }
     }
 }

@@ -304,8 +304,7 @@ impl Scene {
                 })
             };
             let (roughness, metallic) = (m.roughness * texture_min(1), m.metallic * texture_min(2));
-            let smoothest =
-                crate::bsdf::BsdfModel::textured(m, Spectrum::from(m.color), metallic, 0.0);
+            let smoothest = m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0);
             roughness == 0.0 && {
                 let lobes = smoothest.lobes();
                 lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()

@@ -5,8 +5,8 @@
 //! Attributes are stored per triangle corner in the backend's internal triangle order, so a
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
-use super::{Material, TextureRef};
-use crate::bsdf::{Bsdf, BsdfModel};
+use super::material::{Material, TextureRef};
+use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::spectrum::Spectrum;
 use crate::texture::Texture;
@@ -296,7 +296,7 @@ impl SurfacePoint<'_> {
     pub fn bsdf(&self, geometric_normal: Vec3A) -> Bsdf {
         if self.attributes.is_flat(self.material) {
             return Bsdf::new(
-                BsdfModel::of(self.material),
+                self.material.bsdf_model(),
                 geometric_normal,
                 geometric_normal,
             );
@@ -310,7 +310,7 @@ impl SurfacePoint<'_> {
             roughness *= texel.y;
             metallic *= texel.z;
         }
-        let model = BsdfModel::textured(m, color, metallic, roughness);
+        let model = m.textured_bsdf_model(color, metallic, roughness);
         Bsdf::new(
             model,
             self.shading_normal(geometric_normal),
