@@ -1083,7 +1083,12 @@ fn embree_backend_builds_with_the_feature() {
     let (status, hits) = scene.intersect(&[ray([0.5, 1.0, 0.25], [0.0, 2.0, 0.0])]);
     assert_ok(status);
     assert!(hits[0].triangle_id >= 2, "the upward ray hits the light");
-    assert_eq!(hits[0].t, 0.5, "t in multiples of the direction");
+    // Embree's t may be an ulp off (3.13.5 reports 0.49999997 on some CPUs).
+    assert!(
+        (hits[0].t - 0.5).abs() <= 2.0 * f32::EPSILON,
+        "t in multiples of the direction: {}",
+        hits[0].t
+    );
 }
 
 // ---------------------------------------------------------------------------------------

@@ -67,10 +67,13 @@ fn bdpt_agrees_with_the_path_tracer() {
     );
 }
 
-/// A Metropolis algorithm (or ERPT, whose camera samples are BDPT's) against BDPT.
-fn agrees_with_bdpt(algorithm: Algorithm) {
+/// A Metropolis algorithm (or ERPT, whose camera samples are BDPT's) against BDPT; path-space
+/// perturbations turning directions and microfacets, or stepping them in their samplings'
+/// coordinates.
+fn agrees_with_bdpt(algorithm: Algorithm, perturb_in_sample_space: bool) {
     let settings = RenderSettings {
         algorithm,
+        perturb_in_sample_space,
         samples_per_pixel: 40,
         mutations_per_pixel: 128,
         bootstrap_samples: 1 << 16,
@@ -78,7 +81,9 @@ fn agrees_with_bdpt(algorithm: Algorithm) {
         ..Default::default()
     };
     assert_estimates_agree(
-        &format!("surfaces {algorithm:?} against BDPT"),
+        &format!(
+            "surfaces {algorithm:?} (perturbing in sample space: {perturb_in_sample_space}) against BDPT"
+        ),
         &estimate(settings, 16),
         bdpt_reference(),
         4,
@@ -90,15 +95,19 @@ fn agrees_with_bdpt(algorithm: Algorithm) {
 #[test]
 fn primary_space_metropolis_agrees_with_bdpt() {
     for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt, Algorithm::Mmlt] {
-        agrees_with_bdpt(algorithm);
+        agrees_with_bdpt(algorithm, false);
     }
 }
 
+/// Through the scene's glossy vertices (rough gold, rough glass) the perturbations move
+/// microfacets (perturbation.rs); the glossy plastic, a rough coat over a diffuse base, is a
+/// diffuse vertex to them.
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt() {
     for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
-        agrees_with_bdpt(algorithm);
+        agrees_with_bdpt(algorithm, false);
     }
+    agrees_with_bdpt(Algorithm::PathSpaceMlt, true);
 }
 
 /// Writes the BDPT reference at 256², for looking at (`MLT_WRITE_SURFACES=DIR`).

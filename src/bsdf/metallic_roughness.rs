@@ -52,6 +52,15 @@ pub(crate) struct MetallicRoughness {
     pub transmission: f32,
 }
 
+/// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Microfacet {
+    /// Its normal, on the side of the direction it scatters.
+    pub normal: Vec3A,
+    /// Whether it refracts (else it reflects).
+    pub refracts: bool,
+}
+
 /// The surface as seen from `wo`: a frame around the normal on wo's side and the indices on
 /// wo's side and the other (front outside with index 1, back inside with index `ior`).
 struct View {
@@ -311,6 +320,112 @@ impl MetallicRoughness {
                 refracted(self.ior, normal, wo)
             }
             SpecularLobe::Refraction => None,
+        }
+    }
+
+    /// The microfacet through which a rough material scatters `wo` into `wi`: the half
+    /// vector of a reflection, the generalized one of a refraction (on wo's side). `None` at
+    /// roughness 0, or where no microfacet scatters wo into wi.
+    pub fn microfacet(&self, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Option<Microfacet> {
+        self.distribution()?;
+        let view = View::of(self.ior, normal, wo)?;
+        let local = view.local(wi);
+        let (h, refracts) = if local.z > 0.0 {
+            let h = (view.wo + local).normalize();
+            (h, false)
+        } else if local.z < 0.0 && !self.transmission_tint().is_black() {
+            (refraction_half_vector(&view, local)?.0, true)
+        } else {
+            return None;
+        };
+        (h.z > 0.0 && view.wo.dot(h) > 0.0).then(|| Microfacet {
+            normal: view.basis.to_world(h),
+            refracts,
+        })
+    }
+
+    /// The direction `wo` scatters into through microfacet `m` (the inverse of
+    /// [`Self::microfacet`]), or `None` if m is not on wo's side, the refraction is totally
+    /// reflected, or the direction is not one the lobe scatters into.
+    pub fn scatter_through(&self, normal: Vec3A, wo: Vec3A, m: Microfacet) -> Option<Vec3A> {
+        let view = View::of(self.ior, normal, wo)?;
+        let h = view.local(m.normal);
+        if h.z <= 0.0 {
+            return None;
+        }
+        let local = if m.refracts {
+            if self.transmission_tint().is_black() {
+                return None;
+            }
+            refract_through(view.wo, h, view.eta()).filter(|wi| wi.z < 0.0)?
+        } else {
+            Some(reflect(view.wo, h)).filter(|wi| wi.z > 0.0 && view.wo.dot(h) > 0.0)?
+        };
+        Some(view.basis.to_world(local))
+    }
+
+    /// The coordinates of microfacet normal `m` in the sampling of the normals visible from
+    /// `wo` ([`TrowbridgeReitz::visible_normal_coordinates`]).
+    pub fn microfacet_coordinates(&self, normal: Vec3A, wo: Vec3A, m: Vec3A) -> Option<[f32; 2]> {
+        let distribution = self.distribution()?;
+        let view = View::of(self.ior, normal, wo)?;
+        distribution.visible_normal_coordinates(view.wo, view.local(m))
+    }
+
+    /// The microfacet normal visible from `wo` at coordinates `u` of their sampling.
+    pub fn microfacet_at(
+        &self,
+        normal: Vec3A,
+        wo: Vec3A,
+        u: [f32; 2],
+        refracts: bool,
+    ) -> Option<Microfacet> {
+        let distribution = self.distribution()?;
+        let view = View::of(self.ior, normal, wo)?;
+        let h = distribution.sample_visible_normal(view.wo, u);
+        Some(Microfacet {
+            normal: view.basis.to_world(h),
+            refracts,
+        })
+    }
+
+    /// The density, per unit solid angle of `wi`, of a direction found through a microfacet
+    /// normal that has unit density per unit solid angle (`in_sample_space` false) or per
+    /// unit area of its visible-normal coordinates (true): dω_m/dω_i, times the
+    /// visible-normal density of m in the second case. 0 where no microfacet scatters `wo`
+    /// into `wi`.
+    pub fn microfacet_step_density(
+        &self,
+        normal: Vec3A,
+        wo: Vec3A,
+        wi: Vec3A,
+        in_sample_space: bool,
+    ) -> f32 {
+        let (Some(distribution), Some(view)) =
+            (self.distribution(), View::of(self.ior, normal, wo))
+        else {
+            return 0.0;
+        };
+        let local = view.local(wi);
+        let (h, jacobian) = if local.z > 0.0 {
+            let h = (view.wo + local).normalize();
+            (h, 1.0 / (4.0 * view.wo.dot(h)))
+        } else if let Some((h, cos_oh, cos_ih)) = refraction_half_vector(&view, local) {
+            let denominator = view.eta_o * cos_oh + view.eta_t * cos_ih;
+            (
+                h,
+                view.eta_t * view.eta_t * cos_ih.abs() / (denominator * denominator),
+            )
+        } else {
+            return 0.0;
+        };
+        if !(jacobian.is_finite() && jacobian > 0.0) {
+            return 0.0;
+        }
+        if in_sample_space {
+            jacobian * distribution.visible_normal_pdf(view.wo, h)
+        } else {
+            jacobian
         }
     }
 

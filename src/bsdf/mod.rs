@@ -15,7 +15,7 @@ mod microfacet;
 mod scattering;
 
 pub use dielectric::fresnel_dielectric;
-pub(crate) use metallic_roughness::MetallicRoughness;
+pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 
@@ -202,6 +202,73 @@ impl Bsdf {
     pub fn specular_direction(&self, wo: Vec3A, lobe: SpecularLobe) -> Option<Vec3A> {
         let wi = specular_direction(&self.model, self.normal, wo, lobe)?;
         (!self.shading_normal_differs || self.sides_agree(wo, wi)).then_some(wi)
+    }
+}
+
+/// Glossy vertices: a rough surface's scattering through its microfacets, for perturbations
+/// that move a glossy path's microfacet normals (in their sampling's coordinates or by a
+/// small turn) instead of its directions. `None` or 0 for models without a glossy lobe.
+impl Bsdf {
+    /// Whether every lobe is glossy (Veach's classes extended by a third: a glossy vertex
+    /// has a density, so it connects, and a direction found through a moved microfacet
+    /// follows its lobe).
+    #[inline]
+    pub fn is_glossy(&self) -> bool {
+        self.lobes() == BsdfLobes::GLOSSY
+    }
+
+    /// The microfacet that scatters `wo` into `wi`.
+    #[inline]
+    pub fn microfacet(&self, wo: Vec3A, wi: Vec3A) -> Option<Microfacet> {
+        match &self.model {
+            BsdfModel::MetallicRoughness(m) => m.microfacet(self.normal, wo, wi),
+            _ => None,
+        }
+    }
+
+    /// The direction `wo` scatters into through microfacet `m`.
+    #[inline]
+    pub fn scatter_through(&self, wo: Vec3A, m: Microfacet) -> Option<Vec3A> {
+        let wi = match &self.model {
+            BsdfModel::MetallicRoughness(model) => model.scatter_through(self.normal, wo, m)?,
+            _ => return None,
+        };
+        (!self.shading_normal_differs || self.sides_agree(wo, wi)).then_some(wi)
+    }
+
+    /// The coordinates of microfacet normal `m` in the sampling of those visible from `wo`.
+    #[inline]
+    pub fn microfacet_coordinates(&self, wo: Vec3A, m: Vec3A) -> Option<[f32; 2]> {
+        match &self.model {
+            BsdfModel::MetallicRoughness(model) => model.microfacet_coordinates(self.normal, wo, m),
+            _ => None,
+        }
+    }
+
+    /// The microfacet visible from `wo` at coordinates `u` of their sampling.
+    #[inline]
+    pub fn microfacet_at(&self, wo: Vec3A, u: [f32; 2], refracts: bool) -> Option<Microfacet> {
+        match &self.model {
+            BsdfModel::MetallicRoughness(model) => {
+                model.microfacet_at(self.normal, wo, u, refracts)
+            }
+            _ => None,
+        }
+    }
+
+    /// The density of `wi` found through a microfacet moved in solid angle or in its
+    /// sampling's coordinates (see `MetallicRoughness::microfacet_step_density`).
+    #[inline]
+    pub fn microfacet_step_density(&self, wo: Vec3A, wi: Vec3A, in_sample_space: bool) -> f32 {
+        if self.shading_normal_differs && !self.sides_agree(wo, wi) {
+            return 0.0;
+        }
+        match &self.model {
+            BsdfModel::MetallicRoughness(model) => {
+                model.microfacet_step_density(self.normal, wo, wi, in_sample_space)
+            }
+            _ => 0.0,
+        }
     }
 }
 

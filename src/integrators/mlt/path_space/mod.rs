@@ -59,6 +59,14 @@ use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::PI;
 
+/// A vertex's class for the perturbations (see [`PathSpace::class`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum VertexClass {
+    Diffuse,
+    Glossy,
+    Specular,
+}
+
 /// The scene and camera a path lives in, with the functions that evaluate paths.
 pub(crate) struct PathSpace<'a> {
     pub scene: &'a Scene,
@@ -88,13 +96,31 @@ impl PathSpace<'_> {
     }
 
     /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
-    /// specular, else `D`. A glossy lobe counts as `D`, like a diffuse one: it has a density,
-    /// so connections and the perturbations' direction densities work there as at a diffuse
-    /// vertex (a sharp glossy lobe is then explored poorly by them, not wrongly).
-    /// Lights that are not triangles are `D`: they have no surface to scatter.
+    /// specular, else `D`: a glossy lobe has a density, so connections and the
+    /// bidirectional mutation treat it as a diffuse one. (The perturbations tell glossy
+    /// vertices apart: see [`Self::class`].) Lights that are not triangles are `D`: they
+    /// have no surface to scatter.
     #[inline]
     fn is_specular(&self, v: &PathVertex) -> bool {
         v.light.is_none() && self.surface_bsdf(v).lobes().is_specular()
+    }
+
+    /// Veach's classes with a third for the perturbations: `S`, `G` (every lobe glossy:
+    /// a perturbation moves its microfacet and traces on, as through a specular vertex, so
+    /// the path follows a sharp lobe instead of connecting across it) and `D`.
+    #[inline]
+    fn class(&self, v: &PathVertex) -> VertexClass {
+        if v.light.is_some() {
+            return VertexClass::Diffuse;
+        }
+        let bsdf = self.surface_bsdf(v);
+        if bsdf.lobes().is_specular() {
+            VertexClass::Specular
+        } else if bsdf.is_glossy() {
+            VertexClass::Glossy
+        } else {
+            VertexClass::Diffuse
+        }
     }
 
     /// The vertex `ray` hits first, or `None` if it escapes.
@@ -632,8 +658,14 @@ mod tests {
         fn film_offset(&mut self) -> [f32; 2] {
             self.film_offset
         }
-        fn direction(&mut self, old: Vec3A, _: Vec3A, _: Vec3A) -> Option<Vec3A> {
-            Some(Vec3A::from(self.rotation * glam::Vec3::from(old)))
+        fn turn(&mut self, w: Vec3A) -> Vec3A {
+            Vec3A::from(self.rotation * glam::Vec3::from(w))
+        }
+        fn step(&mut self, u: [f32; 2]) -> [f32; 2] {
+            u
+        }
+        fn in_sample_space(&self) -> bool {
+            false
         }
     }
 

@@ -1,21 +1,28 @@
 //! Veach's perturbations (thesis §11.4.3–11.4.4): small moves that keep a path's length and
-//! its pattern of specular (S) and non-specular (D) vertices, for the features bidirectional
-//! mutations find hard to explore (caustics, glossy and mirrored views).
+//! its pattern of vertex classes, for the features bidirectional mutations find hard to
+//! explore (caustics, glossy and mirrored views).
 //!
-//! - **Lens perturbation** (paths `… D D S* E`, or `L S* E`): move the film point by a
-//!   random offset, trace from the (unchanged) lens point through the same specular lobes
-//!   to a non-specular vertex, and connect it to the kept vertex before it.
-//! - **Multi-chain perturbation** (`… S D S* E`, where the lens perturbation cannot connect):
-//!   as the lens perturbation, but at each non-specular vertex whose predecessor is specular
-//!   the direction onwards is perturbed by a small angle and traced through the next
-//!   specular chain, until a vertex can be connected (or the light is reached).
-//! - **Caustic perturbation** (`… D S+ D E`): perturb the direction leaving the non-specular
-//!   vertex before the specular chain by a small angle, trace through the chain to a new
-//!   last vertex and connect it to the lens.
+//! Veach classes vertices as specular (S) or not (D). A sharp glossy lobe is neither: it
+//! has a density, so a connection can end there, but a connection across it (or a
+//! direction turned at random) is almost always outside the lobe. So the perturbations
+//! know a third class, G (`PathSpace::class`: every lobe glossy), and trace through glossy
+//! vertices as through specular ones, moving each one's microfacet by a small step instead
+//! of keeping its lobe exactly (below). "Chain" means a run of S and G vertices.
+//!
+//! - **Lens perturbation** (paths `… D D (S|G)* E`, or `L (S|G)* E`): move the film point by
+//!   a random offset, trace from the (unchanged) lens point through the chain to a diffuse
+//!   vertex, and connect it to the kept vertex before it (D or G).
+//! - **Multi-chain perturbation** (`… S D (S|G)* E`, where the lens perturbation cannot
+//!   connect): as the lens perturbation, but at each diffuse vertex whose predecessor is
+//!   specular the direction onwards is perturbed by a small angle and traced through the
+//!   next chain, until a vertex can be connected (or the light is reached).
+//! - **Caustic perturbation** (`… D (S|G)+ D E`): perturb the direction leaving the diffuse
+//!   vertex before the chain by a small angle, trace through the chain to a new last vertex
+//!   and connect it to the lens.
 //!
 //! Lights that are not triangles: the lens and multi-chain perturbations keep x_0 unless
-//! they trace to it (`L S* E`), and then a light at infinity is found by a ray that leaves
-//! the scene, a triangle by one that hits it: a proposal whose light changes kind is
+//! they trace to it (`L (S|G)* E`), and then a light at infinity is found by a ray that
+//! leaves the scene, a triangle by one that hits it: a proposal whose light changes kind is
 //! refused (both ways), so the perturbations keep the light's kind and with it the
 //! applicable perturbations. The caustic perturbation does not apply when its chain starts
 //! at a light that is not a triangle (`L S+ D E` under a point light or from infinity): a
@@ -31,35 +38,44 @@
 //! T in path measure, the symmetric kernels cancel and what remains are the Jacobians from
 //! film coordinates or directions to the moved vertices. Those are the densities of BDPT's
 //! strategy with the same split, with the specular lobes taken as given (`lobes_sampled`
-//! false: a perturbation keeps each vertex's lobe) and without the BSDF density of the
-//! perturbed directions (the kernel replaced it). So, with s the kept light vertices:
+//! false: a perturbation keeps each vertex's lobe), except at the vertices d whose
+//! direction onwards the move chose (turned, or found through a moved microfacet): C_s
+//! divided by their sampling density p_σ(ω_d), while the move's density there is the
+//! kernel's times q(ω_d), the Jacobian of its map onto the direction. So, with s the kept
+//! light vertices:
 //!
 //! ```text
-//! f(y) T(y→x)   |C_s(y)| · Π p_σ(y, ω_d)
-//! ----------- = ------------------------
-//! f(x) T(x→y)   |C_s(x)| · Π p_σ(x, ω_d)
+//! f(y) T(y→x)   |C_s(y)| · Π p_σ(y, ω_d) / q(y, ω_d)
+//! ----------- = -----------------------------------
+//! f(x) T(x→y)   |C_s(x)| · Π p_σ(x, ω_d) / q(x, ω_d)
 //! ```
 //!
-//! over the vertices d whose outgoing direction was perturbed (their BSDF or emission
-//! density of that direction, which C_s divided by). The film offset needs no such factor:
-//! the camera samples film points uniformly, and C_s's camera factor is already per unit of
-//! film area.
+//! (`moved_direction_factor`). A turned direction has q = 1. A glossy vertex's direction
+//! is found through a microfacet normal m turned within the cone, keeping its reflection or
+//! refraction: q = dω_m/dω_d (Walter et al. 2007), and p_σ / q is the lobe's
+//! probability times the density of visible normals D_ω(m) (Heitz 2018). The film offset
+//! needs no factor: the camera samples film points uniformly, and C_s's camera factor is
+//! already per unit of film area.
 //!
 //! # Steps in the BSDF's sample space
 //!
 //! With `RandomKernel::in_sample_space`, a direction is perturbed where the vertex samples
-//! it: its coordinates u in the vertex's cosine-weighted sampling (the BSDF's of a diffuse
-//! surface, the emission's of a light; p_σ = cos θ / π either way) take a small symmetric
-//! step, and the new direction is the sampling's image of the new u at the new vertex. The
-//! steps are then shaped by the BSDF: wide where it is wide, fine towards grazing angles,
-//! where cos θ changes fast. The map from u to directions has Jacobian 1 / p_σ, so
-//! T(x→y) = k(u_y − u_x) · p_σ(y, ω_d) per unit solid angle, and in the ratio above the
-//! p_σ of both paths cancel against the kernel's: it is |C_s(y)| / |C_s(x)|.
+//! it: its coordinates u in the vertex's sampling take a small symmetric step, and the new
+//! direction is the sampling's image of the new u at the new vertex. At a diffuse vertex or
+//! a light that is the cosine-weighted sampling (p_σ = cos θ / π for a Lambertian surface or
+//! an emitter): the steps are wide where the lobe is wide and fine towards grazing angles.
+//! At a glossy vertex it is the sampling of the normals visible from the direction the
+//! path arrives from (`TrowbridgeReitz::visible_normal_coordinates` inverts it): the steps
+//! follow the lobe, fine where it is sharp. The map from u to directions has Jacobian
+//! 1 / q with q the sampling's own density (cos θ / π; D_ω(m) dω_m/dω_d), so the symmetric
+//! step cancels and, where q is the BSDF's whole density, so does p_σ / q: a Lambertian or
+//! metal vertex adds no factor, a rough glass one the probability of its reflection or
+//! refraction.
 
 use super::bidirectional::Proposal;
-use super::{PathSpace, PathVertex, direction};
+use super::{PathSpace, PathVertex, VertexClass, direction};
 use crate::accel::Ray;
-use crate::bsdf::SpecularLobe;
+use crate::bsdf::{Microfacet, SpecularLobe};
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
 use crate::scene::lights::Emitter;
@@ -152,19 +168,20 @@ fn reflect_into_unit(u: f32) -> f32 {
     if v > 1.0 { 2.0 - v } else { v }
 }
 
-/// Where a perturbation's random moves come from.
+/// Where a perturbation's random moves come from. Each is symmetric: a move and its
+/// reverse have the same density.
 pub(crate) trait Kernel {
     /// An offset of the film position, in pixels.
     fn film_offset(&mut self) -> [f32; 2];
-    /// A direction near `old`, which left a vertex sampling directions around `old_side`
-    /// (its sampling hemisphere's normal), for a vertex sampling around `new_side`.
-    /// `None`: the new direction has no density there (the move is refused).
-    fn direction(&mut self, old: Vec3A, old_side: Vec3A, new_side: Vec3A) -> Option<Vec3A>;
-    /// Whether the direction's density is the vertex's sampling density p_σ times a
-    /// symmetric factor, so that the p_σ cancel from the ratio (see the module docs).
-    fn follows_sampling_density(&self) -> bool {
-        false
-    }
+    /// `w` turned by a small angle, with a density on the sphere that depends only on the
+    /// angle.
+    fn turn(&mut self, w: Vec3A) -> Vec3A;
+    /// Sample-space coordinates moved by a small step: u[0] folded into [0, 1] at both
+    /// ends, u[1] (an angle) wrapped.
+    fn step(&mut self, u: [f32; 2]) -> [f32; 2];
+    /// Whether directions and microfacets move in their samplings' coordinates (`step`)
+    /// rather than by turns (see the module docs).
+    fn in_sample_space(&self) -> bool;
 }
 
 /// The perturbations' kernels: symmetric, of the given sizes; directions turned within a
@@ -184,27 +201,80 @@ impl Kernel for RandomKernel<'_> {
     }
 
     #[inline]
-    fn direction(&mut self, old: Vec3A, old_side: Vec3A, new_side: Vec3A) -> Option<Vec3A> {
-        if !self.in_sample_space {
-            return Some(perturb_direction(old, self.sizes, self.rng));
-        }
+    fn turn(&mut self, w: Vec3A) -> Vec3A {
+        perturb_direction(w, self.sizes, self.rng)
+    }
+
+    #[inline]
+    fn step(&mut self, [u1, u2]: [f32; 2]) -> [f32; 2] {
         // A step of log-uniform length towards a uniform angle: symmetric in u.
-        let [u1, u2] = to_sample_space(old_side, old);
         let length = log_uniform(
             self.sizes.angle_min,
             self.sizes.angle_max,
             self.rng.uniform(),
         );
         let (sin, cos) = (TAU * self.rng.uniform()).sin_cos();
-        let u1 = reflect_into_unit(u1 + length * cos);
-        let u2 = (u2 + length * sin).rem_euclid(1.0);
-        // At u1 = 1 the direction is tangent to the surface: density 0.
-        (u1 < 1.0).then(|| from_sample_space(new_side, [u1, u2]))
+        [
+            reflect_into_unit(u1 + length * cos),
+            (u2 + length * sin).rem_euclid(1.0),
+        ]
     }
 
-    fn follows_sampling_density(&self) -> bool {
+    fn in_sample_space(&self) -> bool {
         self.in_sample_space
     }
+}
+
+/// A direction near `old`, which left a diffuse vertex (or a light) sampling directions
+/// around `old_side` (its sampling hemisphere's normal), for the vertex sampling around
+/// `new_side`: turned, or stepped in the cosine-weighted sampling's coordinates. `None`:
+/// the new direction has no density there (the move is refused).
+#[inline]
+fn perturbed_direction(
+    kernel: &mut impl Kernel,
+    old: Vec3A,
+    old_side: Vec3A,
+    new_side: Vec3A,
+) -> Option<Vec3A> {
+    if !kernel.in_sample_space() {
+        return Some(kernel.turn(old));
+    }
+    let [u1, u2] = kernel.step(to_sample_space(old_side, old));
+    // At u1 = 1 the direction is tangent to the surface: density 0.
+    (u1 < 1.0).then(|| from_sample_space(new_side, [u1, u2]))
+}
+
+/// The direction onwards from glossy vertex `at` of y, arrived at from `from`: through x's
+/// microfacet at its vertex (`x_at`, between `x_from` and `x_onwards`), moved by the
+/// kernel (turned, or stepped in the coordinates of the normals visible from y's
+/// direction back), keeping its reflection or refraction. `None` if the moved microfacet
+/// does not scatter the path onwards.
+#[inline]
+fn glossy_onwards(
+    space: &PathSpace,
+    kernel: &mut impl Kernel,
+    [x_from, x_at, x_onwards]: [&PathVertex; 3],
+    from: &PathVertex,
+    at: &PathVertex,
+) -> Option<Vec3A> {
+    let (wo_x, _) = direction(x_at, x_from)?;
+    let (wi_x, _) = direction(x_at, x_onwards)?;
+    let bsdf_x = space.surface_bsdf(x_at);
+    let microfacet = bsdf_x.microfacet(wo_x, wi_x)?;
+    let (wo, _) = direction(at, from)?;
+    let bsdf = space.surface_bsdf(at);
+    let moved = if kernel.in_sample_space() {
+        // The sampling's coordinates are (azimuth, cap height): step folds the second.
+        let [azimuth, height] = bsdf_x.microfacet_coordinates(wo_x, microfacet.normal)?;
+        let [height, azimuth] = kernel.step([height, azimuth]);
+        bsdf.microfacet_at(wo, [azimuth, height], microfacet.refracts)?
+    } else {
+        Microfacet {
+            normal: kernel.turn(microfacet.normal),
+            ..microfacet
+        }
+    };
+    bsdf.scatter_through(wo, moved)
 }
 
 /// The normal of the hemisphere vertex `at` samples directions in: a light's front, or a
@@ -224,17 +294,18 @@ fn sampling_side(from: Option<&PathVertex>, at: &PathVertex) -> Vec3A {
     }
 }
 
-/// The first non-specular vertex before the lens (the light, x_0, at the latest).
+/// The first diffuse vertex before the lens (the light, x_0, at the latest): where the
+/// lens perturbation's chain of specular and glossy vertices from the lens ends.
 #[inline]
-fn first_non_specular_from_lens(space: &PathSpace, x: &[PathVertex]) -> usize {
+fn first_diffuse_from_lens(space: &PathSpace, x: &[PathVertex]) -> usize {
     (1..x.len() - 1)
         .rev()
-        .find(|&k| !space.is_specular(&x[k]))
+        .find(|&k| space.class(&x[k]) == VertexClass::Diffuse)
         .unwrap_or(0)
 }
 
-/// Which perturbations a path admits. Perturbations keep the pattern of specular vertices,
-/// so a proposal admits the same ones as the path it came from.
+/// Which perturbations a path admits. Perturbations keep the path's pattern of vertex
+/// classes, so a proposal admits the same ones as the path it came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Applicable {
     /// The lens perturbation (else the multi-chain one: exactly one applies).
@@ -244,26 +315,26 @@ pub(crate) struct Applicable {
 
 pub(crate) fn applicable(space: &PathSpace, x: &[PathVertex]) -> Applicable {
     let n = x.len();
-    let m = first_non_specular_from_lens(space, x);
+    let m = first_diffuse_from_lens(space, x);
     let lens = m == 0 || !space.is_specular(&x[m - 1]);
     // A light that is not a triangle (a point light, a direction) has no emitted direction
     // to perturb (a direction's emission starts anywhere on a disc): the caustic
     // perturbation applies only where its chain starts at a surface. The perturbations keep
     // the light's kind, so this too is the same at x and at its proposals.
     let caustic = n >= 4
-        && !space.is_specular(&x[n - 2])
-        && space.is_specular(&x[n - 3])
+        && space.class(&x[n - 2]) == VertexClass::Diffuse
+        && space.class(&x[n - 3]) != VertexClass::Diffuse
         && (x[0].light.is_none() || caustic_start(space, x) > 0);
     Applicable { lens, caustic }
 }
 
-/// The non-specular vertex the caustic perturbation turns: where the specular chain before
-/// x_{n-2} starts (x_0, the light, at the latest).
+/// The diffuse vertex the caustic perturbation turns: where the chain of specular and
+/// glossy vertices before x_{n-2} starts (x_0, the light, at the latest).
 #[inline]
 fn caustic_start(space: &PathSpace, x: &[PathVertex]) -> usize {
     (1..x.len() - 3)
         .rev()
-        .find(|&k| !space.is_specular(&x[k]))
+        .find(|&k| space.class(&x[k]) == VertexClass::Diffuse)
         .unwrap_or(0)
 }
 
@@ -291,6 +362,37 @@ fn direction_density(
             None => 0.0,
         },
     }
+}
+
+/// At a vertex whose direction onwards (towards `onwards`) a perturbation moved: the
+/// density C_s divides by there over the density of the kernel's map onto that direction
+/// (module docs). A diffuse vertex or light, `from` its predecessor on the side that moved
+/// it (`None` at a light): p_σ, over cos θ / π in sample space; a glossy vertex: p_σ over
+/// the moved microfacet's density.
+fn moved_direction_factor(
+    space: &PathSpace,
+    in_sample_space: bool,
+    from: Option<&PathVertex>,
+    at: &PathVertex,
+    onwards: &PathVertex,
+) -> f32 {
+    let Some((wi, _)) = direction(at, onwards) else {
+        return 0.0;
+    };
+    let density = direction_density(space, from, at, wi);
+    if space.class(at) == VertexClass::Glossy
+        && let Some((wo, _)) = from.and_then(|from| direction(at, from))
+    {
+        let step = space
+            .surface_bsdf(at)
+            .microfacet_step_density(wo, wi, in_sample_space);
+        return if step > 0.0 { density / step } else { 0.0 };
+    }
+    if in_sample_space {
+        let cosine = wi.dot(sampling_side(from, at)) * FRAC_1_PI;
+        return if cosine > 0.0 { density / cosine } else { 0.0 };
+    }
+    density
 }
 
 /// The lens perturbation, or with `multi_chain` the multi-chain perturbation, of `x` into
@@ -328,9 +430,9 @@ pub(crate) fn lens(
     let mut k = n - 2;
     let s = loop {
         if k == 0 {
-            // x's light was seen through the specular chain: so must y's, a light of the
-            // same kind (a surface, or a direction at infinity, which a ray that leaves the
-            // scene finds), so that the proposal admits the same perturbations as x.
+            // x's light was seen through the chain: so must y's, a light of the same kind
+            // (a surface, or a direction at infinity, which a ray that leaves the scene
+            // finds), so that the proposal admits the same perturbations as x.
             let v = match x[0].light {
                 None => {
                     let v = space.trace(&ray, rays)?;
@@ -354,56 +456,73 @@ pub(crate) fn lens(
             break 0;
         }
         let v = space.trace(&ray, rays)?;
-        let specular = space.is_specular(&v);
-        if specular != space.is_specular(&x[k]) {
+        let class = space.class(&v);
+        if class != space.class(&x[k]) {
             return None;
         }
         y[k] = v;
-        if specular {
-            let (wo, _) = direction(&y[k], &y[k + 1])?;
-            let next = space
-                .surface_bsdf(&v)
-                .specular_direction(wo, lobe_at(x, k)?)?;
-            ray = spawn_ray(space.scene, v.p, v.normal, next);
-            k -= 1;
-            continue;
-        }
-        if !space.is_specular(&x[k - 1]) {
-            // Connect to the kept vertex before it.
-            if !space.visible(&y[k], &y[k - 1], false, rays) {
-                return None;
+        let next = match class {
+            VertexClass::Specular => {
+                let (wo, _) = direction(&y[k], &y[k + 1])?;
+                space
+                    .surface_bsdf(&v)
+                    .specular_direction(wo, lobe_at(x, k)?)?
             }
-            break k;
-        }
-        // Multi-chain: perturb the direction onwards and trace the next specular chain.
-        let (old, _) = direction(&x[k], &x[k - 1])?;
-        let new = kernel.direction(
-            old,
-            sampling_side(Some(&x[k + 1]), &x[k]),
-            sampling_side(Some(&y[k + 1]), &y[k]),
-        )?;
-        ray = spawn_ray(space.scene, v.p, v.normal, new);
+            VertexClass::Glossy => {
+                glossy_onwards(space, kernel, [&x[k + 1], &x[k], &x[k - 1]], &y[k + 1], &v)?
+            }
+            VertexClass::Diffuse => {
+                if !space.is_specular(&x[k - 1]) {
+                    // Connect to the kept vertex before it.
+                    if !space.visible(&y[k], &y[k - 1], false, rays) {
+                        return None;
+                    }
+                    break k;
+                }
+                // Multi-chain: perturb the direction onwards and trace the next chain.
+                let (old, _) = direction(&x[k], &x[k - 1])?;
+                perturbed_direction(
+                    kernel,
+                    old,
+                    sampling_side(Some(&x[k + 1]), &x[k]),
+                    sampling_side(Some(&y[k + 1]), &y[k]),
+                )?
+            }
+        };
+        ray = spawn_ray(space.scene, v.p, v.normal, next);
         k -= 1;
     };
-    if kernel.follows_sampling_density() {
-        return proposal(space, x, y, s, 1.0, 1.0);
-    }
-    let density_y = multi_chain_densities(space, y, s);
-    let density_x = multi_chain_densities(space, x, s);
+    let in_sample_space = kernel.in_sample_space();
+    let density_y = lens_side_factors(space, in_sample_space, y, s);
+    let density_x = lens_side_factors(space, in_sample_space, x, s);
     proposal(space, x, y, s, density_x, density_y)
 }
 
-/// The product, over the non-specular vertices of the lens side (after the first s) whose
-/// successor towards the light is specular, of the BSDF density of the direction onwards:
-/// the vertices where the multi-chain perturbation turned the path (none for the lens
-/// perturbation). Taken from the vertices, as C_s takes its directions.
-fn multi_chain_densities(space: &PathSpace, path: &[PathVertex], s: usize) -> f32 {
+/// The product of `moved_direction_factor` over the lens-side vertices (after the first s)
+/// whose direction onwards the lens or multi-chain perturbation moved: the glossy ones, and
+/// the diffuse ones whose successor towards the light is specular (none of those for the
+/// lens perturbation). Taken from the vertices, as C_s takes its directions.
+fn lens_side_factors(
+    space: &PathSpace,
+    in_sample_space: bool,
+    path: &[PathVertex],
+    s: usize,
+) -> f32 {
     let n = path.len();
     (s.max(1)..n - 1)
-        .filter(|&k| !space.is_specular(&path[k]) && space.is_specular(&path[k - 1]))
-        .map(|k| match direction(&path[k], &path[k - 1]) {
-            Some((onwards, _)) => direction_density(space, Some(&path[k + 1]), &path[k], onwards),
-            None => 0.0,
+        .filter(|&k| match space.class(&path[k]) {
+            VertexClass::Glossy => k > s,
+            VertexClass::Diffuse => space.is_specular(&path[k - 1]),
+            VertexClass::Specular => false,
+        })
+        .map(|k| {
+            moved_direction_factor(
+                space,
+                in_sample_space,
+                Some(&path[k + 1]),
+                &path[k],
+                &path[k - 1],
+            )
         })
         .product()
 }
@@ -420,12 +539,12 @@ pub(crate) fn caustic(
     if !applicable(space, x).caustic {
         return None;
     }
-    // The non-specular vertex the specular chain before x_{n-2} starts from.
+    // The diffuse vertex the chain before x_{n-2} starts from.
     let c = caustic_start(space, x);
     let (old, _) = direction(&x[c], &x[c + 1])?;
     let from = c.checked_sub(1).map(|i| &x[i]);
     let side = sampling_side(from, &x[c]);
-    let new = kernel.direction(old, side, side)?;
+    let new = perturbed_direction(kernel, old, side, side)?;
     if direction_density(space, from, &x[c], new) <= 0.0 {
         return None;
     }
@@ -434,33 +553,49 @@ pub(crate) fn caustic(
     let mut ray = spawn_ray(space.scene, x[c].p, x[c].normal, new);
     for k in c + 1..=n - 2 {
         let v = space.trace(&ray, rays)?;
-        let specular = space.is_specular(&v);
-        if specular != space.is_specular(&x[k]) {
+        let class = space.class(&v);
+        if class != space.class(&x[k]) {
             return None;
         }
         y[k] = v;
-        if k < n - 2 {
+        if k == n - 2 {
+            break;
+        }
+        let next = if class == VertexClass::Glossy {
+            glossy_onwards(space, kernel, [&x[k - 1], &x[k], &x[k + 1]], &y[k - 1], &v)?
+        } else {
             let (wo, _) = direction(&y[k], &y[k - 1])?;
             // x's lobe at k, seen from the light side (x_{k-1} → x_k → x_{k+1}).
             let (wo_x, _) = direction(&x[k], &x[k - 1])?;
             let (wi_x, _) = direction(&x[k], &x[k + 1])?;
             let lobe = SpecularLobe::of(x[k].normal, wo_x, wi_x);
-            let next = space.surface_bsdf(&v).specular_direction(wo, lobe)?;
-            ray = spawn_ray(space.scene, v.p, v.normal, next);
-        }
+            space.surface_bsdf(&v).specular_direction(wo, lobe)?
+        };
+        ray = spawn_ray(space.scene, v.p, v.normal, next);
     }
     if !space.visible(&y[n - 2], &y[n - 1], true, rays) {
         return None;
     }
-    if kernel.follows_sampling_density() {
-        return proposal(space, x, y, n - 1, 1.0, 1.0);
-    }
-    // The densities C_s divided by at x_c, from the vertices as C_s takes them.
-    let density = |path: &[PathVertex]| match direction(&path[c], &path[c + 1]) {
-        Some((onwards, _)) => direction_density(space, from, &path[c], onwards),
-        None => 0.0,
+    // The factors of the moved directions: at x_c and at the glossy vertices after it, from
+    // the light side, as C_s takes them.
+    let in_sample_space = kernel.in_sample_space();
+    let factors = |path: &[PathVertex]| {
+        let at_start = moved_direction_factor(space, in_sample_space, from, &path[c], &path[c + 1]);
+        (c + 1..n - 2)
+            .filter(|&k| space.class(&path[k]) == VertexClass::Glossy)
+            .map(|k| {
+                moved_direction_factor(
+                    space,
+                    in_sample_space,
+                    Some(&path[k - 1]),
+                    &path[k],
+                    &path[k + 1],
+                )
+            })
+            .product::<f32>()
+            * at_start
     };
-    proposal(space, x, y, n - 1, density(x), density(y))
+    proposal(space, x, y, n - 1, factors(x), factors(y))
 }
 
 /// The proposal y of a perturbation of x that kept s light vertices, with the densities of
@@ -473,6 +608,9 @@ fn proposal(
     density_x: f32,
     density_y: f32,
 ) -> Option<Proposal> {
+    if !(density_x > 0.0 && density_y > 0.0) {
+        return None;
+    }
     let (value, pixel) = space.unweighted_contribution(y, s, false)?;
     let (value_x, _) = space.unweighted_contribution(x, s, false)?;
     let ratio = value.luminance() * density_y / (value_x.luminance() * density_x);
@@ -501,8 +639,14 @@ mod tests {
         fn film_offset(&mut self) -> [f32; 2] {
             self.film_offset
         }
-        fn direction(&mut self, old: Vec3A, _: Vec3A, _: Vec3A) -> Option<Vec3A> {
-            Some(Vec3A::from(self.rotation * glam::Vec3::from(old)))
+        fn turn(&mut self, w: Vec3A) -> Vec3A {
+            Vec3A::from(self.rotation * glam::Vec3::from(w))
+        }
+        fn step(&mut self, u: [f32; 2]) -> [f32; 2] {
+            u
+        }
+        fn in_sample_space(&self) -> bool {
+            false
         }
     }
 
@@ -837,6 +981,49 @@ mod tests {
 
     /// Floor, mirror and light; materials 0 diffuse, 1 mirror, 2 light.
     fn balance_scene() -> Scene {
+        balance_scene_with_floor(Material::diffuse([0.8, 0.6, 0.4]))
+    }
+
+    /// The floor's roughness in the glossy family's scene (α = 0.36).
+    const GLOSSY_FLOOR_ROUGHNESS: f64 = 0.6;
+
+    /// The balance scene with a floor of rough white metal.
+    fn glossy_balance_scene() -> Scene {
+        balance_scene_with_floor(Material::metallic_roughness(
+            [1.0; 3],
+            1.0,
+            GLOSSY_FLOOR_ROUGHNESS as f32,
+        ))
+    }
+
+    /// The floor's BRDF in the glossy scene, from the formulas: GGX D, the height-correlated
+    /// Smith G2 and Fresnel 1 (white metal), for light arriving at floor point p from l and
+    /// leaving towards the eye.
+    fn glossy_floor_brdf(p: DVec3, l: DVec3) -> f64 {
+        let alpha = GLOSSY_FLOOR_ROUGHNESS * GLOSSY_FLOOR_ROUGHNESS;
+        let n = FLOOR.normal();
+        let wo = (Vec3A::from(BALANCE_EYE).as_dvec3() - p).normalize();
+        let wi = (l - p).normalize();
+        let h = (wo + wi).normalize();
+        let cos_h = h.dot(n);
+        let tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h);
+        let d = 1.0
+            / (std::f64::consts::PI
+                * alpha
+                * alpha
+                * cos_h.powi(4)
+                * (1.0 + tan2_h / (alpha * alpha)).powi(2));
+        let lambda = |w: DVec3| {
+            let c = w.dot(n);
+            let tan2 = (1.0 - c * c) / (c * c);
+            0.5 * ((1.0 + alpha * alpha * tan2).sqrt() - 1.0)
+        };
+        let g2 = 1.0 / (1.0 + lambda(wo) + lambda(wi));
+        d * g2 / (4.0 * wo.dot(n) * wi.dot(n))
+    }
+
+    /// Floor, mirror and light; materials 0 the floor's, 1 mirror, 2 light.
+    fn balance_scene_with_floor(floor: Material) -> Scene {
         let mut positions = Vec::new();
         let mut indices = Vec::new();
         let mut material_ids = Vec::new();
@@ -853,7 +1040,7 @@ mod tests {
             indices: &indices,
             material_ids: &material_ids,
             materials: &[
-                Material::diffuse([0.8, 0.6, 0.4]),
+                floor,
                 Material::mirror([0.9, 0.8, 0.7]),
                 Material::diffuse([0.0; 3]).with_emission([4.0, 4.0, 4.0]),
             ],
@@ -906,11 +1093,13 @@ mod tests {
         index(t) * CELLS + index(s)
     }
 
-    /// The path families: light → floor → lens, or light → mirror → floor → lens.
+    /// The path families: light → floor → lens, or light → mirror → floor → lens; or light
+    /// → glossy floor → lens, in the glossy scene.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     enum Family {
         Direct,
         Mirrored,
+        Glossy,
     }
 
     /// ∫ f over each floor cell (normalized), with `m` × `m` nodes per cell and 2m × 2m on
@@ -944,7 +1133,12 @@ mod tests {
                 let w = d / d2.sqrt();
                 let (cos_light, cos_floor) = (n_light.dot(w), -n_floor.dot(w));
                 assert!(cos_light > 0.0 && cos_floor > 0.0);
-                irradiance += light_weight * cos_light * cos_floor / d2;
+                let brdf = if family == Family::Glossy {
+                    glossy_floor_brdf(p, l)
+                } else {
+                    1.0
+                };
+                irradiance += light_weight * cos_light * cos_floor / d2 * brdf;
             }
             target[(j / m) * CELLS + i / m] += weight * irradiance * camera;
         }
@@ -954,14 +1148,16 @@ mod tests {
 
     /// The target ∫ f per floor cell, checked for the quadrature's convergence.
     fn converged_target(family: Family) -> Vec<f64> {
-        let target = floor_target(family, 16);
-        let coarse = floor_target(family, 8);
+        // The glossy highlight needs finer nodes (8 vs 16 differ by 1.8e-3 there).
+        let m = if family == Family::Glossy { 24 } else { 16 };
+        let target = floor_target(family, m);
+        let coarse = floor_target(family, m / 2);
         let error = target
             .iter()
             .zip(&coarse)
             .map(|(t, c)| (c / t - 1.0).abs())
             .fold(0.0, f64::max);
-        println!("{family:?}: quadrature m = 8 vs 16: {error:.1e}");
+        println!("{family:?}: quadrature m = {} vs {m}: {error:.1e}", m / 2);
         // Far below the counts' relative errors (3% and more).
         assert!(error < 1e-3);
         target
@@ -977,10 +1173,30 @@ mod tests {
         let n_floor = FLOOR.normal();
         // G(floor, lens)We is smooth on the floor: 1.25 × its maximum on a fine grid bounds
         // it (and every draw is checked against the bound).
+        // In the glossy family, f/p also has the floor's BRDF: the bound is taken over light
+        // points too.
+        let lights: Vec<DVec3> = if family == Family::Glossy {
+            LIGHT.nodes(12).map(|(_, _, l, _)| l).collect()
+        } else {
+            Vec::new()
+        };
+        let brdf_bound = |p: DVec3| {
+            lights
+                .iter()
+                .map(|&l| glossy_floor_brdf(p, l))
+                .fold(f64::MIN_POSITIVE, f64::max)
+        };
         let bound = 1.25
             * FLOOR
                 .nodes(200)
-                .map(|(_, _, p, _)| film_density(p, n_floor))
+                .map(|(_, _, p, _)| {
+                    let brdf = if family == Family::Glossy {
+                        brdf_bound(p)
+                    } else {
+                        1.0
+                    };
+                    film_density(p, n_floor) * brdf
+                })
                 .fold(0.0, f64::max);
         let mut rng = Rng::new(0xBA1A, family as u64);
         let mut paths = Vec::with_capacity(count);
@@ -1013,7 +1229,12 @@ mod tests {
             if space.is_specular(&floor) || floor.normal != Vec3A::Y {
                 continue;
             }
-            let weight = film_density(floor.p.as_dvec3(), n_floor) / bound;
+            let brdf = if family == Family::Glossy {
+                glossy_floor_brdf(floor.p.as_dvec3(), light.p.as_dvec3())
+            } else {
+                1.0
+            };
+            let weight = film_density(floor.p.as_dvec3(), n_floor) * brdf / bound;
             assert!(weight <= 1.0, "the bound holds at {floor:?}");
             if (rng.uniform() as f64) < weight {
                 path.extend([floor, eye(space.camera)]);
@@ -1286,6 +1507,80 @@ mod tests {
                 })
             })
         });
+    }
+
+    /// The density of the normals visible from the lens at the glossy floor vertex of an
+    /// L G E path, of the microfacet towards the light: what the cone's ratio has and the
+    /// sample-space ratio does not.
+    fn visible_normal_density(space: &PathSpace, path: &[PathVertex]) -> f32 {
+        let (wo, _) = direction(&path[1], &path[2]).unwrap();
+        let (wi, _) = direction(&path[1], &path[0]).unwrap();
+        let bsdf = space.surface_bsdf(&path[1]);
+        bsdf.microfacet_step_density(wo, wi, true) / bsdf.microfacet_step_density(wo, wi, false)
+    }
+
+    /// Lens perturbations of L G E paths through a glossy floor (rough white metal, α =
+    /// 0.36) sample f: the chains move the film point (up to 3 pixels) and the floor's
+    /// microfacet (turned by up to 0.15 rad, or stepped by up to 0.15 in the coordinates of
+    /// the visible normals), tracing on from the new floor point to a new light point. Per
+    /// unit film area and of the microfacet's kernel, f is ∝ the floor's BSDF density of the
+    /// direction found over the density of the map onto it; the ratio gets it from C_s and
+    /// `moved_direction_factor`. The flawed chains leave out (cone) or keep (sample space)
+    /// the visible-normal density, which varies across the highlight.
+    fn glossy_chains_sample_f(in_sample_space: bool) {
+        let scene = glossy_balance_scene();
+        let camera = balance_camera();
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+        };
+        let target = converged_target(Family::Glossy);
+        let starts = family_paths(&space, Family::Glossy, CHAINS);
+        assert!(
+            starts.iter().all(|x| {
+                space.class(&x[1]) == VertexClass::Glossy && applicable(&space, x).lens
+            })
+        );
+        let (low, high) = spread(starts.iter().map(|x| visible_normal_density(&space, x)));
+        println!("visible-normal density over the family: 5% {low:.2}, 95% {high:.2}");
+        assert!(high > 1.7 * low, "the flawed factor varies");
+        let sizes = PerturbationSizes {
+            film_min: 0.1,
+            film_max: 3.0,
+            angle_min: 0.005,
+            angle_max: 0.15,
+        };
+        let (name, flaw) = if in_sample_space {
+            ("glossy lens in sample space", Flaw::WithConeDensities)
+        } else {
+            ("glossy lens", Flaw::WithoutDirectionDensity)
+        };
+        assert_balance(name, &target, &[flaw], |flaw| {
+            final_cells(&starts, 200, |x, y, rng| {
+                let mut kernel = RandomKernel {
+                    sizes: &sizes,
+                    in_sample_space,
+                    rng,
+                };
+                let p = lens(&space, &mut kernel, false, x, y, &mut 0)?;
+                let density = |path: &[PathVertex]| visible_normal_density(&space, path);
+                Some(match flaw {
+                    None => p.ratio,
+                    Some(Flaw::WithConeDensities) => p.ratio * density(y) / density(x),
+                    Some(_) => p.ratio * density(x) / density(y),
+                })
+            })
+        });
+    }
+
+    #[test]
+    fn glossy_lens_chain_samples_f_and_a_ratio_without_the_microfacet_density_does_not() {
+        glossy_chains_sample_f(false);
+    }
+
+    #[test]
+    fn glossy_lens_chain_in_sample_space_samples_f_and_the_cone_ratio_does_not() {
+        glossy_chains_sample_f(true);
     }
 
     /// Sample-space coordinates and directions invert each other, on both sides of a
