@@ -2,8 +2,9 @@
 //! wall-clock time, on the canonical scenes at 256×256, max depth 5, default settings:
 //! cornell-box, cornell-glass (caustics through a glass sphere), door-ajar (a room lit
 //! through the crack of a door), lamp-behind-glass (a room lit only through the glass
-//! cover of a recessed lamp) and window-room (a room lit only by the sky and the sun
-//! through a small window: an environment map and a sun disc).
+//! cover of a recessed lamp), window-room (a room lit only by the sky and the sun
+//! through a small window: an environment map and a sun disc) and cornell-glossy (a rough
+//! metal floor and a rough gold block: glossy interreflection).
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
 //! actual seconds, camera samples and chain mutations per second, the share of mutations
@@ -38,7 +39,7 @@
 //! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
 //! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 2048).
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
-//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass,window-room`).
+//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass,window-room,cornell-glossy`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
 //! - `MLT_BENCH_REPEATS`: renders at the longest budget per thread count (default 1).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
@@ -151,6 +152,7 @@ const DEFAULT_SCENES: &[&str] = &[
     "door-ajar",
     "lamp-behind-glass",
     "window-room",
+    "cornell-glossy",
 ];
 const DEFAULT_MAX_SECONDS: f64 = 10.0;
 /// One time-limited render compared with the reference.
