@@ -1288,7 +1288,7 @@ mod tests {
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
     enum Flaw {
         /// Without the density of the perturbed direction: the caustic perturbation's at
-        /// the light, the multi-chain perturbation's `multi_chain_densities` at the floor.
+        /// the light, the multi-chain perturbation's `lens_side_factors` at the floor.
         WithoutDirectionDensity,
         /// Steps in sample space with the cone's ratio: the densities of the perturbed
         /// directions, which the sample-space kernel's own density cancels, left in.
@@ -1335,6 +1335,51 @@ mod tests {
         }
     }
 
+    /// How a test's chains run: their kernel's sizes and kind, and their length.
+    struct ChainRun {
+        sizes: PerturbationSizes,
+        steps: usize,
+        in_sample_space: bool,
+    }
+
+    /// Chains of one perturbation (`perturb`) from `starts`, paths drawn ∝ f, against
+    /// `target`: with the correct ratio they pass; with the flawed one they fail. The flaw
+    /// is the density the two kernels differ by, `factor`, left out of the cone's ratio
+    /// (`WithoutDirectionDensity`) or left in the sample space's (`WithConeDensities`); it
+    /// must vary over the family for the test to have power.
+    fn kernel_chains_sample_f(
+        name: &str,
+        target: &[f64],
+        starts: &[Vec<PathVertex>],
+        run: ChainRun,
+        factor: impl Fn(&[PathVertex]) -> f32,
+        perturb: impl Fn(&mut RandomKernel, &[PathVertex], &mut Vec<PathVertex>) -> Option<Proposal>,
+    ) {
+        let (low, high) = spread(starts.iter().map(|x| factor(x)));
+        println!("{name}: the flawed factor over the family: 5% {low:.2}, 95% {high:.2}");
+        assert!(high > 1.7 * low, "the flawed factor varies");
+        let (name, flaw) = if run.in_sample_space {
+            (format!("{name} in sample space"), Flaw::WithConeDensities)
+        } else {
+            (name.to_owned(), Flaw::WithoutDirectionDensity)
+        };
+        assert_balance(&name, target, &[flaw], |flaw| {
+            final_cells(starts, run.steps, |x, y, rng| {
+                let mut kernel = RandomKernel {
+                    sizes: &run.sizes,
+                    in_sample_space: run.in_sample_space,
+                    rng,
+                };
+                let p = perturb(&mut kernel, x, y)?;
+                Some(match flaw {
+                    None => p.ratio,
+                    Some(Flaw::WithConeDensities) => p.ratio * factor(y) / factor(x),
+                    Some(_) => p.ratio * factor(x) / factor(y),
+                })
+            })
+        });
+    }
+
     /// cos θ at the light of the direction it emits (the caustic perturbation's direction
     /// density there, times π).
     fn emitted_cosine(path: &[PathVertex]) -> f32 {
@@ -1372,40 +1417,26 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let target = converged_target(Family::Mirrored);
         let starts = family_paths(&space, Family::Mirrored, CHAINS);
         assert!(starts.iter().all(|x| applicable(&space, x).caustic));
-        let (low, high) = spread(starts.iter().map(|x| emitted_cosine(x)));
-        println!("cos θ_light over the family: 5% {low:.2}, 95% {high:.2}");
-        assert!(high > 1.7 * low, "the flawed factor varies");
-        let sizes = PerturbationSizes {
-            film_min: 0.0,
-            film_max: 0.0,
-            angle_min: 0.01,
-            angle_max: 0.5,
+        let run = ChainRun {
+            sizes: PerturbationSizes {
+                film_min: 0.0,
+                film_max: 0.0,
+                angle_min: 0.01,
+                angle_max: 0.5,
+            },
+            steps: 200,
+            in_sample_space,
         };
-        let (name, flaw) = if in_sample_space {
-            ("caustic in sample space", Flaw::WithConeDensities)
-        } else {
-            ("caustic", Flaw::WithoutDirectionDensity)
-        };
-        assert_balance(name, &target, &[flaw], |flaw| {
-            final_cells(&starts, 200, |x, y, rng| {
-                let mut kernel = RandomKernel {
-                    sizes: &sizes,
-                    in_sample_space,
-                    rng,
-                };
-                let p = caustic(&space, &mut kernel, x, y, &mut 0)?;
-                Some(match flaw {
-                    None => p.ratio,
-                    Some(Flaw::WithConeDensities) => {
-                        p.ratio * emitted_cosine(y) / emitted_cosine(x)
-                    }
-                    Some(_) => p.ratio * emitted_cosine(x) / emitted_cosine(y),
-                })
-            })
-        });
+        kernel_chains_sample_f(
+            "caustic",
+            &converged_target(Family::Mirrored),
+            &starts,
+            run,
+            emitted_cosine,
+            |kernel, x, y| caustic(&space, kernel, x, y, &mut 0),
+        );
     }
 
     /// Multi-chain perturbations of L S D E paths (E D S L from the lens: the floor cannot
@@ -1413,7 +1444,7 @@ mod tests {
     /// move the film point (up to 6 pixels) and turn the direction from the floor to the
     /// mirror (up to 0.3 rad), tracing on to a new light point. Per unit film area and solid
     /// angle of that direction, f is ∝ cos θ_floor of the direction (the other factors
-    /// cancel against the Jacobians), which the ratio gets from `multi_chain_densities`;
+    /// cancel against the Jacobians), which the ratio gets from `lens_side_factors`;
     /// without it the chains sample film points and directions uniformly. cos θ_floor varies
     /// by a factor of two over the family. The flawed chains' statistic levels off after
     /// about 200 steps (185, 417, 420 and 439 at 100, 200, 400 and 1000 steps); 400 are run.
@@ -1431,40 +1462,26 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let target = converged_target(Family::Mirrored);
         let starts = family_paths(&space, Family::Mirrored, CHAINS);
         assert!(starts.iter().all(|x| !applicable(&space, x).lens));
-        let (low, high) = spread(starts.iter().map(|x| onwards_cosine(x)));
-        println!("cos θ_floor over the family: 5% {low:.2}, 95% {high:.2}");
-        assert!(high > 1.7 * low, "the flawed factor varies");
-        let sizes = PerturbationSizes {
-            film_min: 0.1,
-            film_max: 6.0,
-            angle_min: 0.005,
-            angle_max: 0.3,
+        let run = ChainRun {
+            sizes: PerturbationSizes {
+                film_min: 0.1,
+                film_max: 6.0,
+                angle_min: 0.005,
+                angle_max: 0.3,
+            },
+            steps: 400,
+            in_sample_space,
         };
-        let (name, flaw) = if in_sample_space {
-            ("multi-chain in sample space", Flaw::WithConeDensities)
-        } else {
-            ("multi-chain", Flaw::WithoutDirectionDensity)
-        };
-        assert_balance(name, &target, &[flaw], |flaw| {
-            final_cells(&starts, 400, |x, y, rng| {
-                let mut kernel = RandomKernel {
-                    sizes: &sizes,
-                    in_sample_space,
-                    rng,
-                };
-                let p = lens(&space, &mut kernel, true, x, y, &mut 0)?;
-                Some(match flaw {
-                    None => p.ratio,
-                    Some(Flaw::WithConeDensities) => {
-                        p.ratio * onwards_cosine(y) / onwards_cosine(x)
-                    }
-                    Some(_) => p.ratio * onwards_cosine(x) / onwards_cosine(y),
-                })
-            })
-        });
+        kernel_chains_sample_f(
+            "multi-chain",
+            &converged_target(Family::Mirrored),
+            &starts,
+            run,
+            onwards_cosine,
+            |kernel, x, y| lens(&space, kernel, true, x, y, &mut 0),
+        );
     }
 
     /// Lens perturbations of L D E paths sample f: the chains move the film point (up to 8
@@ -1534,43 +1551,30 @@ mod tests {
             scene: &scene,
             camera: &camera,
         };
-        let target = converged_target(Family::Glossy);
         let starts = family_paths(&space, Family::Glossy, CHAINS);
         assert!(
             starts.iter().all(|x| {
                 space.class(&x[1]) == VertexClass::Glossy && applicable(&space, x).lens
             })
         );
-        let (low, high) = spread(starts.iter().map(|x| visible_normal_density(&space, x)));
-        println!("visible-normal density over the family: 5% {low:.2}, 95% {high:.2}");
-        assert!(high > 1.7 * low, "the flawed factor varies");
-        let sizes = PerturbationSizes {
-            film_min: 0.1,
-            film_max: 3.0,
-            angle_min: 0.005,
-            angle_max: 0.15,
+        let run = ChainRun {
+            sizes: PerturbationSizes {
+                film_min: 0.1,
+                film_max: 3.0,
+                angle_min: 0.005,
+                angle_max: 0.15,
+            },
+            steps: 200,
+            in_sample_space,
         };
-        let (name, flaw) = if in_sample_space {
-            ("glossy lens in sample space", Flaw::WithConeDensities)
-        } else {
-            ("glossy lens", Flaw::WithoutDirectionDensity)
-        };
-        assert_balance(name, &target, &[flaw], |flaw| {
-            final_cells(&starts, 200, |x, y, rng| {
-                let mut kernel = RandomKernel {
-                    sizes: &sizes,
-                    in_sample_space,
-                    rng,
-                };
-                let p = lens(&space, &mut kernel, false, x, y, &mut 0)?;
-                let density = |path: &[PathVertex]| visible_normal_density(&space, path);
-                Some(match flaw {
-                    None => p.ratio,
-                    Some(Flaw::WithConeDensities) => p.ratio * density(y) / density(x),
-                    Some(_) => p.ratio * density(x) / density(y),
-                })
-            })
-        });
+        kernel_chains_sample_f(
+            "glossy lens",
+            &converged_target(Family::Glossy),
+            &starts,
+            run,
+            |path| visible_normal_density(&space, path),
+            |kernel, x, y| lens(&space, kernel, false, x, y, &mut 0),
+        );
     }
 
     #[test]
