@@ -34,6 +34,7 @@ fn expectations() -> Vec<(String, i64)> {
         RTCHit { Ng_x, Ng_y, Ng_z, u, v, primID, geomID, instID }
         RTCRayHit { ray, hit }
         RTCIntersectContext { flags, filter, instID }
+        RTCFilterFunctionNArguments { valid, geometryUserPtr, context, ray, hit, N }
     }
     macro_rules! constants {
         ($($name:ident),* $(,)?) => {$(
@@ -52,6 +53,7 @@ fn expectations() -> Vec<(String, i64)> {
         RTC_BUILD_QUALITY_HIGH,
         RTC_SCENE_FLAG_NONE,
         RTC_SCENE_FLAG_ROBUST,
+        RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION,
         RTC_GEOMETRY_TYPE_TRIANGLE,
         RTC_BUFFER_TYPE_INDEX,
         RTC_BUFFER_TYPE_VERTEX,
@@ -82,6 +84,12 @@ fn expectations() -> Vec<(String, i64)> {
     list.push(("sizeof(bool)".into(), size_of::<bool>() as i64));
     list.push((
         "__builtin_types_compatible_p(RTCMemoryMonitorFunction, bool (*)(void *, ssize_t, bool))"
+            .into(),
+        1,
+    ));
+    // The filter callback's signature, `fn(*const RTCFilterFunctionNArguments)` in ffi.rs.
+    list.push((
+        "__builtin_types_compatible_p(RTCFilterFunctionN, void (*)(const struct RTCFilterFunctionNArguments *))"
             .into(),
         1,
     ));

@@ -15,7 +15,7 @@ pub use light_desc::{
 pub use lights::AreaLight;
 pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 
-use crate::accel::{Accel, Backend, Hit, Ray};
+use crate::accel::{Accel, Backend, Filtering, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::spectrum::Spectrum;
 use crate::texture::{Texture, TextureDesc};
@@ -172,7 +172,16 @@ impl Scene {
             bounds_max = Vec3A::ZERO;
         }
 
-        let accel = Accel::build(desc.backend, &kept_vertices)?;
+        let has_cutouts = desc
+            .materials
+            .iter()
+            .any(|m| m.alpha_mode == AlphaMode::Mask);
+        let filtering = if has_cutouts {
+            Filtering::Filtered
+        } else {
+            Filtering::Unfiltered
+        };
+        let accel = Accel::build(desc.backend, &kept_vertices, filtering)?;
         let order = accel.internal_to_build_order();
 
         let material_of = |id: u32| {
@@ -261,10 +270,7 @@ impl Scene {
         Ok(Scene {
             accel,
             shading,
-            has_cutouts: desc
-                .materials
-                .iter()
-                .any(|m| m.alpha_mode == AlphaMode::Mask),
+            has_cutouts,
             attributes,
             textures,
             materials: desc.materials.to_vec(),
@@ -433,7 +439,7 @@ impl Scene {
         self.info
     }
 
-    /// Closest hit in the host's triangle ids; `None` on a miss.
+    /// Closest hit in the host's triangle ids, through alpha cut-outs; `None` on a miss.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.closest_hit(ray).map(|hit| Hit {
             triangle: self.internal_to_input[hit.triangle as usize],
@@ -441,7 +447,8 @@ impl Scene {
         })
     }
 
-    /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax].
+    /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax], through
+    /// alpha cut-outs.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.blocked(ray)
     }
@@ -564,4 +571,59 @@ fn area_weighted_vertex_normals(positions: &[f32], indices: &[u32]) -> Vec<f32> 
     sums.iter()
         .flat_map(|n| n.try_normalize().unwrap_or(Vec3A::Y).to_array())
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ray queries through a scene go through its cut-outs, with either backend: a triangle
+    /// whose vertex alphas make alpha = 1 - u - v is solid only where u + v <= 1/2 (the
+    /// cutoff), and rays through the rest reach the opaque triangle behind it.
+    #[test]
+    fn rays_pass_through_cut_outs() {
+        #[rustfmt::skip]
+        let positions = [
+            -1.0, -1.0, 1.0, 1.0, -1.0, 1.0, 0.0, 1.0, 1.0,
+            -9.0, -9.0, 2.0, 9.0, -9.0, 2.0, 0.0, 9.0, 2.0,
+        ];
+        let mut colors = vec![1.0; 6 * 4];
+        colors[4 + 3] = 0.0;
+        colors[8 + 3] = 0.0;
+        let cut_out = Material {
+            alpha_mode: AlphaMode::Mask,
+            alpha_cutoff: 0.5,
+            ..Material::diffuse([0.5; 3])
+        };
+        let materials = [cut_out, Material::diffuse([0.5; 3])];
+        for backend in [Backend::Bvh, Backend::Embree] {
+            if !backend.is_available() {
+                continue;
+            }
+            let scene = Scene::new(&SceneDesc {
+                positions: &positions,
+                indices: &[0, 1, 2, 3, 4, 5],
+                material_ids: &[0, 1],
+                materials: &materials,
+                colors: &colors,
+                backend,
+                ..Default::default()
+            })
+            .unwrap();
+            // Points of the front triangle at (u, v) = (0.1, 0.2) and (0.4, 0.4).
+            for (u, v, front) in [(0.1, 0.2, true), (0.4, 0.4, false)] {
+                let origin = Vec3A::new(-1.0 + 2.0 * u + v, -1.0 + 2.0 * v, 0.0);
+                let ray = Ray::new(origin, Vec3A::Z, 0.0, f32::INFINITY);
+                let hit = scene.intersect(&ray).unwrap();
+                let what = format!("{backend:?}, u {u}, v {v}: {hit:?}");
+                assert_eq!(hit.triangle, if front { 0 } else { 1 }, "{what}");
+                assert!(
+                    (hit.t - if front { 1.0 } else { 2.0 }).abs() < 1e-5,
+                    "{what}"
+                );
+                let short = Ray::new(origin, Vec3A::Z, 0.0, 1.5);
+                assert_eq!(scene.occluded(&short), front, "{what}");
+            }
+        }
+    }
 }

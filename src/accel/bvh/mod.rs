@@ -180,22 +180,38 @@ impl BvhAccel {
 
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        match &self.tree {
-            Tree::Four(tree) => traversal::intersect4(tree, ray),
-            // SAFETY: `Tree::Eight` is only built on CPUs with AVX2 and FMA
-            // (`build_with_width`), which `intersect8` needs.
-            #[cfg(target_arch = "x86_64")]
-            Tree::Eight(tree) => unsafe { traversal::intersect8(tree, ray) },
-        }
+        self.intersect_filtered(ray, &|_, _, _| true)
     }
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_filtered(ray, &|_, _, _| true)
+    }
+
+    /// The closest hit that `accept(triangle, u, v)` keeps.
+    #[inline]
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        accept: &impl Fn(u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
         match &self.tree {
-            Tree::Four(tree) => traversal::occluded4(tree, ray),
-            // SAFETY: as in `intersect`.
+            Tree::Four(tree) => traversal::intersect4(tree, ray, accept),
+            // SAFETY: `Tree::Eight` is only built on CPUs with AVX2 and FMA
+            // (`build_with_width`), which `intersect8` needs.
             #[cfg(target_arch = "x86_64")]
-            Tree::Eight(tree) => unsafe { traversal::occluded8(tree, ray) },
+            Tree::Eight(tree) => unsafe { traversal::intersect8(tree, ray, accept) },
+        }
+    }
+
+    /// Whether a hit that `accept(triangle, u, v)` keeps lies on the ray.
+    #[inline]
+    pub fn occluded_filtered(&self, ray: &Ray, accept: &impl Fn(u32, f32, f32) -> bool) -> bool {
+        match &self.tree {
+            Tree::Four(tree) => traversal::occluded4(tree, ray, accept),
+            // SAFETY: as in `intersect_filtered`.
+            #[cfg(target_arch = "x86_64")]
+            Tree::Eight(tree) => unsafe { traversal::occluded8(tree, ray, accept) },
         }
     }
 }

@@ -4,6 +4,9 @@
 //! 4-wide nodes, `avx2`'s for 8-wide ones). Leaf blocks are tested four triangles at a time
 //! with `Vec4` at both widths.
 //!
+//! Both bodies also take `accept(triangle, u, v)`, which says whether a candidate hit counts
+//! (alpha cut-outs): the unfiltered queries pass a constant `true`, which compiles away.
+//!
 //! A body gets the box test as a closure rather than through a trait: a trait method cannot be
 //! `#[target_feature]` unless it is `unsafe` to call, whereas a closure written in `intersect8`
 //! or `occluded8` inherits their AVX2 and FMA. The bodies are `#[inline(always)]`, so each
@@ -21,68 +24,97 @@ use crate::accel::ray::{Hit, Ray};
 use glam::Vec3A;
 use glam::{BVec4A, Vec4};
 
-/// The closest hit in a 4-wide tree.
+/// The closest hit in a 4-wide tree that `accept` keeps.
 #[inline(always)]
-pub(super) fn intersect4(tree: &WideTree<Node4>, ray: &Ray) -> Option<Hit> {
+pub(super) fn intersect4(
+    tree: &WideTree<Node4>,
+    ray: &Ray,
+    accept: &impl Fn(u32, f32, f32) -> bool,
+) -> Option<Hit> {
     if tree.root == EMPTY {
         return None;
     }
     let boxes = BoxRay4::new(ray);
-    intersect(tree, ray, |node, tmin, tmax| {
-        boxes.intersect(node, tmin, tmax)
-    })
+    intersect(
+        tree,
+        ray,
+        |node, tmin, tmax| boxes.intersect(node, tmin, tmax),
+        accept,
+    )
 }
 
-/// Whether anything in a 4-wide tree blocks the ray.
+/// Whether a hit `accept` keeps in a 4-wide tree blocks the ray.
 #[inline(always)]
-pub(super) fn occluded4(tree: &WideTree<Node4>, ray: &Ray) -> bool {
+pub(super) fn occluded4(
+    tree: &WideTree<Node4>,
+    ray: &Ray,
+    accept: &impl Fn(u32, f32, f32) -> bool,
+) -> bool {
     if tree.root == EMPTY {
         return false;
     }
     let boxes = BoxRay4::new(ray);
-    occluded(tree, ray, |node, tmin, tmax| {
-        boxes.intersect(node, tmin, tmax)
-    })
+    occluded(
+        tree,
+        ray,
+        |node, tmin, tmax| boxes.intersect(node, tmin, tmax),
+        accept,
+    )
 }
 
-/// The closest hit in an 8-wide tree; for CPUs with AVX2 and FMA.
+/// The closest hit in an 8-wide tree that `accept` keeps; for CPUs with AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-pub(super) fn intersect8(tree: &WideTree<Node8>, ray: &Ray) -> Option<Hit> {
+pub(super) fn intersect8(
+    tree: &WideTree<Node8>,
+    ray: &Ray,
+    accept: &impl Fn(u32, f32, f32) -> bool,
+) -> Option<Hit> {
     // A ray with no direction hits nothing, and `BoxRay8` would not cull empty slots for it.
     if tree.root == EMPTY || ray.direction == Vec3A::ZERO {
         return None;
     }
     let boxes = BoxRay8::new(ray);
-    intersect(tree, ray, |node, tmin, tmax| {
-        boxes.intersect(node, tmin, tmax)
-    })
+    intersect(
+        tree,
+        ray,
+        |node, tmin, tmax| boxes.intersect(node, tmin, tmax),
+        accept,
+    )
 }
 
-/// Whether anything in an 8-wide tree blocks the ray; for CPUs with AVX2 and FMA.
+/// Whether a hit `accept` keeps in an 8-wide tree blocks the ray; for CPUs with AVX2 and
+/// FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-pub(super) fn occluded8(tree: &WideTree<Node8>, ray: &Ray) -> bool {
+pub(super) fn occluded8(
+    tree: &WideTree<Node8>,
+    ray: &Ray,
+    accept: &impl Fn(u32, f32, f32) -> bool,
+) -> bool {
     if tree.root == EMPTY || ray.direction == Vec3A::ZERO {
         return false;
     }
     let boxes = BoxRay8::new(ray);
-    occluded(tree, ray, |node, tmin, tmax| {
-        boxes.intersect(node, tmin, tmax)
-    })
+    occluded(
+        tree,
+        ray,
+        |node, tmin, tmax| boxes.intersect(node, tmin, tmax),
+        accept,
+    )
 }
 
-/// The closest hit with t in [tmin, tmax], in a tree with a root. `boxes(node, tmin, tmax)`
-/// tests the ray against the node's child boxes: their entry distances, and the mask of those
-/// it enters within [tmin, tmax].
+/// The closest hit with t in [tmin, tmax] that `accept` keeps, in a tree with a root.
+/// `boxes(node, tmin, tmax)` tests the ray against the node's child boxes: their entry
+/// distances, and the mask of those it enters within [tmin, tmax].
 #[inline(always)]
 fn intersect<const W: usize, N: WideNode<W>, D: Lanes<W>>(
     tree: &WideTree<N>,
     ray: &Ray,
     boxes: impl Fn(&N, f32, f32) -> (D, u32),
+    accept: &impl Fn(u32, f32, f32) -> bool,
 ) -> Option<Hit> {
-    let origin = splat3(ray.origin);
-    let direction = splat3(ray.direction);
+    let block_ray = BlockRay::new(ray);
     let mut tmax = ray.tmax;
     let mut best: Option<Hit> = None;
     let mut stack = TraversalStack::<(u32, f32)>::new();
@@ -97,7 +129,7 @@ fn intersect<const W: usize, N: WideNode<W>, D: Lanes<W>>(
                 continue;
             }
         } else {
-            tree.intersect_leaf(current, &origin, &direction, ray.tmin, &mut tmax, &mut best);
+            tree.intersect_leaf(current, &block_ray, &mut tmax, &mut best, accept);
         }
         match stack.pop_within(tmax) {
             Some(next) => current = next,
@@ -106,16 +138,16 @@ fn intersect<const W: usize, N: WideNode<W>, D: Lanes<W>>(
     }
 }
 
-/// Whether anything lies on the ray with t in [tmin, tmax], in a tree with a root; `boxes` as
-/// for `intersect`.
+/// Whether a hit `accept` keeps lies on the ray with t in [tmin, tmax], in a tree with a
+/// root; `boxes` as for `intersect`.
 #[inline(always)]
 fn occluded<const W: usize, N: WideNode<W>, D: Lanes<W>>(
     tree: &WideTree<N>,
     ray: &Ray,
     boxes: impl Fn(&N, f32, f32) -> (D, u32),
+    accept: &impl Fn(u32, f32, f32) -> bool,
 ) -> bool {
-    let origin = splat3(ray.origin);
-    let direction = splat3(ray.direction);
+    let block_ray = BlockRay::new(ray);
     let mut stack = TraversalStack::<u32>::new();
     stack.push(tree.root);
     while let Some(current) = stack.pop() {
@@ -128,7 +160,7 @@ fn occluded<const W: usize, N: WideNode<W>, D: Lanes<W>>(
                 tree.prefetch(node.children()[slot]);
                 stack.push(node.children()[slot]);
             }
-        } else if tree.leaf_blocked(current, &origin, &direction, ray.tmin, ray.tmax) {
+        } else if tree.leaf_blocked(current, &block_ray, ray.tmax, accept) {
             return true;
         }
     }
@@ -136,25 +168,27 @@ fn occluded<const W: usize, N: WideNode<W>, D: Lanes<W>>(
 }
 
 impl<N> WideTree<N> {
-    /// Tests leaf block `reference` and narrows `tmax` to its closest hit in [tmin, tmax].
+    /// Tests leaf block `reference` and narrows `tmax` to its closest hit in [tmin, tmax]
+    /// that `accept` keeps.
     #[inline(always)]
     fn intersect_leaf(
         &self,
         reference: u32,
-        origin: &[Vec4; 3],
-        direction: &[Vec4; 3],
-        tmin: f32,
+        ray: &BlockRay,
         tmax: &mut f32,
         best: &mut Option<Hit>,
+        accept: &impl Fn(u32, f32, f32) -> bool,
     ) {
         let (index, blocks) = self.leaf_blocks(reference);
         for (block, &first) in blocks.iter().zip(&self.block_first[index..]) {
-            let (t, u, v, hit) = intersect_block(block, origin, direction, tmin, *tmax);
+            let (t, u, v, hit) = intersect_block(block, ray, *tmax);
             let mut mask = hit.bitmask();
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if t[lane] <= *tmax {
+                // Lanes come in lane order, not by t: `accept` is asked only about a lane
+                // nearer than the best so far.
+                if t[lane] <= *tmax && accept(first + lane as u32, u[lane], v[lane]) {
                     *tmax = t[lane];
                     *best = Some(Hit {
                         triangle: first + lane as u32,
@@ -209,33 +243,59 @@ impl<N> WideTree<N> {
         let _ = reference;
     }
 
-    /// Whether leaf block `reference` has a hit in [tmin, tmax].
+    /// Whether leaf block `reference` has a hit in [tmin, tmax] that `accept` keeps.
     #[inline(always)]
     fn leaf_blocked(
         &self,
         reference: u32,
-        origin: &[Vec4; 3],
-        direction: &[Vec4; 3],
-        tmin: f32,
+        ray: &BlockRay,
         tmax: f32,
+        accept: &impl Fn(u32, f32, f32) -> bool,
     ) -> bool {
-        self.leaf_blocks(reference).1.iter().any(|block| {
-            intersect_block(block, origin, direction, tmin, tmax)
-                .3
-                .any()
+        let (index, blocks) = self.leaf_blocks(reference);
+        blocks.iter().enumerate().any(|(offset, block)| {
+            let (_, u, v, hit) = intersect_block(block, ray, tmax);
+            // Written so that with an `accept` that is constant true this is `hit.any()`:
+            // the first hit lane answers, and nothing in the lane loop can panic (`get`, with
+            // a default never used since every block has its entry; lanes masked to 0..4), so
+            // the unused lookups compile away.
+            hit.any() && {
+                let first = self.block_first.get(index + offset).copied().unwrap_or(0);
+                let mut mask = hit.bitmask();
+                let mut accepted = false;
+                while mask != 0 && !accepted {
+                    let lane = mask.trailing_zeros() as usize & 3;
+                    mask &= mask - 1;
+                    accepted = accept(first + lane as u32, u[lane], v[lane]);
+                }
+                accepted
+            }
         })
+    }
+}
+
+/// The ray as the leaf block test takes it: origin and direction splatted to four lanes.
+struct BlockRay {
+    origin: [Vec4; 3],
+    direction: [Vec4; 3],
+    tmin: f32,
+}
+
+impl BlockRay {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        BlockRay {
+            origin: splat3(ray.origin),
+            direction: splat3(ray.direction),
+            tmin: ray.tmin,
+        }
     }
 }
 
 /// The ray against four triangles: (t, u, v) per lane and the lanes hit within [tmin, tmax].
 #[inline(always)]
-fn intersect_block(
-    block: &TriangleBlock,
-    origin: &[Vec4; 3],
-    direction: &[Vec4; 3],
-    tmin: f32,
-    tmax: f32,
-) -> (Vec4, Vec4, Vec4, BVec4A) {
+fn intersect_block(block: &TriangleBlock, ray: &BlockRay, tmax: f32) -> (Vec4, Vec4, Vec4, BVec4A) {
+    let (origin, direction, tmin) = (&ray.origin, &ray.direction, ray.tmin);
     let dot = |a: &[Vec4; 3], b: &[Vec4; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let c = [
         block.v0[0] - origin[0],

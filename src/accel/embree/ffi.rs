@@ -47,6 +47,7 @@ pub const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
 pub type RTCSceneFlags = c_int;
 pub const RTC_SCENE_FLAG_NONE: RTCSceneFlags = 0;
 pub const RTC_SCENE_FLAG_ROBUST: RTCSceneFlags = 1 << 2;
+pub const RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION: RTCSceneFlags = 1 << 3;
 
 /// `enum RTCGeometryType`.
 pub type RTCGeometryType = c_int;
@@ -81,8 +82,24 @@ pub type RTCErrorFunction =
 pub type RTCMemoryMonitorFunction =
     Option<unsafe extern "C" fn(user_ptr: *mut c_void, bytes: isize, post: bool) -> bool>;
 
-/// `RTCFilterFunctionN` (never set: always NULL).
-pub type RTCFilterFunctionN = Option<unsafe extern "C" fn(args: *const c_void)>;
+/// `RTCFilterFunctionN`: called with candidate hits, it clears `valid[i]` of those it
+/// rejects.
+pub type RTCFilterFunctionN =
+    Option<unsafe extern "C" fn(args: *const RTCFilterFunctionNArguments)>;
+
+/// `struct RTCFilterFunctionNArguments`: `N` rays and their candidate hits in
+/// structure-of-arrays layout (`RTCRayN`, `RTCHitN`: each field an array of `N`), and
+/// `valid[i]`, -1 for a ray that has a candidate, 0 for one that has none or was rejected.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct RTCFilterFunctionNArguments {
+    pub valid: *mut c_int,
+    pub geometryUserPtr: *mut c_void,
+    pub context: *mut RTCIntersectContext,
+    pub ray: *mut c_void,
+    pub hit: *mut c_void,
+    pub N: c_uint,
+}
 
 /// `struct RTCRay`: a single ray.
 #[repr(C, align(16))]

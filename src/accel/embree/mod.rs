@@ -12,10 +12,20 @@
 //! (tnear, tfar] where the BVH accepts [tmin, tmax], so the two differ only for a hit at
 //! exactly t = tmin. Embree's `u`, `v` are the barycentrics of vertices 1 and 2, the
 //! convention of [`Hit`].
+//!
+//! Filtered queries (alpha cut-outs) use Embree's per-query context filter: the query's
+//! intersection context is extended with a reference to the `accept` closure, and the filter
+//! callback Embree calls for each candidate hit clears the candidates it rejects. A scene only
+//! runs context filters when built with `RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION`, which
+//! switches the whole scene to Embree's filter-capable kernels (slower for unfiltered queries
+//! too), so only scenes built with [`Filtering::Filtered`] set it. Unfiltered queries pass no
+//! filter and never call back into Rust. (Geometry filter functions would instead be called
+//! for every query on a scene that has them, the unfiltered ones included.)
 
 #[doc(hidden)]
 pub mod ffi;
 
+use super::Filtering;
 use super::ray::{Hit, Ray};
 use crate::error::{
     Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, MLT_STATUS_UNSUPPORTED, MltStatus,
@@ -23,7 +33,10 @@ use crate::error::{
 };
 use ffi::*;
 use glam::{Vec3A, Vec4};
+use std::any::Any;
+use std::cell::Cell;
 use std::ffi::{CStr, c_char, c_void};
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::sync::atomic::{AtomicIsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
@@ -224,6 +237,8 @@ pub struct EmbreeAccel {
     device: Device,
     /// The identity: Embree's primID is the build order.
     build_order: Vec<u32>,
+    /// Whether the scene runs context filters (`Filtering::Filtered`).
+    filterable: bool,
 }
 
 // SAFETY: after `rtcCommitScene` the scene is never modified, and Embree documents committed
@@ -236,8 +251,9 @@ unsafe impl Sync for EmbreeAccel {}
 
 impl EmbreeAccel {
     /// Builds over triangles given as vertex triples (a triangle soup: three vertices per
-    /// triangle, 32-bit indices). None of them may be degenerate.
-    pub fn build(triangles: &[[Vec3A; 3]]) -> Result<Self> {
+    /// triangle, 32-bit indices). None of them may be degenerate. Filtered queries need
+    /// `Filtering::Filtered`.
+    pub fn build(triangles: &[[Vec3A; 3]], filtering: Filtering) -> Result<Self> {
         let count = triangles.len();
         let vertex_count = count.checked_mul(3).filter(|&n| n <= 1 << 32);
         let Some(vertex_count) = vertex_count else {
@@ -256,13 +272,18 @@ impl EmbreeAccel {
             scene,
             device,
             build_order: (0..count as u32).collect(),
+            filterable: filtering == Filtering::Filtered,
+        };
+        let flags = match filtering {
+            Filtering::Unfiltered => SCENE_FLAGS,
+            Filtering::Filtered => SCENE_FLAGS | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION,
         };
         let device = &accel.device;
         device.check_handle("rtcNewScene", scene)?;
         // SAFETY: a live, uncommitted scene; valid enum values.
         unsafe {
             rtcSetSceneBuildQuality(scene, BUILD_QUALITY);
-            rtcSetSceneFlags(scene, SCENE_FLAGS);
+            rtcSetSceneFlags(scene, flags);
         }
         device.check("rtcSetSceneBuildQuality")?;
         if count > 0 {
@@ -350,6 +371,134 @@ impl EmbreeAccel {
         // A blocked ray comes back with tfar = -inf.
         ray.tfar == f32::NEG_INFINITY
     }
+
+    /// The closest hit that `accept(triangle, u, v)` keeps. Panics if the scene was built
+    /// without `Filtering::Filtered` (Embree would ignore the filter), or if `accept` panics.
+    #[inline]
+    pub fn intersect_filtered<F: Fn(u32, f32, f32) -> bool>(
+        &self,
+        ray: &Ray,
+        accept: &F,
+    ) -> Option<Hit> {
+        assert!(self.filterable, "{NOT_FILTERABLE}");
+        let mut context = FilterContext::new(accept);
+        let mut rayhit = rtc_rayhit(ray);
+        // SAFETY: as in `intersect`; `context` starts with the `RTCIntersectContext` that
+        // `filter_hits::<F>` expects to find a `FilterContext<F>` around, and Embree passes
+        // this pointer to it unchanged. It is derived from the whole local, which outlives
+        // the call.
+        unsafe {
+            rtcIntersect1(
+                self.scene,
+                (&raw mut context).cast::<RTCIntersectContext>(),
+                &mut rayhit,
+            )
+        };
+        context.resume_panic();
+        (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID).then_some(Hit {
+            triangle: rayhit.hit.primID,
+            t: rayhit.ray.tfar,
+            u: rayhit.hit.u,
+            v: rayhit.hit.v,
+        })
+    }
+
+    /// Whether a hit that `accept(triangle, u, v)` keeps lies on the ray; panics as
+    /// `intersect_filtered`.
+    #[inline]
+    pub fn occluded_filtered<F: Fn(u32, f32, f32) -> bool>(&self, ray: &Ray, accept: &F) -> bool {
+        assert!(self.filterable, "{NOT_FILTERABLE}");
+        let mut context = FilterContext::new(accept);
+        let mut ray = rtc_ray(ray);
+        // SAFETY: as in `intersect_filtered`.
+        unsafe {
+            rtcOccluded1(
+                self.scene,
+                (&raw mut context).cast::<RTCIntersectContext>(),
+                &mut ray,
+            )
+        };
+        context.resume_panic();
+        ray.tfar == f32::NEG_INFINITY
+    }
+}
+
+const NOT_FILTERABLE: &str =
+    "a filtered query on an Embree scene built without Filtering::Filtered";
+
+/// An intersection context extended with what the filter callback needs: Embree passes the
+/// context pointer of the query to the callback as it was given.
+#[repr(C)]
+struct FilterContext<'a, F> {
+    /// First, so a pointer to the whole is a pointer to it (`repr(C)`).
+    context: RTCIntersectContext,
+    accept: &'a F,
+    /// What `accept` panicked with: caught in the callback, since a panic must not unwind
+    /// through Embree's C++ frames, and resumed once the query has returned.
+    panic: Cell<Option<Box<dyn Any + Send>>>,
+}
+
+impl<'a, F: Fn(u32, f32, f32) -> bool> FilterContext<'a, F> {
+    fn new(accept: &'a F) -> Self {
+        let mut context = RTCIntersectContext::new();
+        context.filter = Some(filter_hits::<F>);
+        FilterContext {
+            context,
+            accept,
+            panic: Cell::new(None),
+        }
+    }
+
+    /// Goes on with the panic of `accept`, if it panicked during the query.
+    fn resume_panic(self) {
+        if let Some(payload) = self.panic.into_inner() {
+            resume_unwind(payload);
+        }
+    }
+}
+
+/// The context filter of filtered queries: clears `valid[i]` of the candidate hits that the
+/// query's `accept` rejects. Never unwinds: a panic of `accept` is stored in the context (the
+/// candidates after it are kept, so the query ends soon) and resumed by the caller.
+unsafe extern "C" fn filter_hits<F: Fn(u32, f32, f32) -> bool>(
+    args: *const RTCFilterFunctionNArguments,
+) {
+    // SAFETY: Embree passes valid arguments for the duration of the call.
+    let args = unsafe { &*args };
+    // SAFETY: this function is only installed by `FilterContext::<F>::new`, in the context
+    // at the start of a `FilterContext<F>` that the querying thread keeps alive (and only
+    // reads through shared references) during the query.
+    let context = unsafe { &*args.context.cast_const().cast::<FilterContext<F>>() };
+    let rays = args.N as usize;
+    // `RTCHitN` holds each field as an array of N: Ng_x, Ng_y, Ng_z, u, v, primID, ... (the
+    // header's `RTCHitN_u`, `RTCHitN_v`, `RTCHitN_primID`).
+    let hit_floats = args.hit.cast::<f32>().cast_const();
+    let hit_ids = args.hit.cast::<u32>().cast_const();
+    for i in 0..rays {
+        // SAFETY: `valid` and each field of `hit` have N entries.
+        let (valid, u, v, primitive) = unsafe {
+            (
+                &mut *args.valid.add(i),
+                *hit_floats.add(3 * rays + i),
+                *hit_floats.add(4 * rays + i),
+                *hit_ids.add(5 * rays + i),
+            )
+        };
+        if *valid == 0 {
+            continue;
+        }
+        let earlier_panic = context.panic.take();
+        if earlier_panic.is_some() {
+            context.panic.set(earlier_panic);
+            continue;
+        }
+        // The internal triangle index is the primID, as in `intersect`.
+        match catch_unwind(AssertUnwindSafe(|| (context.accept)(primitive, u, v))) {
+            Ok(true) => {}
+            Ok(false) => *valid = 0,
+            Err(payload) => context.panic.set(Some(payload)),
+        }
+    }
 }
 
 /// Our ray as Embree's: every mask bit set (Debian's Embree is built with ray masks, and a
@@ -405,11 +554,55 @@ mod tests {
 
     #[test]
     fn empty_scene_misses() {
-        let accel = EmbreeAccel::build(&[]).unwrap();
+        let accel = EmbreeAccel::build(&[], Filtering::Unfiltered).unwrap();
         let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
         assert_eq!(accel.intersect(&ray), None);
         assert!(!accel.occluded(&ray));
         assert!(accel.internal_to_build_order().is_empty());
+    }
+
+    fn facing_triangle() -> [Vec3A; 3] {
+        [
+            Vec3A::new(-1.0, -1.0, 1.0),
+            Vec3A::new(1.0, -1.0, 1.0),
+            Vec3A::new(0.0, 1.0, 1.0),
+        ]
+    }
+
+    /// A panic of the filter closure does not unwind through Embree: it is caught in the
+    /// callback and resumed once the query has returned, and the scene still works after.
+    #[test]
+    fn filter_panics_reach_the_caller() {
+        let accel = EmbreeAccel::build(&[facing_triangle()], Filtering::Filtered).unwrap();
+        let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
+        let panicking = |_, _, _| -> bool { panic!("the filter panicked") };
+        for occlusion in [false, true] {
+            let payload = std::panic::catch_unwind(|| {
+                if occlusion {
+                    accel.occluded_filtered(&ray, &panicking);
+                } else {
+                    accel.intersect_filtered(&ray, &panicking);
+                }
+            })
+            .unwrap_err();
+            assert_eq!(
+                payload.downcast_ref::<&str>(),
+                Some(&"the filter panicked"),
+                "occlusion {occlusion}"
+            );
+        }
+        assert!(accel.intersect_filtered(&ray, &|_, _, _| true).is_some());
+        assert!(accel.occluded_filtered(&ray, &|_, _, _| true));
+    }
+
+    /// Embree ignores the context filter in a scene built without its flag: a filtered query
+    /// there would silently be unfiltered, so it panics instead.
+    #[test]
+    #[should_panic(expected = "built without Filtering::Filtered")]
+    fn filtered_query_needs_a_filterable_scene() {
+        let accel = EmbreeAccel::build(&[facing_triangle()], Filtering::Unfiltered).unwrap();
+        let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
+        accel.intersect_filtered(&ray, &|_, _, _| false);
     }
 
     /// The memory monitor counts what a build allocates: at least the vertex and index
@@ -426,7 +619,7 @@ mod tests {
                 ]
             })
             .collect();
-        let accel = EmbreeAccel::build(&triangles).unwrap();
+        let accel = EmbreeAccel::build(&triangles, Filtering::Unfiltered).unwrap();
         let bytes = accel.memory_bytes();
         assert!(bytes >= 1000 * 48, "{bytes}");
         assert!(bytes < 100 << 20, "{bytes}");
