@@ -253,24 +253,23 @@ impl<N> WideTree<N> {
         accept: &impl Fn(u32, f32, f32) -> bool,
     ) -> bool {
         let (index, blocks) = self.leaf_blocks(reference);
-        blocks.iter().enumerate().any(|(offset, block)| {
+        for (offset, block) in blocks.iter().enumerate() {
             let (_, u, v, hit) = intersect_block(block, ray, tmax);
             // Written so that with an `accept` that is constant true this is `hit.any()`:
             // the first hit lane answers, and nothing in the lane loop can panic (`get`, with
             // a default never used since every block has its entry; lanes masked to 0..4), so
             // the unused lookups compile away.
-            hit.any() && {
+            let mut mask = hit.bitmask();
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize & 3;
                 let first = self.block_first.get(index + offset).copied().unwrap_or(0);
-                let mut mask = hit.bitmask();
-                let mut accepted = false;
-                while mask != 0 && !accepted {
-                    let lane = mask.trailing_zeros() as usize & 3;
-                    mask &= mask - 1;
-                    accepted = accept(first + lane as u32, u[lane], v[lane]);
+                if accept(first + lane as u32, u[lane], v[lane]) {
+                    return true;
                 }
-                accepted
+                mask &= mask - 1;
             }
-        })
+        }
+        false
     }
 }
 
