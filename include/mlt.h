@@ -502,6 +502,14 @@ typedef struct MltMaterial {
    * Scales the normal map's x and y (glTF's `normalTexture.scale`); finite. Default 1.
    */
   float normal_scale;
+  /**
+   * 0 or 1; metallic-roughness only: compensate the metal's reflection for the light
+   * that bounces between microfacets more than once, which glTF's single-scattering
+   * model loses (Kulla and Conty 2017): a white metal then reflects all the light at
+   * every roughness, instead of 92% at roughness 0.5 and 31% at 1 (normal incidence).
+   * Default 0, glTF's model as its specification defines it.
+   */
+  uint32_t energy_compensation;
 } MltMaterial;
 
 /**

@@ -2628,6 +2628,7 @@ impl HostSurfaces {
             metallic_roughness_texture: slot(1),
             normal_texture: slot(2),
             normal_scale: 0.8,
+            energy_compensation: 1,
             ..host.materials[0]
         };
         host.materials[1].emission_texture = slot(0);
@@ -2709,8 +2710,13 @@ fn surface_defaults_are_valid_and_documented() {
         (0.0, 1.0, 0.0, 1.0)
     );
     assert_eq!(
-        (m.alpha_mode, m.alpha_cutoff, m.normal_scale),
-        (MLT_ALPHA_OPAQUE, 0.5, 1.0)
+        (
+            m.alpha_mode,
+            m.alpha_cutoff,
+            m.normal_scale,
+            m.energy_compensation
+        ),
+        (MLT_ALPHA_OPAQUE, 0.5, 1.0, 0)
     );
     for r in [
         m.base_color_texture,
@@ -2794,6 +2800,8 @@ fn scene_create_bad_surfaces() {
         h.host.materials[0].alpha_mode = 2
             => ["desc.materials[0].alpha_mode is 2", "MLT_ALPHA_OPAQUE", "MLT_ALPHA_MASK"],
         h.host.materials[1].alpha_mode = -1 => ["desc.materials[1].alpha_mode is -1"],
+        h.host.materials[0].energy_compensation = 2
+            => ["desc.materials[0].energy_compensation is 2", "0 or 1"],
         h.host.materials[0].base_color_texture.texture = 3
             => ["desc.materials[0].base_color_texture.texture is 3", "3 textures"],
         h.host.materials[0].metallic_roughness_texture.texture = i32::MAX

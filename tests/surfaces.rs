@@ -100,8 +100,8 @@ fn primary_space_metropolis_agrees_with_bdpt() {
 }
 
 /// Through the scene's glossy vertices (rough gold, rough glass) the perturbations move
-/// microfacets (perturbation.rs); the glossy plastic, a rough coat over a diffuse base, is a
-/// diffuse vertex to them.
+/// microfacets (perturbation.rs); the short block, a rough coat over a diffuse base beside
+/// a compensated metal, is a diffuse vertex to them.
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt() {
     for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {

@@ -12,6 +12,7 @@
 mod dielectric;
 mod metallic_roughness;
 mod microfacet;
+mod multiple_scattering;
 mod scattering;
 
 pub use dielectric::fresnel_dielectric;

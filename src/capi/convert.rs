@@ -58,6 +58,10 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         normal_texture: slot("normal_texture", &m.normal_texture)?,
         normal_scale: m.normal_scale,
         emission_texture: slot("emission_texture", &m.emission_texture)?,
+        energy_compensation: flag(
+            m.energy_compensation,
+            &format!("{name}.energy_compensation"),
+        )?,
     })
 }
 
@@ -246,8 +250,11 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         mutation_weights: MutationWeights(s.mutation_weights),
         erpt_chain_length: s.erpt_chain_length,
         erpt_deposit_energy: s.erpt_deposit_energy,
-        adapt_mutation_weights: flag(s.adapt_mutation_weights, "adapt_mutation_weights")?,
-        perturb_in_sample_space: flag(s.perturb_in_sample_space, "perturb_in_sample_space")?,
+        adapt_mutation_weights: flag(s.adapt_mutation_weights, "settings.adapt_mutation_weights")?,
+        perturb_in_sample_space: flag(
+            s.perturb_in_sample_space,
+            "settings.perturb_in_sample_space",
+        )?,
         filter_buffers: s.filter_buffers,
         filter_strength: s.filter_strength,
         filter_radius: s.filter_radius,
@@ -255,13 +262,13 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
     })
 }
 
-/// A C boolean setting: 0 or 1, anything else is a mistake.
+/// A C boolean field `name`: 0 or 1, anything else is a mistake.
 pub(super) fn flag(value: u32, name: &str) -> Result<bool> {
     match value {
         0 => Ok(false),
         1 => Ok(true),
         other => Err(Error::invalid(format!(
-            "settings.{name} is {other}; it must be 0 or 1"
+            "{name} is {other}; it must be 0 or 1"
         ))),
     }
 }

@@ -218,6 +218,7 @@ impl Extensible for MltMaterial {
             normal_texture: NO_TEXTURE,
             emission_texture: NO_TEXTURE,
             normal_scale: d.normal_scale,
+            energy_compensation: d.energy_compensation as u32,
         }
     }
 }
@@ -477,7 +478,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 160]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 164]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);

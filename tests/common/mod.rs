@@ -87,8 +87,13 @@ pub fn inward_icosphere(levels: u32, radius: f32) -> (Vec<f32>, Vec<u32>) {
 
 /// The white furnace: a closed sphere whose inside is diffuse with `albedo` and emits `emission`.
 pub fn furnace_scene(albedo: [f32; 3], emission: [f32; 3]) -> Scene {
+    furnace_scene_of(Material::diffuse(albedo).with_emission(emission))
+}
+
+/// The furnace's sphere made of `material`.
+pub fn furnace_scene_of(material: Material) -> Scene {
     let (positions, indices) = inward_icosphere(2, 1.0);
-    let materials = [Material::diffuse(albedo).with_emission(emission)];
+    let materials = [material];
     Scene::new(&SceneDesc {
         positions: &positions,
         indices: &indices,
@@ -529,6 +534,7 @@ impl Mesh {
                 normal_texture: slot(m.normal_texture),
                 emission_texture: slot(m.emission_texture),
                 normal_scale: m.normal_scale,
+                energy_compensation: m.energy_compensation as u32,
             })
             .collect()
     }

@@ -1,6 +1,6 @@
 //! The surfaces scene, built in code: the canonical Cornell box with glTF
-//! metallic-roughness materials — a rough gold tall block, a glossy plastic short block,
-//! and on it a smooth-shaded rough glass sphere (per-vertex normals on a coarse icosphere,
+//! metallic-roughness materials — a rough gold tall block, a short block half rough metal
+//! and half glossy plastic with the multiple-scattering energy compensation, and on it a smooth-shaded rough glass sphere (per-vertex normals on a coarse icosphere,
 //! so shading and geometric normals differ by up to ~18°) — a floor whose colour is a
 //! checker texture, and a lamp whose emission a 2 × 2 texture modulates. It is where the algorithms must agree
 //! once BSDFs are evaluated in a shading frame that is not the triangle's (light tracing
@@ -85,17 +85,18 @@ pub fn surfaces_mesh() -> SurfacesMesh {
         }),
         ..Material::diffuse([0.9; 3])
     });
-    // Rough gold and glossy plastic blocks.
+    // Rough gold, and half metal, half plastic with the energy compensation (its metal part
+    // gains the compensation lobe; the plastic's coat and diffuse base stay as they are).
     let metal = scene.mesh.materials.len() as u32;
     scene
         .mesh
         .materials
         .push(Material::metallic_roughness([1.0, 0.78, 0.34], 1.0, 0.3));
     let plastic = metal + 1;
-    scene
-        .mesh
-        .materials
-        .push(Material::metallic_roughness([0.2, 0.35, 0.7], 0.0, 0.4));
+    scene.mesh.materials.push(Material {
+        energy_compensation: true,
+        ..Material::metallic_roughness([0.2, 0.35, 0.7], 0.5, 0.6)
+    });
     // The lamp's emission, modulated across it by the 2 × 2 pattern.
     let lamp = box_mesh
         .materials

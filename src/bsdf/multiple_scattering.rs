@@ -1,0 +1,210 @@
+//! Energy compensation for GGX reflection (Kulla and Conty 2017): a single-scattering
+//! microfacet lobe loses the light that bounces between microfacets more than once (a white
+//! metal at roughness 1 reflects only about a third of it at normal incidence). The
+//! compensation adds a lobe
+//!
+//! f_ms(μo, μi) = F_ms · (1 − E(μo)) (1 − E(μi)) / (π (1 − E_avg)),
+//!
+//! where E(μ) is the single-scattering albedo of a white (F = 1) GGX reflector for light
+//! arriving at cosine μ and E_avg = 2 ∫ E(μ) μ dμ its cosine-weighted mean. For F = 1 the two
+//! lobes together reflect exactly 1 at every angle; for a coloured Fresnel F_ms =
+//! F_avg² E_avg / (1 − F_avg (1 − E_avg)) sums the bounces' geometric series with the mean
+//! Fresnel reflectance F_avg.
+//!
+//! E is tabulated over (μ, roughness) on first use, by a deterministic quadrature of the
+//! visible-normal sampling, and interpolated bilinearly; E_avg is the exact cosine-weighted
+//! integral of the interpolated E, so the compensated white reflector's albedo is 1 up to the
+//! table's error in E alone.
+
+use super::microfacet::{MIN_ALPHA, TrowbridgeReitz};
+use super::scattering::reflect;
+use glam::Vec3A;
+use std::sync::OnceLock;
+
+/// Table nodes over μ = cos θ in [0, 1] (denser near grazing, where E changes fastest: μ =
+/// t² at uniform t) and over perceptual roughness in [0, 1] (α = roughness²).
+const COSINES: usize = 48;
+const ROUGHNESSES: usize = 32;
+/// Quadrature nodes per table entry: over the half vector's polar angle (mapped so that
+/// they follow GGX's tail) and over its azimuth on one side of the plane of incidence.
+const POLAR_NODES: usize = 96;
+const AZIMUTH_NODES: usize = 24;
+
+struct AlbedoTable {
+    /// E at (roughness j, cosine node i), row-major by roughness.
+    albedo: Vec<f32>,
+    /// E_avg per roughness node.
+    average: Vec<f32>,
+}
+
+fn cosine_node(i: usize) -> f32 {
+    let t = i as f32 / (COSINES - 1) as f32;
+    t * t
+}
+
+/// The white GGX reflector's albedo at cosine `mu`: ∫ D(h) G2 |wo·h| / μ dω_h over the
+/// half vectors that reflect wo above the surface, by the midpoint rule in x with the polar
+/// angle θ_h = atan(α tan(πx/2)), which puts the nodes where D's long tail is (sampling
+/// the visible normals on a grid would leave the tail, where the loss is, to a node or
+/// two), and in the azimuth on one side of the plane of incidence (the integrand is
+/// symmetric about it).
+fn single_scattering_albedo(distribution: TrowbridgeReitz, alpha: f32, mu: f32) -> f64 {
+    use std::f64::consts::PI;
+    let mu = mu.max(1e-4);
+    let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+    let alpha = alpha as f64;
+    let mut sum = 0.0f64;
+    for i in 0..POLAR_NODES {
+        let x = (i as f64 + 0.5) / POLAR_NODES as f64;
+        let t = (PI / 2.0 * x).tan();
+        let theta = (alpha * t).atan();
+        // dθ/dx, with the sine of the solid angle.
+        let d_theta = alpha * PI / 2.0 * (1.0 + t * t) / (1.0 + alpha * alpha * t * t);
+        let (sin, cos) = theta.sin_cos();
+        for j in 0..AZIMUTH_NODES {
+            let phi = PI * (j as f64 + 0.5) / AZIMUTH_NODES as f64;
+            let h = Vec3A::new(
+                (sin * phi.cos()) as f32,
+                (sin * phi.sin()) as f32,
+                cos as f32,
+            );
+            let cos_oh = wo.dot(h);
+            let wi = reflect(wo, h);
+            if cos_oh <= 0.0 || wi.z <= 0.0 {
+                continue;
+            }
+            let f = distribution.d(h) as f64 * distribution.g2(wo, wi) as f64 * cos_oh as f64;
+            sum += f * sin * d_theta;
+        }
+    }
+    // Both sides of the plane: 2 × π / AZIMUTH_NODES per azimuth node.
+    sum * 2.0 * PI / (AZIMUTH_NODES * POLAR_NODES) as f64 / mu as f64
+}
+
+fn table() -> &'static AlbedoTable {
+    static TABLE: OnceLock<AlbedoTable> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut albedo = Vec::with_capacity(COSINES * ROUGHNESSES);
+        let mut average = Vec::with_capacity(ROUGHNESSES);
+        for j in 0..ROUGHNESSES {
+            let roughness = j as f32 / (ROUGHNESSES - 1) as f32;
+            let alpha = (roughness * roughness).max(MIN_ALPHA);
+            let distribution = TrowbridgeReitz::new(alpha);
+            let row: Vec<f32> = (0..COSINES)
+                .map(|i| {
+                    single_scattering_albedo(distribution, alpha, cosine_node(i)).min(1.0) as f32
+                })
+                .collect();
+            // 2 ∫ E(μ) μ dμ of the piecewise-linear E, segment by segment exactly.
+            let mut integral = 0.0f64;
+            for i in 0..COSINES - 1 {
+                let (a, b) = (cosine_node(i) as f64, cosine_node(i + 1) as f64);
+                let (ea, eb) = (row[i] as f64, row[i + 1] as f64);
+                let slope = (eb - ea) / (b - a);
+                let at = |x: f64| (ea - slope * a) * x * x / 2.0 + slope * x * x * x / 3.0;
+                integral += at(b) - at(a);
+            }
+            average.push((2.0 * integral).min(1.0) as f32);
+            albedo.extend(row);
+        }
+        AlbedoTable { albedo, average }
+    })
+}
+
+/// The roughness node below `roughness` and the weight of the one above.
+fn roughness_cell(roughness: f32) -> (usize, f32) {
+    let x = roughness.clamp(0.0, 1.0) * (ROUGHNESSES - 1) as f32;
+    let j = (x as usize).min(ROUGHNESSES - 2);
+    (j, x - j as f32)
+}
+
+/// A GGX reflector's compensation at one roughness: E and E_avg looked up in the table.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EnergyCompensation {
+    roughness_node: usize,
+    roughness_weight: f32,
+    /// 1 − E_avg.
+    missing_average: f32,
+}
+
+/// Below this 1 − E_avg (roughness under about 0.03) nothing is missing to compensate, and
+/// the lobe's normalization would divide rounding by rounding.
+const NEGLIGIBLE: f32 = 1e-4;
+
+impl EnergyCompensation {
+    /// The compensation at perceptual roughness `roughness`, or `None` where the single
+    /// scattering loses (next to) nothing.
+    pub fn new(roughness: f32) -> Option<Self> {
+        let table = table();
+        let (j, w) = roughness_cell(roughness);
+        let average = table.average[j] * (1.0 - w) + table.average[j + 1] * w;
+        let missing_average = 1.0 - average;
+        (missing_average > NEGLIGIBLE).then_some(EnergyCompensation {
+            roughness_node: j,
+            roughness_weight: w,
+            missing_average,
+        })
+    }
+
+    /// E(μ): the white single-scattering lobe's albedo at cosine `mu`.
+    pub fn albedo(&self, mu: f32) -> f32 {
+        let albedo = &table().albedo;
+        let t = mu.clamp(0.0, 1.0).sqrt() * (COSINES - 1) as f32;
+        let i = (t as usize).min(COSINES - 2);
+        // Linear in μ between the nodes (the integral of E_avg assumes it).
+        let (a, b) = (cosine_node(i), cosine_node(i + 1));
+        let s = ((mu - a) / (b - a)).clamp(0.0, 1.0);
+        let row = |j: usize| {
+            let e = &albedo[j * COSINES..];
+            e[i] * (1.0 - s) + e[i + 1] * s
+        };
+        let (j, w) = (self.roughness_node, self.roughness_weight);
+        row(j) * (1.0 - w) + row(j + 1) * w
+    }
+
+    /// The white compensation lobe f_ms at cosines `mu_o`, `mu_i` (without F_ms).
+    pub fn f(&self, mu_o: f32, mu_i: f32) -> f32 {
+        (1.0 - self.albedo(mu_o)) * (1.0 - self.albedo(mu_i))
+            / (std::f32::consts::PI * self.missing_average)
+    }
+
+    /// F_ms for a mean Fresnel reflectance `f_avg`: the share of the light missing from
+    /// single scattering that the bounces between microfacets of that reflectance return.
+    pub fn fresnel(&self, f_avg: f32) -> f32 {
+        let average = 1.0 - self.missing_average;
+        f_avg * f_avg * average / (1.0 - f_avg * self.missing_average)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The compensation lobe returns what single scattering misses: ∫ f_ms μi dωi = 1 − E(μo)
+    /// (its normalization by E_avg), and a coloured Fresnel returns less of it.
+    #[test]
+    fn compensation_lobe_returns_the_missing_energy() {
+        for roughness in [0.3f32, 0.6, 1.0] {
+            let compensation = EnergyCompensation::new(roughness).unwrap();
+            for mu_o in [0.1f32, 0.5, 1.0] {
+                let n = 20_000;
+                let integral: f64 = (0..n)
+                    .map(|k| {
+                        let mu_i = (k as f32 + 0.5) / n as f32;
+                        (compensation.f(mu_o, mu_i) * mu_i) as f64
+                    })
+                    .sum::<f64>()
+                    * std::f64::consts::TAU
+                    / n as f64;
+                let missing = 1.0 - compensation.albedo(mu_o) as f64;
+                assert!(
+                    (integral - missing).abs() < 1e-3 * missing.max(1e-2),
+                    "roughness {roughness} μo {mu_o}: {integral} vs {missing}"
+                );
+            }
+            assert!((compensation.fresnel(1.0) - 1.0).abs() < 1e-6);
+            assert!(compensation.fresnel(0.5) < 0.5);
+        }
+        assert!(EnergyCompensation::new(0.0).is_none());
+    }
+}
