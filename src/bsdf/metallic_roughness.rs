@@ -1097,8 +1097,9 @@ mod tests {
     }
 
     /// The compensation's table of the white metal's single-scattering albedo E agrees with
-    /// the quadrature above (a different integral: over half vectors, not the sampler's
-    /// coordinates), at angles and roughnesses between the table's nodes.
+    /// the quadrature above (the table's own is the same integral with 1/470 of its nodes,
+    /// interpolated), at angles and roughnesses between the table's nodes. The sampled
+    /// furnace below checks E independently of both.
     #[test]
     fn compensation_table_is_the_single_scattering_albedo() {
         for roughness in [0.15f32, 0.25, 0.3, 0.5, 0.77, 1.0] {

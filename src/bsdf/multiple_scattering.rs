@@ -11,8 +11,8 @@
 //! F_avg² E_avg / (1 − F_avg (1 − E_avg)) sums the bounces' geometric series with the mean
 //! Fresnel reflectance F_avg.
 //!
-//! E is tabulated over (μ, roughness) on first use, by a deterministic quadrature of the
-//! visible-normal sampling, and interpolated bilinearly; E_avg is the exact cosine-weighted
+//! E is tabulated over (μ, roughness) on first use (about 0.1 s), by a deterministic
+//! quadrature over the half vectors, and interpolated bilinearly; E_avg is the exact cosine-weighted
 //! integral of the interpolated E, so the compensated white reflector's albedo is 1 up to the
 //! table's error in E alone.
 
