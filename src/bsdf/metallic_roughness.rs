@@ -727,13 +727,12 @@ impl LobeChoice {
 #[cfg(test)]
 mod tests {
     use super::super::dielectric;
-    use super::super::multiple_scattering::EnergyCompensation;
+    use super::super::multiple_scattering::{EnergyCompensation, single_scattering_albedo};
     use super::*;
     use crate::sampling::Rng;
     use crate::sampling::chi_square::{
         Z_1E6, pooled_statistic, quantile, sphere_cell_probabilities,
     };
-    use std::f64::consts::PI as PI64;
 
     /// A tilted shading normal, so no test relies on the frame being the world's.
     fn normal() -> Vec3A {
@@ -1031,34 +1030,11 @@ mod tests {
         }
     }
 
-    /// ∫ G2 D / (4 cos θo) dωi of a white metal (F = 1) by quadrature over the half vector
-    /// h, dωi = 4 |wo·h| dωh: θh = atan(α tan(πx/2)) puts the nodes where D is.
-    fn white_metal_albedo_by_quadrature(alpha: f32, wo: Vec3A) -> f64 {
-        let distribution = TrowbridgeReitz::new(alpha);
-        let (nx, nphi) = (3000, 720);
-        let alpha = alpha as f64;
-        let mut sum = 0.0;
-        for i in 0..nx {
-            let x = (i as f64 + 0.5) / nx as f64;
-            let t = (PI64 / 2.0 * x).tan();
-            let theta = (alpha * t).atan();
-            let d_theta = alpha * PI64 / 2.0 * (1.0 + t * t) / (1.0 + alpha * alpha * t * t);
-            let (s, c) = theta.sin_cos();
-            for j in 0..nphi {
-                let phi = 2.0 * PI64 * (j as f64 + 0.5) / nphi as f64;
-                let h = Vec3A::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
-                let cos_oh = wo.dot(h);
-                let wi = reflect(wo, h);
-                if cos_oh <= 0.0 || wi.z <= 0.0 {
-                    continue;
-                }
-                let integrand =
-                    distribution.d(h) as f64 * distribution.g2(wo, wi) as f64 * cos_oh as f64
-                        / wo.z as f64;
-                sum += integrand * s * d_theta / nx as f64 * 2.0 * PI64 / nphi as f64;
-            }
-        }
-        sum
+    /// A white metal's (F = 1) albedo by the compensation table's quadrature over half
+    /// vectors (multiple_scattering.rs), with 3000 × 360 nodes: about 470 times the
+    /// table's.
+    fn white_metal_albedo_by_quadrature(alpha: f32, mu: f32) -> f64 {
+        single_scattering_albedo(alpha, mu, 3000, 360)
     }
 
     /// A white metal's albedo is the microfacet integral (computed without the sampler);
@@ -1079,7 +1055,7 @@ mod tests {
                 let sampled = albedo(&m, wo, 400_000, &mut rng)[0] as f64;
                 let local = Vec3A::new(wo.dot(basis.tangent), wo.dot(basis.bitangent), wo.dot(n));
                 let integral = if roughness > 0.0 {
-                    white_metal_albedo_by_quadrature(roughness * roughness, local)
+                    white_metal_albedo_by_quadrature(roughness * roughness, local.z)
                 } else {
                     1.0
                 };
@@ -1096,17 +1072,16 @@ mod tests {
         }
     }
 
-    /// The compensation's table of the white metal's single-scattering albedo E agrees with
-    /// the quadrature above (the table's own is the same integral with 1/470 of its nodes,
-    /// interpolated), at angles and roughnesses between the table's nodes. The sampled
-    /// furnace below checks E independently of both.
+    /// The compensation's table of the white metal's single-scattering albedo E, interpolated
+    /// between its nodes, agrees with its quadrature at 470 times the nodes; the test above
+    /// checks that quadrature against the sampler, and the furnace below checks E through
+    /// the sampler independently of both.
     #[test]
     fn compensation_table_is_the_single_scattering_albedo() {
         for roughness in [0.15f32, 0.25, 0.3, 0.5, 0.77, 1.0] {
             let compensation = EnergyCompensation::new(roughness).unwrap();
             for mu in [0.05f32, 0.2, 0.5, 0.9, 1.0] {
-                let wo = Vec3A::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-                let integral = white_metal_albedo_by_quadrature(roughness * roughness, wo);
+                let integral = white_metal_albedo_by_quadrature(roughness * roughness, mu);
                 let tabulated = compensation.albedo(mu) as f64;
                 assert!(
                     (tabulated - integral).abs() < 3e-3,

@@ -47,22 +47,29 @@ fn cosine_node(i: usize) -> f32 {
 /// angle θ_h = atan(α tan(πx/2)), which puts the nodes where D's long tail is (sampling
 /// the visible normals on a grid would leave the tail, where the loss is, to a node or
 /// two), and in the azimuth on one side of the plane of incidence (the integrand is
-/// symmetric about it).
-fn single_scattering_albedo(distribution: TrowbridgeReitz, alpha: f32, mu: f32) -> f64 {
+/// symmetric about it): `polar_nodes` × `azimuth_nodes` nodes.
+pub(crate) fn single_scattering_albedo(
+    alpha: f32,
+    mu: f32,
+    polar_nodes: usize,
+    azimuth_nodes: usize,
+) -> f64 {
     use std::f64::consts::PI;
+    let distribution = TrowbridgeReitz::new(alpha);
+    let alpha = alpha.max(MIN_ALPHA);
     let mu = mu.max(1e-4);
     let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let alpha = alpha as f64;
     let mut sum = 0.0f64;
-    for i in 0..POLAR_NODES {
-        let x = (i as f64 + 0.5) / POLAR_NODES as f64;
+    for i in 0..polar_nodes {
+        let x = (i as f64 + 0.5) / polar_nodes as f64;
         let t = (PI / 2.0 * x).tan();
         let theta = (alpha * t).atan();
         // dθ/dx, with the sine of the solid angle.
         let d_theta = alpha * PI / 2.0 * (1.0 + t * t) / (1.0 + alpha * alpha * t * t);
         let (sin, cos) = theta.sin_cos();
-        for j in 0..AZIMUTH_NODES {
-            let phi = PI * (j as f64 + 0.5) / AZIMUTH_NODES as f64;
+        for j in 0..azimuth_nodes {
+            let phi = PI * (j as f64 + 0.5) / azimuth_nodes as f64;
             let h = Vec3A::new(
                 (sin * phi.cos()) as f32,
                 (sin * phi.sin()) as f32,
@@ -77,8 +84,8 @@ fn single_scattering_albedo(distribution: TrowbridgeReitz, alpha: f32, mu: f32) 
             sum += f * sin * d_theta;
         }
     }
-    // Both sides of the plane: 2 × π / AZIMUTH_NODES per azimuth node.
-    sum * 2.0 * PI / (AZIMUTH_NODES * POLAR_NODES) as f64 / mu as f64
+    // Both sides of the plane: 2 × π / azimuth_nodes per azimuth node.
+    sum * 2.0 * PI / (azimuth_nodes * polar_nodes) as f64 / mu as f64
 }
 
 fn table() -> &'static AlbedoTable {
@@ -88,11 +95,12 @@ fn table() -> &'static AlbedoTable {
         let mut average = Vec::with_capacity(ROUGHNESSES);
         for j in 0..ROUGHNESSES {
             let roughness = j as f32 / (ROUGHNESSES - 1) as f32;
-            let alpha = (roughness * roughness).max(MIN_ALPHA);
-            let distribution = TrowbridgeReitz::new(alpha);
+            let alpha = roughness * roughness;
             let row: Vec<f32> = (0..COSINES)
                 .map(|i| {
-                    single_scattering_albedo(distribution, alpha, cosine_node(i)).min(1.0) as f32
+                    let e =
+                        single_scattering_albedo(alpha, cosine_node(i), POLAR_NODES, AZIMUTH_NODES);
+                    e.min(1.0) as f32
                 })
                 .collect();
             // 2 ∫ E(μ) μ dμ of the piecewise-linear E, segment by segment exactly.

@@ -354,12 +354,7 @@ impl EmbreeAccel {
         // `rayhit` are initialized, correctly aligned locals that Embree writes only during
         // the call.
         unsafe { rtcIntersect1(self.scene, &mut context, &mut rayhit) };
-        (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID).then_some(Hit {
-            triangle: rayhit.hit.primID,
-            t: rayhit.ray.tfar,
-            u: rayhit.hit.u,
-            v: rayhit.hit.v,
-        })
+        hit_of(&rayhit)
     }
 
     #[inline]
@@ -395,12 +390,7 @@ impl EmbreeAccel {
             )
         };
         context.resume_panic();
-        (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID).then_some(Hit {
-            triangle: rayhit.hit.primID,
-            t: rayhit.ray.tfar,
-            u: rayhit.hit.u,
-            v: rayhit.hit.v,
-        })
+        hit_of(&rayhit)
     }
 
     /// Whether a hit that `accept(triangle, u, v)` keeps lies on the ray; panics as
@@ -499,6 +489,17 @@ unsafe extern "C" fn filter_hits<F: Fn(u32, f32, f32) -> bool>(
             Err(payload) => context.panic.set(Some(payload)),
         }
     }
+}
+
+/// The hit Embree wrote into `rayhit`, if any (its primID is the internal triangle index).
+#[inline]
+fn hit_of(rayhit: &RTCRayHit) -> Option<Hit> {
+    (rayhit.hit.geomID != RTC_INVALID_GEOMETRY_ID).then_some(Hit {
+        triangle: rayhit.hit.primID,
+        t: rayhit.ray.tfar,
+        u: rayhit.hit.u,
+        v: rayhit.hit.v,
+    })
 }
 
 /// Our ray as Embree's: every mask bit set (Debian's Embree is built with ray masks, and a
