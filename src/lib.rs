@@ -39,6 +39,7 @@ mod interaction;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+mod spectral;
 pub mod spectrum;
 mod texture;
 
