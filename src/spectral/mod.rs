@@ -1,5 +1,7 @@
 //! Spectral transport (issue 19, in progress): the wavelengths a camera path carries.
 //! Not yet used by the integrators.
+// Until the integrators use it.
+#![cfg_attr(not(test), allow(dead_code))]
 
 mod wavelengths;
 
