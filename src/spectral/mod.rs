@@ -3,8 +3,12 @@
 // Until the integrators use it.
 #![cfg_attr(not(test), allow(dead_code))]
 
+mod cie;
+mod cie_data;
 mod wavelengths;
 
+#[allow(unused_imports)]
+pub(crate) use cie::{cie_1931_xyz, d65};
 #[allow(unused_imports)]
 pub(crate) use wavelengths::{
     LAMBDA_MAX, LAMBDA_MIN, SampledWavelengths, WAVELENGTHS, visible_wavelength_pdf,
