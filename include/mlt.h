@@ -510,6 +510,15 @@ typedef struct MltMaterial {
    * Default 0, glTF's model as its specification defines it.
    */
   uint32_t energy_compensation;
+  /**
+   * Dispersion of a dielectric or of the metallic-roughness model's dielectric part, as
+   * the Abbe number V_d: `ior` holds at 587.56 nm and the index at wavelength λ is
+   * n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168), the Cauchy form of glTF's
+   * `KHR_materials_dispersion` (whose `dispersion` is 20 / V_d). 0 (the default) is no
+   * dispersion; otherwise finite and positive. Only `MltSettings.spectral` renders
+   * disperse light.
+   */
+  float abbe_number;
 } MltMaterial;
 
 /**
@@ -959,6 +968,14 @@ typedef struct MltRenderSettings {
    * samples.
    */
   float normalization_work_fraction;
+  /**
+   * 0 or 1: spectral transport. Each camera path carries four wavelengths (hero-wavelength
+   * sampling) instead of RGB; colours given as RGB become smooth spectra, lights emit
+   * them times D65, and the image is CIE XYZ converted to linear sRGB. Dielectrics with
+   * an `MltMaterial.abbe_number` disperse light (a path through one goes on at one
+   * wavelength). Default 0 (RGB).
+   */
+  uint32_t spectral;
 } MltRenderSettings;
 
 /**

@@ -10,6 +10,7 @@
 use crate::accel::{Hit, Ray};
 use crate::bsdf::Bsdf;
 use crate::scene::Scene;
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
@@ -45,17 +46,17 @@ impl SurfaceInteraction {
         }
     }
 
-    /// The surface's BSDF here.
+    /// The surface's BSDF here, its colours in `channels`.
     #[inline]
-    pub fn bsdf(&self, scene: &Scene) -> Bsdf {
-        scene.bsdf_at(self.triangle, self.uv)
+    pub fn bsdf(&self, scene: &Scene, channels: &Channels) -> Bsdf {
+        scene.bsdf_at(self.triangle, self.uv, channels)
     }
 
     /// Radiance the surface emits from its front side (its material's emission; only
-    /// surfaces with `light_area_pdf` > 0 are lights).
+    /// surfaces with `light_area_pdf` > 0 are lights), in `channels`.
     #[inline]
-    pub fn emission(&self, scene: &Scene) -> Spectrum {
-        scene.emission(self.triangle, self.uv)
+    pub fn emission(&self, scene: &Scene, channels: &Channels) -> Spectrum {
+        scene.emission(self.triangle, self.uv, channels)
     }
 }
 
@@ -63,8 +64,13 @@ impl SurfaceInteraction {
 /// keep only the point, the geometric normal, the triangle and the barycentrics, to stay
 /// small): the same BSDF the interaction gave.
 #[inline]
-pub(crate) fn vertex_bsdf(scene: &Scene, triangle: u32, barycentrics: [f32; 2]) -> Bsdf {
-    scene.bsdf_at(triangle, barycentrics)
+pub(crate) fn vertex_bsdf(
+    scene: &Scene,
+    triangle: u32,
+    barycentrics: [f32; 2],
+    channels: &Channels,
+) -> Bsdf {
+    scene.bsdf_at(triangle, barycentrics, channels)
 }
 
 #[cfg(test)]
@@ -95,13 +101,20 @@ mod tests {
         let si = SurfaceInteraction::new(&scene, &ray, &hit);
         assert_eq!(si.p, Vec3A::new(0.0, 0.0, 1.0));
         assert_eq!(si.geometric_normal, Vec3A::new(0.0, 0.0, -1.0));
-        assert_eq!(si.bsdf(&scene).shading_normal(), si.geometric_normal);
+        assert_eq!(
+            si.bsdf(&scene, &Channels::Rgb).shading_normal(),
+            si.geometric_normal
+        );
         assert_eq!(si.uv, [hit.u, hit.v]);
         assert_eq!(si.triangle, hit.triangle);
         // The only light: picked with probability 1 over its area 2.
         assert_eq!(si.light_area_pdf, 0.5);
-        assert_eq!(si.emission(&scene), Spectrum::splat(2.0));
-        assert!(si.bsdf(&scene).lobes().contains(BsdfLobes::SPECULAR));
+        assert_eq!(si.emission(&scene, &Channels::Rgb), Spectrum::splat(2.0));
+        assert!(
+            si.bsdf(&scene, &Channels::Rgb)
+                .lobes()
+                .contains(BsdfLobes::SPECULAR)
+        );
         let Some(crate::scene::lights::LightSample::Area {
             triangle,
             area_pdf,

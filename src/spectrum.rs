@@ -3,18 +3,22 @@
 //!
 //! Colour has a type of its own, not the `Vec3A` of positions and directions, so that a
 //! colour cannot be mixed up with a point and so that every piece of colour arithmetic goes
-//! through this one definition. Today a spectrum is linear RGB held in a `Vec3A` (its SIMD
-//! arithmetic, one operation per channel; every operator forwards to `Vec3A`'s, so results
-//! are bit for bit those of plain `Vec3A` code). A spectral mode will make it carry samples
-//! at a few wavelengths instead: that changes this definition, not the integrators.
+//! through this one definition. A spectrum is four lanes of a `Vec4` (its SIMD arithmetic,
+//! one operation per lane). What the lanes mean is the path's [`Channels`]
+//! (`crate::spectral`): in RGB mode linear R, G, B and G once more — the fourth lane
+//! repeats the green so that every lane-wise operation, division included, stays as
+//! defined as on the three channels, and RGB results are those of three-channel
+//! arithmetic; in spectral mode the radiance at the path's four sampled wavelengths.
 //!
-//! Where colour leaves the kernel it becomes plain RGB again: the film and the filter keep
-//! `f32`/`f64` triples (`to_array`, indexing), the C ABI and the Rust API take and give
-//! `[f32; 3]`.
+//! Where colour leaves the kernel it becomes plain RGB again (`Channels::to_rgb`): the
+//! film and the filter keep `f32`/`f64` triples (`to_array`, indexing), the C ABI and the
+//! Rust API take and give `[f32; 3]`.
+//!
+//! [`Channels`]: crate::spectral::Channels
 //!
 //! A leaf module: it depends on glam only.
 
-use glam::Vec3A;
+use glam::Vec4;
 use std::fmt;
 use std::ops::{Add, AddAssign, Div, DivAssign, Index, Mul, MulAssign, Sub, SubAssign};
 
@@ -24,50 +28,72 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Index, Mul, MulAssign, Sub, SubAs
 /// `pub`: cbindgen would put a public constant in `include/mlt.h`.)
 pub(crate) const LUMINANCE_WEIGHTS: [f64; 3] = [0.2126, 0.7152, 0.0722];
 
-/// The weights in `f32` (each rounds to the same `f32` as its decimal literal).
-const LUMINANCE_WEIGHTS_F32: Vec3A = Vec3A::new(
+/// The weights in `f32` (each rounds to the same `f32` as its decimal literal); the fourth
+/// lane, a copy of green, weighs nothing.
+const LUMINANCE_WEIGHTS_F32: Vec4 = Vec4::new(
     LUMINANCE_WEIGHTS[0] as f32,
     LUMINANCE_WEIGHTS[1] as f32,
     LUMINANCE_WEIGHTS[2] as f32,
+    0.0,
 );
 
-/// A colour quantity: linear RGB, one `f32` per channel.
+/// A colour quantity: four `f32` lanes, linear RGB (and green again) or the values at four
+/// wavelengths.
 #[derive(Clone, Copy, Default, PartialEq)]
 #[repr(transparent)]
-pub struct Spectrum(Vec3A);
+pub struct Spectrum(Vec4);
 
 impl Spectrum {
     /// Black: no light, no reflectance.
-    pub const ZERO: Spectrum = Spectrum(Vec3A::ZERO);
-    /// One in every channel: the throughput a path starts with.
-    pub const ONE: Spectrum = Spectrum(Vec3A::ONE);
+    pub const ZERO: Spectrum = Spectrum(Vec4::ZERO);
+    /// One in every lane: the throughput a path starts with.
+    pub const ONE: Spectrum = Spectrum(Vec4::ONE);
 
-    /// The spectrum with channels `r`, `g`, `b`.
+    /// The RGB spectrum with channels `r`, `g`, `b`.
     #[inline]
     pub const fn new(r: f32, g: f32, b: f32) -> Spectrum {
-        Spectrum(Vec3A::new(r, g, b))
+        Spectrum(Vec4::new(r, g, b, g))
     }
 
-    /// `v` in every channel (a grey).
+    /// The spectrum with these four lanes (values at four wavelengths).
+    #[inline]
+    pub(crate) const fn from_lanes(lanes: [f32; 4]) -> Spectrum {
+        Spectrum(Vec4::from_array(lanes))
+    }
+
+    /// `v` in every lane (a grey).
     #[inline]
     pub const fn splat(v: f32) -> Spectrum {
-        Spectrum(Vec3A::splat(v))
+        Spectrum(Vec4::splat(v))
     }
 
-    /// The channels as RGB.
+    /// The first three lanes: the channels of an RGB spectrum.
     #[inline]
-    pub const fn to_array(self) -> [f32; 3] {
+    pub fn to_array(self) -> [f32; 3] {
+        [self.0.x, self.0.y, self.0.z]
+    }
+
+    /// All four lanes.
+    #[inline]
+    pub(crate) const fn lanes(self) -> [f32; 4] {
         self.0.to_array()
     }
 
-    /// Luminance (Rec. 709, `LUMINANCE_WEIGHTS`): the scalar of a colour, by which lights
-    /// are picked and Metropolis chains are distributed.
+    /// `f` applied to every lane (a non-linear function of a colour, channel by channel).
+    #[inline]
+    pub(crate) fn map(self, f: impl Fn(f32) -> f32) -> Spectrum {
+        Spectrum(self.0.map(f))
+    }
+
+    /// Luminance (Rec. 709, `LUMINANCE_WEIGHTS`) of an RGB spectrum: the scalar of a
+    /// colour, by which lights are picked and Metropolis chains are distributed. (A
+    /// spectrum at wavelengths has its luminance through `Channels::luminance`.)
     #[inline]
     pub fn luminance(self) -> f32 {
         self.0.dot(LUMINANCE_WEIGHTS_F32)
     }
 
-    /// The largest channel (Russian roulette's survival, tests for black).
+    /// The largest lane (Russian roulette's survival, tests for black).
     #[inline]
     pub fn max_component(self) -> f32 {
         self.0.max_element()
@@ -99,16 +125,16 @@ impl Spectrum {
 }
 
 impl From<[f32; 3]> for Spectrum {
-    /// The spectrum of linear RGB channels (materials' colours and emission).
+    /// The RGB spectrum of linear RGB channels (materials' colours and emission).
     #[inline]
-    fn from(rgb: [f32; 3]) -> Spectrum {
-        Spectrum(Vec3A::from(rgb))
+    fn from([r, g, b]: [f32; 3]) -> Spectrum {
+        Spectrum::new(r, g, b)
     }
 }
 
 impl Index<usize> for Spectrum {
     type Output = f32;
-    /// Channel `index` (0, 1, 2: R, G, B).
+    /// Lane `index` (0, 1, 2: R, G, B of an RGB spectrum; 3 repeats G).
     #[inline]
     fn index(&self, index: usize) -> &f32 {
         &self.0[index]
@@ -117,12 +143,11 @@ impl Index<usize> for Spectrum {
 
 impl fmt::Debug for Spectrum {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let [r, g, b] = self.to_array();
-        f.debug_tuple("Spectrum")
-            .field(&r)
-            .field(&g)
-            .field(&b)
-            .finish()
+        let mut tuple = f.debug_tuple("Spectrum");
+        for lane in self.lanes() {
+            tuple.field(&lane);
+        }
+        tuple.finish()
     }
 }
 
@@ -132,7 +157,7 @@ impl fmt::Display for Spectrum {
     }
 }
 
-/// `impl $trait for Spectrum` (and its `…Assign`), channel by channel, by `Vec3A`'s.
+/// `impl $trait for Spectrum` (and its `…Assign`), lane by lane, by `Vec4`'s.
 macro_rules! channelwise {
     ($trait:ident $method:ident, $assign:ident $assign_method:ident) => {
         impl $trait for Spectrum {
@@ -190,9 +215,11 @@ impl Mul<Spectrum> for f32 {
 mod tests {
     use super::*;
 
-    /// The operators are `Vec3A`'s, bit for bit, in the order they are written.
+    /// On RGB spectra the operators are three-channel (`Vec3A`) arithmetic, bit for bit,
+    /// in the order they are written, and the fourth lane stays a copy of green.
     #[test]
     fn arithmetic_is_vec3a_arithmetic() {
+        use glam::Vec3A;
         let (a, b, c) = ([0.3f32, 1.7, 2.9], [0.11f32, 7.3, 0.013], 0.37f32);
         let (sa, sb) = (Spectrum::from(a), Spectrum::from(b));
         let (va, vb) = (Vec3A::from(a), Vec3A::from(b));
@@ -215,10 +242,10 @@ mod tests {
         s -= sb;
         v -= vb;
         assert_eq!(bits(s), vbits(v));
-        assert_eq!(
-            sa.luminance().to_bits(),
-            va.dot(Vec3A::new(0.2126, 0.7152, 0.0722)).to_bits()
-        );
+        assert_eq!(s[3].to_bits(), s[1].to_bits());
+        assert_eq!((sa / sb)[3].to_bits(), (sa / sb)[1].to_bits());
+        let luminance = va.dot(Vec3A::new(0.2126, 0.7152, 0.0722));
+        assert!((sa.luminance() - luminance).abs() <= 1e-6 * luminance);
     }
 
     #[test]
@@ -232,6 +259,14 @@ mod tests {
         assert!(s.is_finite() && !Spectrum::splat(f32::NAN).is_finite());
         assert!((Spectrum::ONE.luminance() - 1.0).abs() < 1e-6);
         assert_eq!(Spectrum::splat(2.0), Spectrum::new(2.0, 2.0, 2.0));
-        assert_eq!(format!("{:?}", Spectrum::ONE), "Spectrum(1.0, 1.0, 1.0)");
+        assert_eq!(
+            format!("{:?}", Spectrum::ONE),
+            "Spectrum(1.0, 1.0, 1.0, 1.0)"
+        );
+        assert_eq!(s.map(|x| 2.0 * x).to_array(), [0.5, -2.0, 1.0]);
+        assert_eq!(
+            Spectrum::from_lanes([1.0, 2.0, 3.0, 4.0]).lanes(),
+            [1.0, 2.0, 3.0, 4.0]
+        );
     }
 }

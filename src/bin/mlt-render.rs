@@ -238,6 +238,15 @@ struct Args {
     /// reflects all the light at every roughness instead of 31% at roughness 1.
     #[arg(long)]
     energy_compensation: bool,
+    /// Spectral transport: each path carries four wavelengths instead of RGB (the image is
+    /// CIE XYZ converted to linear sRGB); dispersive glass splits light into colours.
+    #[arg(long)]
+    spectral: bool,
+    /// Make every dielectric (glass, and transmissive glTF materials) without a dispersion
+    /// of its own dispersive with this Abbe number (crown glass ~60, flint ~36, lower is
+    /// stronger). Seen in --spectral renders only.
+    #[arg(long, value_name = "V")]
+    abbe_number: Option<f32>,
     /// Metropolis and ERPT: filter the image's blotchy noise after the render (non-local
     /// means guided by variances measured from partial images; keeps the total).
     #[arg(long)]
@@ -353,6 +362,15 @@ fn run(args: &Args) -> Result<(), String> {
     let mut data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
     for material in &mut data.materials {
         material.energy_compensation = args.energy_compensation;
+        let transmits = material.kind == mlt::MaterialKind::Dielectric
+            || (material.kind == mlt::MaterialKind::MetallicRoughness
+                && material.transmission > 0.0);
+        if let Some(abbe_number) = args.abbe_number
+            && transmits
+            && material.abbe_number == 0.0
+        {
+            material.abbe_number = abbe_number;
+        }
     }
     let framed = data.camera.is_none() && args.camera.is_none();
     let camera_file = match &args.camera {
@@ -498,6 +516,7 @@ fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
         filter_buffers: if args.filter { args.filter_buffers } else { 0 },
         filter_strength: args.filter_strength,
         filter_radius: args.filter_radius,
+        spectral: args.spectral,
     }
 }
 

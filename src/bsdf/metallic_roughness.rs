@@ -482,7 +482,7 @@ impl MetallicRoughness {
     fn multiple_scattering_tint(&self, compensation: &EnergyCompensation) -> Spectrum {
         let f_ms = |f0: f32| compensation.fresnel(f0 + (1.0 - f0) / 21.0);
         let c = self.base_color;
-        Spectrum::new(f_ms(c[0]), f_ms(c[1]), f_ms(c[2])) * self.metallic
+        c.map(f_ms) * self.metallic
     }
 
     /// The diffuse base's share of the material, times its albedo.

@@ -75,6 +75,9 @@ pub(crate) struct Bsdf {
     geometric_normal: Vec3A,
     /// Whether the two normals differ (without, the corrections are exactly 1 and skipped).
     shading_normal_differs: bool,
+    /// Whether its index of refraction is the path's hero wavelength's (see
+    /// `is_dispersive`).
+    dispersive: bool,
 }
 
 impl Bsdf {
@@ -86,7 +89,23 @@ impl Bsdf {
             normal: shading_normal,
             geometric_normal,
             shading_normal_differs: shading_normal != geometric_normal,
+            dispersive: false,
         }
+    }
+
+    /// The BSDF, marked dispersive or not (see `is_dispersive`).
+    #[inline]
+    pub fn with_dispersion(mut self, dispersive: bool) -> Self {
+        self.dispersive = dispersive;
+        self
+    }
+
+    /// Whether it refracts the path's wavelengths differently and was built with the
+    /// hero wavelength's index: a path that scatters here must go on at the hero
+    /// wavelength alone (`Channels::keep_hero_only`).
+    #[inline]
+    pub fn is_dispersive(&self) -> bool {
+        self.dispersive
     }
 
     /// The classes of its lobes.
@@ -407,16 +426,19 @@ mod tests {
     use super::*;
     use crate::sampling::Rng;
     use crate::scene::Material;
+    use crate::spectral::Channels;
 
     /// Today's materials: diffuse is connectible (D), mirror and glass are Dirac (S); a
     /// glossy lobe counts as non-specular, alone or next to a specular one.
     #[test]
     fn lobes_classify_materials() {
-        let diffuse = Material::diffuse([0.5; 3]).bsdf_model().lobes();
+        let diffuse = Material::diffuse([0.5; 3])
+            .bsdf_model(&Channels::Rgb)
+            .lobes();
         assert!(diffuse.has_non_specular() && !diffuse.is_specular());
         assert!(diffuse.contains(BsdfLobes::DIFFUSE));
         for m in [Material::mirror([1.0; 3]), Material::dielectric(1.5)] {
-            let lobes = m.bsdf_model().lobes();
+            let lobes = m.bsdf_model(&Channels::Rgb).lobes();
             assert!(lobes.is_specular() && !lobes.has_non_specular());
             assert!(lobes.contains(BsdfLobes::SPECULAR));
         }
@@ -429,7 +451,7 @@ mod tests {
     /// equals the material's color for diffuse, and the pdf matches eval/cos for diffuse.
     #[test]
     fn diffuse_sample_is_consistent_with_eval_and_pdf() {
-        let m = Material::diffuse([0.5, 0.25, 0.75]).bsdf_model();
+        let m = Material::diffuse([0.5, 0.25, 0.75]).bsdf_model(&Channels::Rgb);
         let n = Vec3A::new(0.0, 0.6, 0.8);
         let wo = Vec3A::new(0.3, -0.5, -0.8).normalize();
         let mut rng = Rng::new(1, 2);

@@ -62,6 +62,7 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
             m.energy_compensation,
             &format!("{name}.energy_compensation"),
         )?,
+        abbe_number: m.abbe_number,
     })
 }
 
@@ -259,6 +260,7 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         filter_strength: s.filter_strength,
         filter_radius: s.filter_radius,
         normalization_work_fraction: s.normalization_work_fraction,
+        spectral: flag(s.spectral, "settings.spectral")?,
     })
 }
 

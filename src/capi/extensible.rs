@@ -219,6 +219,7 @@ impl Extensible for MltMaterial {
             emission_texture: NO_TEXTURE,
             normal_scale: d.normal_scale,
             energy_compensation: d.energy_compensation as u32,
+            abbe_number: d.abbe_number,
         }
     }
 }
@@ -392,6 +393,7 @@ impl Extensible for MltRenderSettings {
             filter_strength: d.filter_strength,
             filter_radius: d.filter_radius,
             normalization_work_fraction: d.normalization_work_fraction,
+            spectral: d.spectral as u32,
         }
     }
 }
@@ -478,7 +480,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 164]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);

@@ -210,6 +210,13 @@ pub struct MltMaterial {
     /// every roughness, instead of 92% at roughness 0.5 and 31% at 1 (normal incidence).
     /// Default 0, glTF's model as its specification defines it.
     pub energy_compensation: u32,
+    /// Dispersion of a dielectric or of the metallic-roughness model's dielectric part, as
+    /// the Abbe number V_d: `ior` holds at 587.56 nm and the index at wavelength λ is
+    /// n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168), the Cauchy form of glTF's
+    /// `KHR_materials_dispersion` (whose `dispersion` is 20 / V_d). 0 (the default) is no
+    /// dispersion; otherwise finite and positive. Only `MltSettings.spectral` renders
+    /// disperse light.
+    pub abbe_number: f32,
 }
 
 /// A texture the materials refer to by index (`MltSceneDesc.textures`). Initialize with
@@ -511,6 +518,12 @@ pub struct MltRenderSettings {
     /// large steps), so its brightness error shrinks as the render goes on. 0: no such
     /// samples.
     pub normalization_work_fraction: f32,
+    /// 0 or 1: spectral transport. Each camera path carries four wavelengths (hero-wavelength
+    /// sampling) instead of RGB; colours given as RGB become smooth spectra, lights emit
+    /// them times D65, and the image is CIE XYZ converted to linear sRGB. Dielectrics with
+    /// an `MltMaterial.abbe_number` disperse light (a path through one goes on at one
+    /// wavelength). Default 0 (RGB).
+    pub spectral: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.

@@ -28,6 +28,7 @@ use crate::interaction::{SurfaceInteraction, vertex_bsdf};
 use crate::sampling::{Rng, Sampler};
 use crate::scene::lights::{Emitter, LightSample};
 use crate::scene::{CameraModel, Scene};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::FRAC_1_PI;
@@ -38,6 +39,9 @@ pub struct Bdpt<'a> {
     pub max_depth: u32,
     /// Paths with fewer scattering vertices contribute nothing (another pass renders them).
     pub min_depth: u32,
+    /// Whether paths carry wavelengths (one more camera-stream coordinate, read right
+    /// after the film position) instead of RGB.
+    pub spectral: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,6 +140,8 @@ pub struct BdptScratch {
     light: Vec<Vertex>,
     /// The vertex the last strategy with s = 1 or t = 1 sampled to connect to.
     connection: Vertex,
+    /// What the subpaths' spectra are: RGB, or the wavelengths both subpaths carry.
+    channels: Channels,
 }
 
 /// Converts a solid-angle density at `from` of the direction towards `to` into an area
@@ -164,28 +170,37 @@ fn to_area(pdf_solid_angle: f32, from: &Vertex, to: &Vertex) -> f32 {
 impl Bdpt<'_> {
     /// The BSDF of a surface vertex.
     #[inline]
-    fn bsdf(&self, v: &Vertex) -> Bsdf {
-        vertex_bsdf(self.scene, v.triangle, v.barycentrics)
+    fn bsdf(&self, v: &Vertex, channels: &Channels) -> Bsdf {
+        vertex_bsdf(self.scene, v.triangle, v.barycentrics, channels)
     }
 
     /// Radiance the light a camera subpath ended on sends back along it: an emitting
     /// surface towards `w` (front side only), or the lights at infinity.
     #[inline]
-    fn emitted(&self, v: &Vertex, w: Vec3A) -> Spectrum {
+    fn emitted(&self, v: &Vertex, w: Vec3A, channels: &Channels) -> Spectrum {
         match v.kind {
             VertexKind::Surface
                 if self.scene.light_area_pdf(v.triangle) > 0.0 && w.dot(v.normal) > 0.0 =>
             {
-                self.scene.emission(v.triangle, v.barycentrics)
+                self.scene.emission(v.triangle, v.barycentrics, channels)
             }
-            VertexKind::Light(Emitter::Infinite) => self.scene.lights.infinite_radiance(v.normal),
+            VertexKind::Light(Emitter::Infinite) => {
+                self.scene.lights.infinite_radiance(v.normal, channels)
+            }
             _ => Spectrum::ZERO,
         }
     }
 
     /// Area density at `next` of sampling it from `v`, which was reached from `prev`.
     #[inline]
-    fn pdf(&self, camera: &CameraModel, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -> f32 {
+    fn pdf(
+        &self,
+        camera: &CameraModel,
+        v: &Vertex,
+        prev: Option<&Vertex>,
+        next: &Vertex,
+        channels: &Channels,
+    ) -> f32 {
         let Some((wn, _)) = direction(v, next) else {
             return 0.0;
         };
@@ -198,7 +213,7 @@ impl Bdpt<'_> {
                     Some(prev) => (prev.p - v.p).normalize(),
                     None => v.wo,
                 };
-                self.bsdf(v).pdf(wp, wn)
+                self.bsdf(v, channels).pdf(wp, wn)
             }
         };
         to_area(pdf_solid_angle, v, next)
@@ -257,6 +272,7 @@ impl Bdpt<'_> {
         mut pdf_solid_angle: f32,
         max_vertices: usize,
         mode: TransportMode,
+        channels: &mut Channels,
         sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
@@ -281,7 +297,10 @@ impl Bdpt<'_> {
                 break;
             };
             let si = SurfaceInteraction::new(self.scene, &ray, &hit);
-            let bsdf = si.bsdf(self.scene);
+            let bsdf = si.bsdf(self.scene, channels);
+            if bsdf.is_dispersive() {
+                channels.keep_hero_only();
+            }
             let mut vertex = Vertex {
                 kind: VertexKind::Surface,
                 p: si.p,
@@ -335,6 +354,7 @@ impl Bdpt<'_> {
         y: f32,
         path: &mut [Vertex],
         max_vertices: usize,
+        channels: &mut Channels,
         sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
@@ -356,6 +376,7 @@ impl Bdpt<'_> {
             pdf_direction,
             max_vertices,
             TransportMode::Radiance,
+            channels,
             sampler,
             counters,
         )
@@ -365,6 +386,7 @@ impl Bdpt<'_> {
         &self,
         path: &mut [Vertex],
         max_vertices: usize,
+        channels: &mut Channels,
         sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> usize {
@@ -374,7 +396,10 @@ impl Bdpt<'_> {
         if max_vertices == 0 {
             return 0;
         }
-        let Some(light) = self.scene.sample_emission(u_select, u_point, u_direction) else {
+        let Some(light) = self
+            .scene
+            .sample_emission(u_select, u_point, u_direction, channels)
+        else {
             return 0;
         };
         let triangle = match light.emitter {
@@ -406,6 +431,7 @@ impl Bdpt<'_> {
             light.pdf_direction,
             max_vertices,
             TransportMode::Importance,
+            channels,
             sampler,
             counters,
         )
@@ -421,6 +447,7 @@ impl Bdpt<'_> {
         light: &mut [Vertex],
         s: usize,
         t: usize,
+        channels: &Channels,
     ) -> f32 {
         if s + t == 2 {
             return 1.0;
@@ -441,20 +468,22 @@ impl Bdpt<'_> {
 
         camera[t - 1].specular = false;
         camera[t - 1].pdf_reverse = match qs {
-            Some(qs) => self.pdf(camera_model, &qs, qs_minus.as_ref(), &pt),
+            Some(qs) => self.pdf(camera_model, &qs, qs_minus.as_ref(), &pt, channels),
             None => self.pdf_light_origin(&pt),
         };
         if let Some(pt_minus) = pt_minus {
             camera[t - 2].pdf_reverse = match qs {
-                Some(qs) => self.pdf(camera_model, &pt, Some(&qs), &pt_minus),
+                Some(qs) => self.pdf(camera_model, &pt, Some(&qs), &pt_minus, channels),
                 None => self.pdf_light_direction(&pt, &pt_minus),
             };
         }
         if let Some(qs) = qs {
             light[s - 1].specular = false;
-            light[s - 1].pdf_reverse = self.pdf(camera_model, &pt, pt_minus.as_ref(), &qs);
+            light[s - 1].pdf_reverse =
+                self.pdf(camera_model, &pt, pt_minus.as_ref(), &qs, channels);
             if let Some(qs_minus) = qs_minus {
-                light[s - 2].pdf_reverse = self.pdf(camera_model, &qs, Some(&pt), &qs_minus);
+                light[s - 2].pdf_reverse =
+                    self.pdf(camera_model, &qs, Some(&pt), &qs_minus, channels);
             }
         }
 
@@ -502,13 +531,13 @@ impl Bdpt<'_> {
     /// on a subpath carrying `mode` (radiance on camera subpaths, importance on light
     /// subpaths: the BSDF is not symmetric under shading normals).
     #[inline]
-    fn f(&self, v: &Vertex, to: Vec3A, mode: TransportMode) -> Spectrum {
+    fn f(&self, v: &Vertex, to: Vec3A, mode: TransportMode, channels: &Channels) -> Spectrum {
         let w = to - v.p;
         let length = w.length();
         if length == 0.0 {
             return Spectrum::ZERO;
         }
-        self.bsdf(v).eval(v.wo, w / length, mode)
+        self.bsdf(v, channels).eval(v.wo, w / length, mode)
     }
 
     /// Whether nothing blocks the way from surface vertex `a` to infinity along `w`.
@@ -557,8 +586,9 @@ impl Bdpt<'_> {
     /// Most coordinates one stream is read at by any sample: a Metropolis sampler reserves
     /// `STREAMS` times this many.
     pub(crate) fn coordinates_per_stream(&self) -> usize {
-        // Film position 2, strategy 1, lens 2, then 3 per scattering vertex.
-        5 + 3 * (self.max_depth as usize + 2)
+        // Film position 2, strategy 1, wavelengths 1 (spectral only), lens 2, then 3 per
+        // scattering vertex.
+        5 + self.spectral as usize + 3 * (self.max_depth as usize + 2)
     }
 
     /// Traces the camera subpath through film position (x, y) with at most `camera_vertices`
@@ -577,17 +607,25 @@ impl Bdpt<'_> {
         scratch: &mut BdptScratch,
         counters: &mut SampleCounters,
     ) -> (usize, usize) {
+        scratch.channels = Channels::new(self.spectral, || sampler.uniform());
         let n_camera = self.camera_subpath(
             camera_model,
             x,
             y,
             &mut scratch.camera,
             camera_vertices,
+            &mut scratch.channels,
             sampler,
             counters,
         );
         sampler.start_stream(LIGHT_STREAM);
-        let n_light = self.light_subpath(&mut scratch.light, light_vertices, sampler, counters);
+        let n_light = self.light_subpath(
+            &mut scratch.light,
+            light_vertices,
+            &mut scratch.channels,
+            sampler,
+            counters,
+        );
         (n_camera, n_light)
     }
 
@@ -646,14 +684,33 @@ impl Bdpt<'_> {
         }
     }
 
-    /// The MIS-weighted contribution of strategy (s, t) of the traced subpaths; `None` when
-    /// it is zero.
+    /// The MIS-weighted contribution of strategy (s, t) of the traced subpaths, as linear
+    /// RGB; `None` when it is zero.
     pub(crate) fn connect<S: Sampler>(
         &self,
         camera_model: &CameraModel,
         scratch: &mut BdptScratch,
         s: usize,
         t: usize,
+        sampler: &mut S,
+        counters: &mut SampleCounters,
+    ) -> Option<Contribution> {
+        let channels = scratch.channels;
+        let mut contribution =
+            self.connect_in_channels(camera_model, scratch, s, t, &channels, sampler, counters)?;
+        contribution.value = channels.to_rgb(contribution.value);
+        Some(contribution)
+    }
+
+    /// `connect`'s contribution in the subpaths' channels.
+    #[allow(clippy::too_many_arguments)]
+    fn connect_in_channels<S: Sampler>(
+        &self,
+        camera_model: &CameraModel,
+        scratch: &mut BdptScratch,
+        s: usize,
+        t: usize,
+        channels: &Channels,
         sampler: &mut S,
         counters: &mut SampleCounters,
     ) -> Option<Contribution> {
@@ -665,11 +722,11 @@ impl Bdpt<'_> {
             if pt.kind == VertexKind::Camera {
                 return None;
             }
-            let le = self.emitted(&pt, pt.wo);
+            let le = self.emitted(&pt, pt.wo, channels);
             if le.is_black() {
                 return None;
             }
-            let weight = self.mis_weight(camera_model, camera, light, 0, t);
+            let weight = self.mis_weight(camera_model, camera, light, 0, t, channels);
             Some(Contribution {
                 value: pt.beta * le * weight,
                 splat_pixel: None,
@@ -702,14 +759,14 @@ impl Bdpt<'_> {
             // s >= 2 here, so qs is a surface vertex.
             let contribution = qs.beta
                 * sampled.beta
-                * self.f(&qs, lens, TransportMode::Importance)
+                * self.f(&qs, lens, TransportMode::Importance, channels)
                 * direction.dot(qs.normal).abs();
             if contribution.is_black() || !self.visible(&qs, &sampled, counters) {
                 return None;
             }
             let saved = camera[0];
             camera[0] = sampled;
-            let weight = self.mis_weight(camera_model, camera, light, s, 1);
+            let weight = self.mis_weight(camera_model, camera, light, s, 1, channels);
             camera[0] = saved;
             let [rx, ry] = importance.raster;
             scratch.connection = sampled;
@@ -726,7 +783,10 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let (sampled, contribution) = match self.scene.sample_light(u_select, u_point)? {
+            let (sampled, contribution) = match self
+                .scene
+                .sample_light(u_select, u_point, channels)?
+            {
                 LightSample::Area {
                     point,
                     normal,
@@ -757,7 +817,7 @@ impl Bdpt<'_> {
                     }
                     let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
                     let contribution = pt.beta
-                        * self.f(&pt, sampled.p, TransportMode::Radiance)
+                        * self.f(&pt, sampled.p, TransportMode::Radiance, channels)
                         * sampled.beta
                         * geometry;
                     if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
@@ -780,13 +840,13 @@ impl Bdpt<'_> {
                         kind: VertexKind::Light(Emitter::Point(light)),
                         p: position,
                         normal: -w,
-                        beta: self.scene.lights.point_light(light).intensity(-w) / pdf,
+                        beta: self.scene.lights.point_light(light).intensity(-w, channels) / pdf,
                         pdf_forward: pdf,
                         ..Vertex::EMPTY
                     };
                     let geometry = w.dot(pt.normal).abs() / distance2;
                     let contribution = pt.beta
-                        * self.f(&pt, position, TransportMode::Radiance)
+                        * self.f(&pt, position, TransportMode::Radiance, channels)
                         * sampled.beta
                         * geometry;
                     if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
@@ -811,7 +871,9 @@ impl Bdpt<'_> {
                         pdf_forward: pdf,
                         ..Vertex::EMPTY
                     };
-                    let f = self.bsdf(&pt).eval(pt.wo, toward, TransportMode::Radiance);
+                    let f = self
+                        .bsdf(&pt, channels)
+                        .eval(pt.wo, toward, TransportMode::Radiance);
                     let contribution = pt.beta * f * sampled.beta * toward.dot(pt.normal).abs();
                     if contribution.is_black() || !self.unoccluded_towards(&pt, toward, counters) {
                         return None;
@@ -821,7 +883,7 @@ impl Bdpt<'_> {
             };
             let saved = light[0];
             light[0] = sampled;
-            let weight = self.mis_weight(camera_model, camera, light, 1, t);
+            let weight = self.mis_weight(camera_model, camera, light, 1, t, channels);
             light[0] = saved;
             scratch.connection = sampled;
             Some(Contribution {
@@ -845,14 +907,14 @@ impl Bdpt<'_> {
             let w = d / distance2.sqrt();
             let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
             let contribution = qs.beta
-                * self.f(&qs, pt.p, TransportMode::Importance)
-                * self.f(&pt, qs.p, TransportMode::Radiance)
+                * self.f(&qs, pt.p, TransportMode::Importance, channels)
+                * self.f(&pt, qs.p, TransportMode::Radiance, channels)
                 * pt.beta
                 * geometry;
             if contribution.is_black() || !self.visible(&qs, &pt, counters) {
                 return None;
             }
-            let weight = self.mis_weight(camera_model, camera, light, s, t);
+            let weight = self.mis_weight(camera_model, camera, light, s, t, channels);
             Some(Contribution {
                 value: contribution * weight,
                 splat_pixel: None,
@@ -910,6 +972,7 @@ impl PixelEstimator for Bdpt<'_> {
             camera: vec![Vertex::EMPTY; n],
             light: vec![Vertex::EMPTY; n],
             connection: Vertex::EMPTY,
+            channels: Channels::Rgb,
         }
     }
 
@@ -1011,6 +1074,7 @@ mod tests {
             scene,
             max_depth: 2,
             min_depth: 0,
+            spectral: false,
         };
         let mut scratch = bdpt.scratch();
         let mut counters = SampleCounters::default();
@@ -1093,6 +1157,7 @@ mod tests {
                 scene: &scene,
                 max_depth: bounces,
                 min_depth: bounces,
+                spectral: false,
             };
             let mut rng = Rng::new(3, 5);
             let (mut sum, mut sum2) = (0.0f64, 0.0f64);

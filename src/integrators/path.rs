@@ -10,6 +10,7 @@ use crate::interaction::SurfaceInteraction;
 use crate::sampling::{Rng, Sampler, power_heuristic};
 use crate::scene::lights::LightSample;
 use crate::scene::{CameraModel, Scene};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
@@ -24,10 +25,14 @@ pub struct PathTracer<'a> {
     pub max_depth: u32,
     /// Paths with fewer scattering vertices contribute nothing (another pass renders them).
     pub min_depth: u32,
+    /// Whether paths carry wavelengths (one more sampler coordinate, read first) instead
+    /// of RGB.
+    pub spectral: bool,
 }
 
 impl PathTracer<'_> {
-    /// Radiance arriving at `origin` from `direction` (unit length). `rays` counts traced rays.
+    /// Radiance arriving at `origin` from `direction` (unit length), as linear RGB. `rays`
+    /// counts traced rays.
     #[inline]
     pub fn radiance<S: Sampler>(
         &self,
@@ -37,6 +42,7 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
+        let mut channels = Channels::new(self.spectral, || rng.uniform());
         let mut radiance = Spectrum::ZERO;
         let mut throughput = Spectrum::ONE;
         let mut ray = crate::accel::Ray::new(origin, direction, 0.0, f32::INFINITY);
@@ -51,7 +57,7 @@ impl PathTracer<'_> {
             let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
-                    let emission = scene.lights.infinite_radiance(ray.direction);
+                    let emission = scene.lights.infinite_radiance(ray.direction, &channels);
                     let weight = if previous_specular {
                         1.0
                     } else {
@@ -62,7 +68,10 @@ impl PathTracer<'_> {
                 break;
             };
             let si = SurfaceInteraction::new(scene, &ray, &hit);
-            let bsdf = si.bsdf(scene);
+            let bsdf = si.bsdf(scene, &channels);
+            if bsdf.is_dispersive() {
+                channels.keep_hero_only();
+            }
             let normal = si.geometric_normal;
             let wo = -ray.direction;
             let p = si.p;
@@ -70,7 +79,7 @@ impl PathTracer<'_> {
 
             // Emission from the front side.
             if si.light_area_pdf > 0.0 && cos_o > 0.0 && depth >= self.min_depth {
-                let emission = si.emission(scene);
+                let emission = si.emission(scene, &channels);
                 let weight = if previous_specular {
                     1.0
                 } else {
@@ -96,7 +105,8 @@ impl PathTracer<'_> {
             let u_roulette = rng.uniform();
             // Only a lobe with a density (diffuse, glossy) can meet a light sample.
             if bsdf.lobes().has_non_specular() && depth + 1 >= self.min_depth {
-                radiance += throughput * self.sample_light(p, normal, wo, &bsdf, u_light, rays);
+                radiance +=
+                    throughput * self.sample_light(p, normal, wo, &bsdf, u_light, &channels, rays);
             }
 
             let Some(sample) = bsdf.sample(wo, u_bsdf, u_lobe, TransportMode::Radiance) else {
@@ -119,7 +129,7 @@ impl PathTracer<'_> {
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
         }
-        radiance
+        channels.to_rgb(radiance)
     }
 
     /// Next-event estimation: one light (chosen by power) and a point or direction on it,
@@ -128,6 +138,7 @@ impl PathTracer<'_> {
     // Always inlined: called once per vertex, and as a call it costs ~1.5% more
     // instructions (the compiler stopped inlining it once it took a `Bsdf`).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn sample_light(
         &self,
         p: Vec3A,
@@ -135,10 +146,11 @@ impl PathTracer<'_> {
         wo: Vec3A,
         bsdf: &Bsdf,
         [u_select, u_point @ ..]: [f32; 3],
+        channels: &Channels,
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
-        match scene.sample_light(u_select, u_point) {
+        match scene.sample_light(u_select, u_point, channels) {
             None => Spectrum::ZERO,
             Some(LightSample::Area {
                 point: y,
@@ -183,7 +195,7 @@ impl PathTracer<'_> {
                     return Spectrum::ZERO;
                 }
                 let wi = to_light / distance2.sqrt();
-                let intensity = scene.lights.point_light(light).intensity(-wi);
+                let intensity = scene.lights.point_light(light).intensity(-wi, channels);
                 let f = bsdf.eval(wo, wi, TransportMode::Radiance);
                 if f.is_black() || intensity.is_black() {
                     return Spectrum::ZERO;

@@ -124,6 +124,7 @@ impl Estimator<'_> {
                         scene: bdpt.scene,
                         max_depth: bdpt.max_depth,
                         min_depth: bdpt.min_depth,
+                        spectral: bdpt.spectral,
                     }),
                     camera: *camera,
                     weights: settings.mutation_weights,
@@ -227,6 +228,7 @@ fn render_into(
             scene,
             max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
             min_depth: 0,
+            spectral: settings.spectral,
         });
     let min_depth = if direct.is_some() {
         DIRECT_PASS_DEPTHS
@@ -237,12 +239,28 @@ fn render_into(
         scene,
         max_depth: settings.max_depth,
         min_depth,
+        spectral: settings.spectral,
     };
     let bdpt = Bdpt {
         scene,
         max_depth: settings.max_depth,
         min_depth,
+        spectral: settings.spectral,
     };
+    if settings.spectral
+        && matches!(
+            settings.algorithm,
+            Algorithm::PathSpaceMlt | Algorithm::Erpt
+        )
+    {
+        return Err(crate::error::Error::new(
+            crate::error::MLT_STATUS_UNSUPPORTED,
+            format!(
+                "{:?} does not render in spectral mode yet (its path-space mutations carry RGB); use path tracing, BDPT, PSSMLT, MMLT or PSSMLT over BDPT, or turn spectral off",
+                settings.algorithm
+            ),
+        ));
+    }
     if matches!(
         settings.algorithm,
         Algorithm::PathSpaceMlt | Algorithm::Erpt

@@ -146,6 +146,11 @@ pub struct RenderSettings {
     pub filter_strength: f32,
     /// The filter's search radius in pixels: each pixel averages pixels up to this far.
     pub filter_radius: u32,
+    /// Spectral transport: each camera path carries `WAVELENGTHS` (4) wavelengths drawn by
+    /// hero-wavelength sampling instead of RGB; RGB colours become smooth spectra (lights
+    /// times D65) and the film gets CIE XYZ converted to linear sRGB. Dispersive
+    /// dielectrics (`Material::abbe_number`) split light by wavelength only in this mode.
+    pub spectral: bool,
 }
 
 impl Default for RenderSettings {
@@ -174,6 +179,7 @@ impl Default for RenderSettings {
             filter_buffers: 0,
             filter_strength: Self::DEFAULT_FILTER_STRENGTH,
             filter_radius: Self::DEFAULT_FILTER_RADIUS,
+            spectral: false,
         }
     }
 }

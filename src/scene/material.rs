@@ -2,6 +2,7 @@
 
 use crate::bsdf::{BsdfModel, MetallicRoughness};
 use crate::error::{Error, Result, check_finite, check_finite3};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 
 /// The scattering model of a material.
@@ -127,6 +128,15 @@ pub struct Material {
     /// roughness instead of 92% at roughness 0.5 and 31% at 1 (normal incidence). Off by
     /// default, as glTF defines the model; the dielectric's reflection is not compensated.
     pub energy_compensation: bool,
+    /// Dispersion of a dielectric (and of the metallic-roughness model's dielectric part),
+    /// as the Abbe number V_d: the index of refraction `ior` holds at 587.56 nm (the
+    /// helium d line) and varies with the wavelength λ by the Cauchy form that glTF's
+    /// `KHR_materials_dispersion` defines (whose `dispersion` is 20 / V_d),
+    /// n(λ) = n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168),
+    /// so that n(486.13 nm) − n(656.27 nm) = (n_d − 1) / V_d. 0 means no dispersion;
+    /// otherwise finite and positive (crown glass ≈ 60, flint ≈ 36, diamond ≈ 55 at a
+    /// higher index). Only spectral renders disperse light; RGB renders use n_d.
+    pub abbe_number: f32,
 }
 
 impl Material {
@@ -148,6 +158,7 @@ impl Material {
             normal_scale: 1.0,
             emission_texture: None,
             energy_compensation: false,
+            abbe_number: 0.0,
         }
     }
 
@@ -266,6 +277,13 @@ impl Material {
             )));
         }
         check_finite(&format_args!("{name}.normal_scale"), self.normal_scale)?;
+        check_finite(&format_args!("{name}.abbe_number"), self.abbe_number)?;
+        if self.abbe_number < 0.0 {
+            return Err(Error::invalid(format!(
+                "{name}.abbe_number is {}; an Abbe number must be positive (0: no dispersion)",
+                self.abbe_number
+            )));
+        }
         for (field, texture) in self.texture_refs() {
             if let Some(texture) = texture {
                 texture.validate(&format!("{name}.{field}"), texture_count)?;
@@ -276,10 +294,39 @@ impl Material {
 }
 
 impl Material {
+    /// Whether light of different wavelengths refracts differently at this material in a
+    /// spectral render: a dispersion is set and the model has a dielectric interface.
+    #[inline]
+    pub(crate) fn disperses(&self, channels: &Channels) -> bool {
+        self.abbe_number > 0.0
+            && matches!(
+                self.kind,
+                MaterialKind::Dielectric | MaterialKind::MetallicRoughness
+            )
+            && channels.hero().is_some()
+    }
+
+    /// The index of refraction for a path in `channels`: at the hero wavelength where the
+    /// material disperses (Cauchy's form, see `abbe_number`, never below 1), else `ior`.
+    #[inline]
+    pub(crate) fn ior_in(&self, channels: &Channels) -> f32 {
+        match channels.hero() {
+            Some(lambda) if self.abbe_number > 0.0 => {
+                cauchy_index(self.ior, self.abbe_number, lambda)
+            }
+            _ => self.ior,
+        }
+    }
+
     /// The scattering model of the untextured material.
     #[inline]
-    pub(crate) fn bsdf_model(&self) -> BsdfModel {
-        self.textured_bsdf_model(Spectrum::from(self.color), self.metallic, self.roughness)
+    pub(crate) fn bsdf_model(&self, channels: &Channels) -> BsdfModel {
+        self.textured_bsdf_model(
+            channels.reflectance(self.color),
+            self.metallic,
+            self.roughness,
+            self.ior_in(channels),
+        )
     }
 
     /// The scattering model with the colour replaced by `color` and, for the
@@ -291,22 +338,28 @@ impl Material {
         color: Spectrum,
         metallic: f32,
         roughness: f32,
+        ior: f32,
     ) -> BsdfModel {
         match self.kind {
             MaterialKind::Diffuse => BsdfModel::Diffuse(color),
             MaterialKind::Mirror => BsdfModel::Mirror(color),
-            MaterialKind::Dielectric => BsdfModel::Dielectric {
-                ior: self.ior,
-                tint: color,
-            },
+            MaterialKind::Dielectric => BsdfModel::Dielectric { ior, tint: color },
             MaterialKind::MetallicRoughness => BsdfModel::MetallicRoughness(MetallicRoughness {
                 base_color: color,
                 metallic,
                 roughness,
-                ior: self.ior,
+                ior,
                 transmission: self.transmission,
                 energy_compensation: self.energy_compensation,
             }),
         }
     }
+}
+
+/// The index of refraction at `lambda` nm of a material with index `ior_d` at the d line
+/// (587.56 nm) and Abbe number `abbe_number` > 0, by `KHR_materials_dispersion`'s Cauchy
+/// form; at least 1 (a far-dispersing low index would otherwise fall below vacuum's).
+#[inline]
+pub(crate) fn cauchy_index(ior_d: f32, abbe_number: f32, lambda: f32) -> f32 {
+    (ior_d + (ior_d - 1.0) / abbe_number * (523_655.0 / (lambda * lambda) - 1.5168)).max(1.0)
 }

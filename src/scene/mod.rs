@@ -17,6 +17,7 @@ pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 
 use crate::accel::{Accel, Backend, Filtering, Hit, Ray};
 use crate::error::{Error, Result};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use crate::texture::{Texture, TextureDesc};
 use glam::Vec3A;
@@ -291,9 +292,15 @@ impl Scene {
     /// The BSDF at barycentrics `barycentrics` of internal triangle `triangle`: its
     /// material with textures and vertex colours applied, in the shading frame there.
     #[inline]
-    pub(crate) fn bsdf_at(&self, triangle: u32, barycentrics: [f32; 2]) -> crate::bsdf::Bsdf {
+    pub(crate) fn bsdf_at(
+        &self,
+        triangle: u32,
+        barycentrics: [f32; 2],
+        channels: &Channels,
+    ) -> crate::bsdf::Bsdf {
         let normal = self.shading[triangle as usize].normal;
-        self.surface_point(triangle, barycentrics).bsdf(normal)
+        self.surface_point(triangle, barycentrics)
+            .bsdf(normal, channels)
     }
 
     /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
@@ -310,7 +317,7 @@ impl Scene {
                 })
             };
             let (roughness, metallic) = (m.roughness * texture_min(1), m.metallic * texture_min(2));
-            let smoothest = m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0);
+            let smoothest = m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, m.ior);
             roughness == 0.0 && {
                 let lobes = smoothest.lobes();
                 lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
@@ -366,41 +373,59 @@ impl Scene {
     }
 
     /// Radiance the front side of internal triangle `triangle` emits at `barycentrics`, if
-    /// it is a light (`light_area_pdf` > 0: the integrators ask that first).
+    /// it is a light (`light_area_pdf` > 0: the integrators ask that first), in `channels`.
     #[inline]
-    pub(crate) fn emission(&self, triangle: u32, barycentrics: [f32; 2]) -> Spectrum {
-        self.surface_point(triangle, barycentrics).emission()
+    pub(crate) fn emission(
+        &self,
+        triangle: u32,
+        barycentrics: [f32; 2],
+        channels: &Channels,
+    ) -> Spectrum {
+        self.surface_point(triangle, barycentrics)
+            .emission(channels)
     }
 
-    /// A light sample (`SceneLights::sample_light`) with the emission texture applied.
+    /// A light sample (`SceneLights::sample_light`) with the emission texture applied, its
+    /// radiance in `channels` (a point light's intensity is looked up by the caller, in
+    /// `PointLight::intensity`).
     #[inline]
     pub(crate) fn sample_light(
         &self,
         u_select: f32,
         u_point: [f32; 2],
+        channels: &Channels,
     ) -> Option<lights::LightSample> {
         let mut sample = self.lights.sample_light(u_select, u_point)?;
-        if let lights::LightSample::Area {
-            triangle,
-            barycentrics,
-            emission,
-            ..
-        } = &mut sample
-            && self.emission_is_textured(*triangle)
-        {
-            *emission = self.emission(*triangle, *barycentrics);
+        match &mut sample {
+            lights::LightSample::Area {
+                triangle,
+                barycentrics,
+                emission,
+                ..
+            } => {
+                *emission = if self.emission_is_textured(*triangle) {
+                    self.emission(*triangle, *barycentrics, channels)
+                } else {
+                    channels.illuminant(emission.to_array())
+                };
+            }
+            lights::LightSample::Direction { radiance, .. } => {
+                *radiance = channels.illuminant(radiance.to_array());
+            }
+            lights::LightSample::Point { .. } => {}
         }
         Some(sample)
     }
 
     /// An emission sample (`SceneLights::sample_emission`) with the emission texture
-    /// applied.
+    /// applied, its emission and weight in `channels`.
     #[inline]
     pub(crate) fn sample_emission(
         &self,
         u_select: f32,
         u_point: [f32; 2],
         u_direction: [f32; 2],
+        channels: &Channels,
     ) -> Option<lights::EmissionSample> {
         let mut sample = self
             .lights
@@ -408,9 +433,14 @@ impl Scene {
         if let lights::Emitter::Area(triangle) = sample.emitter
             && self.emission_is_textured(triangle)
         {
-            sample.emission = self.emission(triangle, sample.barycentrics);
+            sample.emission = self.emission(triangle, sample.barycentrics, channels);
             let cos = sample.direction.dot(sample.normal);
             sample.beta = sample.emission * (cos / (sample.pdf_origin * sample.pdf_direction));
+        } else {
+            // The weight is the emission times a number, and the upsampling scales with
+            // its argument, so it converts as the emission does.
+            sample.emission = channels.illuminant(sample.emission.to_array());
+            sample.beta = channels.illuminant(sample.beta.to_array());
         }
         Some(sample)
     }

@@ -8,6 +8,7 @@
 use super::material::{Material, TextureRef};
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use crate::texture::Texture;
 use glam::{Vec3A, Vec4};
@@ -245,14 +246,18 @@ impl SurfacePoint<'_> {
 
     /// Emitted radiance: the emission factor × the emission texture.
     #[inline]
-    pub fn emission(&self) -> Spectrum {
+    pub fn emission(&self, channels: &Channels) -> Spectrum {
         let m = self.material;
-        let mut emission = Spectrum::from(m.emission);
+        let mut emission = m.emission;
         if let Some(texture) = &m.emission_texture {
             let texel = lookup(self.textures, texture, self.texcoord());
-            emission *= Spectrum::new(texel.x, texel.y, texel.z);
+            emission = [
+                emission[0] * texel.x,
+                emission[1] * texel.y,
+                emission[2] * texel.z,
+            ];
         }
-        emission
+        channels.illuminant(emission)
     }
 
     /// The shading normal: interpolated, then bent by the normal map (tangent space, x and
@@ -293,16 +298,18 @@ impl SurfacePoint<'_> {
 
     /// The BSDF here, on a triangle with front geometric normal `geometric_normal`.
     #[inline]
-    pub fn bsdf(&self, geometric_normal: Vec3A) -> Bsdf {
+    pub fn bsdf(&self, geometric_normal: Vec3A, channels: &Channels) -> Bsdf {
+        let dispersive = self.material.disperses(channels);
         if self.attributes.is_flat(self.material) {
             return Bsdf::new(
-                self.material.bsdf_model(),
+                self.material.bsdf_model(channels),
                 geometric_normal,
                 geometric_normal,
-            );
+            )
+            .with_dispersion(dispersive);
         }
         let base = self.base_color();
-        let color = Spectrum::new(base.x, base.y, base.z);
+        let color = channels.reflectance([base.x, base.y, base.z]);
         let m = self.material;
         let (mut metallic, mut roughness) = (m.metallic, m.roughness);
         if let Some(texture) = &m.metallic_roughness_texture {
@@ -310,12 +317,13 @@ impl SurfacePoint<'_> {
             roughness *= texel.y;
             metallic *= texel.z;
         }
-        let model = m.textured_bsdf_model(color, metallic, roughness);
+        let model = m.textured_bsdf_model(color, metallic, roughness, m.ior_in(channels));
         Bsdf::new(
             model,
             self.shading_normal(geometric_normal),
             geometric_normal,
         )
+        .with_dispersion(dispersive)
     }
 }
 
@@ -335,7 +343,7 @@ pub(crate) fn mean_emission_scale<'a>(
                 (i as f32 + 1.0 / 3.0) / STEPS as f32,
                 (j as f32 + 1.0 / 3.0) / STEPS as f32,
             ];
-            sum += point(b).emission().luminance();
+            sum += point(b).emission(&Channels::Rgb).luminance();
             count += 1;
         }
     }

@@ -3,11 +3,14 @@
 // Until the integrators use it.
 #![cfg_attr(not(test), allow(dead_code))]
 
+mod channels;
 mod cie;
 mod cie_data;
 mod color;
+mod rgb_to_spectrum;
 mod wavelengths;
 
+pub(crate) use channels::Channels;
 #[allow(unused_imports)]
 pub(crate) use cie::{cie_1931_xyz, d65};
 #[allow(unused_imports)]

@@ -544,6 +544,7 @@ impl Mesh {
                 emission_texture: slot(m.emission_texture),
                 normal_scale: m.normal_scale,
                 energy_compensation: m.energy_compensation as u32,
+                abbe_number: m.abbe_number,
             })
             .collect()
     }

@@ -547,11 +547,13 @@ mod tests {
             scene: &scene,
             max_depth: 5,
             min_depth,
+            spectral: false,
         };
         let tracer = PathTracer {
             scene: &scene,
             max_depth: 5,
             min_depth: 2,
+            spectral: false,
         };
         check_pass_points(&BdptMultiplexed(bdpt(2)), &camera);
         check_pass_points(&BdptMultiplexed(bdpt(0)), &camera);
@@ -628,6 +630,7 @@ mod tests {
                 scene: &scene,
                 max_depth: 5,
                 min_depth,
+                spectral: false,
             });
             let mut scratch = target.scratch();
             let mut seeded = PathSample::with_capacity(1);

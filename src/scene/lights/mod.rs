@@ -16,6 +16,7 @@ pub(crate) use environment::{EnvironmentMap, InfiniteLight, SunDisc, uniform_sph
 
 use super::light_desc::{LightsDesc, PunctualLightKind};
 use crate::sampling::{OrthonormalBasis, uniform_disk, uniform_triangle};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -76,13 +77,14 @@ pub(crate) struct PointLight {
 }
 
 impl PointLight {
-    /// Radiant intensity towards unit direction `w` (leaving the light).
+    /// Radiant intensity towards unit direction `w` (leaving the light), in `channels`.
     #[inline]
-    pub fn intensity(&self, w: Vec3A) -> Spectrum {
-        match &self.cone {
+    pub fn intensity(&self, w: Vec3A, channels: &Channels) -> Spectrum {
+        let rgb = match &self.cone {
             None => self.intensity,
             Some(cone) => self.intensity * cone.falloff(w),
-        }
+        };
+        channels.illuminant(rgb.to_array())
     }
 
     /// Density in solid angle with which light subpaths leave in `w`: uniform over the
@@ -312,7 +314,7 @@ impl SceneLights {
             Light::Point(light) => {
                 let direction = light.sample_direction(u_direction);
                 let pdf_direction = light.direction_pdf(direction);
-                let emission = light.intensity(direction);
+                let emission = light.intensity(direction, &Channels::Rgb);
                 Some(EmissionSample {
                     emitter: Emitter::Point(index as u32),
                     point: light.position,
@@ -394,11 +396,12 @@ impl SceneLights {
         self.infinite_select_pdf > 0.0
     }
 
-    /// Radiance arriving from direction `w` (unit) along a ray that left the scene.
+    /// Radiance arriving from direction `w` (unit) along a ray that left the scene, in
+    /// `channels`.
     #[inline]
-    pub(crate) fn infinite_radiance(&self, w: Vec3A) -> Spectrum {
+    pub(crate) fn infinite_radiance(&self, w: Vec3A, channels: &Channels) -> Spectrum {
         match &self.infinite {
-            Some(light) => light.radiance(w),
+            Some(light) => channels.illuminant(light.radiance(w).to_array()),
             None => Spectrum::ZERO,
         }
     }

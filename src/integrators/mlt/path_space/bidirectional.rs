@@ -50,6 +50,7 @@ use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
 use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::TAU;
@@ -236,7 +237,7 @@ impl Bidirectional {
                 }
                 // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
                 // which are `sample_emission`'s).
-                match scene.sample_light(rng.uniform(), rng.uniform2())? {
+                match scene.sample_light(rng.uniform(), rng.uniform2(), &Channels::Rgb)? {
                     LightSample::Area {
                         point,
                         normal,

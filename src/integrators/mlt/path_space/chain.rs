@@ -260,6 +260,7 @@ pub(crate) fn run(
             scene: target.bdpt.0.scene,
             max_depth: target.bdpt.0.max_depth,
             min_depth: target.bdpt.0.min_depth,
+            spectral: target.bdpt.0.spectral,
         }),
         camera: target.camera,
         weights: adapted_weights(target.weights, &counts),

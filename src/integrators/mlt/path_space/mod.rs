@@ -53,8 +53,10 @@ pub(crate) use perturbation::PerturbationSizes;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrators::PathVertex;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
+// Path-space MLT and ERPT render RGB: the settings refuse them in spectral mode.
 use crate::scene::lights::{Emitter, Light};
 use crate::scene::{CameraModel, Scene};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::PI;
@@ -92,7 +94,7 @@ impl PathSpace<'_> {
     /// The BSDF of surface vertex `v`.
     #[inline]
     fn surface_bsdf(&self, v: &PathVertex) -> Bsdf {
-        vertex_bsdf(self.scene, v.triangle, v.barycentrics)
+        vertex_bsdf(self.scene, v.triangle, v.barycentrics, &Channels::Rgb)
     }
 
     /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
@@ -251,7 +253,9 @@ impl PathSpace<'_> {
                 if area_pdf <= 0.0 {
                     return None;
                 }
-                let emission = self.scene.emission(light.triangle, light.barycentrics);
+                let emission =
+                    self.scene
+                        .emission(light.triangle, light.barycentrics, &Channels::Rgb);
                 // The light leaves its front side only.
                 let (w_light, _) = direction(&path[0], &path[1])?;
                 if w_light.dot(light.normal) <= 0.0 {
@@ -263,7 +267,11 @@ impl PathSpace<'_> {
             Some(e) if s == 0 && e.is_delta() => return None,
             Some(Emitter::Point(index)) => {
                 let (w, _) = direction(&path[0], &path[1])?;
-                let intensity = self.scene.lights.point_light(index).intensity(w);
+                let intensity = self
+                    .scene
+                    .lights
+                    .point_light(index)
+                    .intensity(w, &Channels::Rgb);
                 (intensity, self.scene.lights.light_select_pdf(index))
             }
             Some(Emitter::Directional(index)) => match &self.scene.lights.lights[index as usize] {
@@ -273,7 +281,9 @@ impl PathSpace<'_> {
                 _ => return None,
             },
             Some(Emitter::Infinite) => (
-                self.scene.lights.infinite_radiance(light.normal),
+                self.scene
+                    .lights
+                    .infinite_radiance(light.normal, &Channels::Rgb),
                 self.scene.lights.infinite_pdf(light.normal),
             ),
             Some(Emitter::Area(_)) => return None,
@@ -421,6 +431,7 @@ mod tests {
             scene,
             max_depth,
             min_depth: 0,
+            spectral: false,
         };
         let space = PathSpace {
             scene,
@@ -726,6 +737,7 @@ mod tests {
                 scene: &scene,
                 max_depth: 5,
                 min_depth: 0,
+                spectral: false,
             };
             let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
             let mut counters = SampleCounters::default();

@@ -1,0 +1,133 @@
+//! What the four lanes of a path's [`Spectrum`]s mean, and the conversions in and out.
+//!
+//! In RGB mode a path's spectra are linear sRGB (R, G, B, and G again: see `spectrum.rs`)
+//! and every conversion is the identity. In spectral mode they are the values at the
+//! path's sampled wavelengths: colours given as RGB (materials, textures, lights) become
+//! spectra there, and the path's radiance becomes linear sRGB again through CIE XYZ when
+//! it leaves the integrator, so the film, the filter and the Metropolis targets (the
+//! luminance of that RGB, which is the estimate's Y) see RGB in both modes.
+
+use super::cie::{cie_1931_xyz, d65};
+use super::color::linear_srgb_from_xyz;
+use super::rgb_to_spectrum::reflectance_coefficients;
+use super::wavelengths::{SampledWavelengths, WAVELENGTHS};
+use crate::spectrum::Spectrum;
+use std::sync::OnceLock;
+
+/// The meaning of a path's spectrum lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Channels {
+    /// Linear sRGB.
+    Rgb,
+    /// Values at these wavelengths.
+    Wavelengths(SampledWavelengths),
+}
+
+impl Channels {
+    /// The channels of a new camera path: RGB, or (`spectral`) wavelengths drawn from `u`.
+    /// RGB mode leaves `u` unread, so RGB renders draw the random numbers they always did.
+    #[inline]
+    pub fn new(spectral: bool, u: impl FnOnce() -> f32) -> Channels {
+        if spectral {
+            Channels::Wavelengths(SampledWavelengths::sample(u()))
+        } else {
+            Channels::Rgb
+        }
+    }
+
+    /// The reflectance (or transmittance) given as linear sRGB `rgb`: each channel within
+    /// [0, 1] by the smooth, bounded upsampling; above 1 the spectrum of the colour divided
+    /// by its largest channel, scaled back up.
+    #[inline]
+    pub fn reflectance(&self, rgb: [f32; 3]) -> Spectrum {
+        match self {
+            Channels::Rgb => Spectrum::from(rgb),
+            Channels::Wavelengths(w) => {
+                let m = rgb[0].max(rgb[1]).max(rgb[2]);
+                if m <= 1.0 {
+                    let fit = reflectance_coefficients(rgb);
+                    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l)))
+                } else {
+                    let fit = reflectance_coefficients(rgb.map(|c| c / m));
+                    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l))) * m
+                }
+            }
+        }
+    }
+
+    /// The emitted radiance given as linear sRGB `rgb` (unbounded): a smooth spectrum of
+    /// the colour's chromaticity times sRGB's illuminant, D65, scaled so that a light of
+    /// RGB (1, 1, 1) comes out as RGB (1, 1, 1).
+    #[inline]
+    pub fn illuminant(&self, rgb: [f32; 3]) -> Spectrum {
+        match self {
+            Channels::Rgb => Spectrum::from(rgb),
+            Channels::Wavelengths(w) => {
+                let m = rgb[0].max(rgb[1]).max(rgb[2]);
+                if !(m > 0.0) {
+                    return Spectrum::ZERO;
+                }
+                // Halved so that the fitted chromaticity stays inside the table's interior,
+                // where the spectra are smooth.
+                let scale = 2.0 * m;
+                let fit = reflectance_coefficients(rgb.map(|c| c / scale));
+                let per_y = *d65_per_luminance();
+                Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l) * d65(l) * per_y)) * scale
+            }
+        }
+    }
+
+    /// The linear sRGB of `value`, a spectrum in these channels (as an RGB spectrum): in
+    /// spectral mode the Monte Carlo estimate of its CIE XYZ over the wavelengths still
+    /// carried, Σ value·(x̄, ȳ, z̄)/p / `WAVELENGTHS`, through the XYZ → sRGB matrix.
+    #[inline]
+    pub fn to_rgb(&self, value: Spectrum) -> Spectrum {
+        match self {
+            Channels::Rgb => value,
+            Channels::Wavelengths(w) => {
+                let mut xyz = [0.0f64; 3];
+                for ((&lambda, &pdf), v) in w.lambda.iter().zip(&w.pdf).zip(value.lanes()) {
+                    if pdf > 0.0 && v != 0.0 {
+                        let cmf = cie_1931_xyz(lambda);
+                        let weight = (v / pdf) as f64;
+                        for (sum, c) in xyz.iter_mut().zip(cmf) {
+                            *sum += weight * c as f64;
+                        }
+                    }
+                }
+                let [r, g, b] =
+                    linear_srgb_from_xyz(xyz.map(|c| c / WAVELENGTHS as f64)).map(|c| c as f32);
+                Spectrum::new(r, g, b)
+            }
+        }
+    }
+
+    /// Keeps only the hero wavelength, where the path can go on at one wavelength only (a
+    /// dispersive interface). Nothing in RGB mode.
+    #[inline]
+    pub fn keep_hero_only(&mut self) {
+        if let Channels::Wavelengths(w) = self {
+            w.keep_hero_only();
+        }
+    }
+
+    /// The hero wavelength (lane 0) in nm; `None` in RGB mode.
+    #[inline]
+    pub fn hero(&self) -> Option<f32> {
+        match self {
+            Channels::Rgb => None,
+            Channels::Wavelengths(w) => Some(w.lambda[0]),
+        }
+    }
+}
+
+/// 1 / ∫ D65 ȳ dλ: D65 scaled by it has luminance Y = 1, the Y of RGB (1, 1, 1).
+fn d65_per_luminance() -> &'static f32 {
+    static SCALE: OnceLock<f32> = OnceLock::new();
+    SCALE.get_or_init(|| {
+        let integral: f64 = (360..=830)
+            .map(|l| (d65(l as f32) * cie_1931_xyz(l as f32)[1]) as f64)
+            .sum();
+        (1.0 / integral) as f32
+    })
+}
