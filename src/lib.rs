@@ -58,6 +58,7 @@ pub use scene::{
     AlphaMode, Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight,
     PunctualLightKind, Scene, SceneDesc, SceneInfo, SunDesc, TextureRef,
 };
+pub use spectral::white_light_srgb_per_nm;
 pub use texture::{
     MLT_MAX_TEXTURE_SIDE, MLT_MAX_TEXTURE_TEXELS, TexelData, TextureDesc, TextureEncoding,
     TextureFilter, WrapMode,

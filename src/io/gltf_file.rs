@@ -580,6 +580,24 @@ impl Loader<'_> {
             converted.emission_texture =
                 Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
         }
+        // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
+        if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
+            let dispersion = extension
+                .get("dispersion")
+                .map_or(Some(0.0), |v| v.as_f64())
+                .filter(|d| d.is_finite() && *d >= 0.0)
+                .ok_or_else(|| {
+                    self.fail(format!(
+                        "material {}: KHR_materials_dispersion's dispersion must be a number >= 0",
+                        material
+                            .index()
+                            .map_or("(default)".into(), |i| i.to_string())
+                    ))
+                })?;
+            if dispersion > 0.0 {
+                converted.abbe_number = (20.0 / dispersion) as f32;
+            }
+        }
         if converted.has_textures() && !self.attributes.texcoords {
             // Without texture coordinates every lookup would read one texel; glTF files
             // with textures always carry them, so this is a broken file.

@@ -121,6 +121,17 @@ impl Channels {
     }
 }
 
+/// The linear sRGB that a white light (emission RGB (1, 1, 1), whose spectrum in a spectral
+/// render is D65 scaled to luminance 1) carries per nanometre of wavelength at `lambda`:
+/// D65(λ)·(x̄, ȳ, z̄)(λ) / ∫ D65 ȳ dλ through the XYZ → linear sRGB matrix. Summed at 1 nm
+/// over 360–830 nm it is (1, 1, 1). What a spectral image shows where only wavelength λ of
+/// white light arrives, for predicting dispersion (a prism's spectrum) outside the renderer.
+pub fn white_light_srgb_per_nm(lambda: f32) -> [f64; 3] {
+    let per_y = *d65_per_luminance() as f64;
+    let xyz = cie_1931_xyz(lambda).map(|c| c as f64 * d65(lambda) as f64 * per_y);
+    linear_srgb_from_xyz(xyz)
+}
+
 /// 1 / ∫ D65 ȳ dλ: D65 scaled by it has luminance Y = 1, the Y of RGB (1, 1, 1).
 fn d65_per_luminance() -> &'static f32 {
     static SCALE: OnceLock<f32> = OnceLock::new();
@@ -130,4 +141,23 @@ fn d65_per_luminance() -> &'static f32 {
             .sum();
         (1.0 / integral) as f32
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// White light's per-nanometre colours add up to white.
+    #[test]
+    fn white_light_adds_up_to_white() {
+        let mut sum = [0.0f64; 3];
+        for lambda in 360..=830 {
+            for (s, c) in sum.iter_mut().zip(white_light_srgb_per_nm(lambda as f32)) {
+                *s += c;
+            }
+        }
+        for c in sum {
+            assert!((c - 1.0).abs() < 1e-4, "{sum:?}");
+        }
+    }
 }

@@ -11,6 +11,7 @@ mod rgb_to_spectrum;
 mod wavelengths;
 
 pub(crate) use channels::Channels;
+pub use channels::white_light_srgb_per_nm;
 #[allow(unused_imports)]
 pub(crate) use cie::{cie_1931_xyz, d65};
 #[allow(unused_imports)]
