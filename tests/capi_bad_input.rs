@@ -1460,6 +1460,7 @@ fn metropolis_settings_out_of_range() {
             => ["mutation_weights[0]", "bidirectional", "positive"],
         s.adapt_mutation_weights = 2 => ["adapt_mutation_weights is 2", "0 or 1"],
         s.perturb_in_sample_space = u32::MAX => ["perturb_in_sample_space is 4294967295", "0 or 1"],
+        s.spectral = 2 => ["settings.spectral is 2", "0 or 1"],
     ];
     cases.extend(non_finite_cases![s = metropolis;
         s.normalization_work_fraction => "settings.normalization_work_fraction" + "0 to 0.9",
@@ -2802,6 +2803,11 @@ fn scene_create_bad_surfaces() {
         h.host.materials[1].alpha_mode = -1 => ["desc.materials[1].alpha_mode is -1"],
         h.host.materials[0].energy_compensation = 2
             => ["desc.materials[0].energy_compensation is 2", "0 or 1"],
+        h.host.materials[0].abbe_number = -20.0
+            => ["desc.materials[0].abbe_number is -20", "positive", "0: no dispersion"],
+        h.host.materials[1].abbe_number = f32::NAN => ["desc.materials[1].abbe_number", "NaN"],
+        h.host.materials[1].abbe_number = f32::INFINITY
+            => ["desc.materials[1].abbe_number", "inf"],
         h.host.materials[0].base_color_texture.texture = 3
             => ["desc.materials[0].base_color_texture.texture is 3", "3 textures"],
         h.host.materials[0].metallic_roughness_texture.texture = i32::MAX

@@ -597,7 +597,7 @@ fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
     format!(
         r#"{{
   "asset": {{ "version": "2.0" }},
-  "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior"],
+  "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_dispersion"],
   "scene": 0,
   "scenes": [{{ "nodes": [0, 3] }}],
   "nodes": [
@@ -617,7 +617,8 @@ fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
        "pbrMetallicRoughness": {{ "baseColorFactor": [0.2, 0.3, 0.4, 1] }} }},
     {{ "name": "glass",
        "extensions": {{ "KHR_materials_transmission": {{ "transmissionFactor": 1 }},
-                        "KHR_materials_ior": {{ "ior": 1.33 }} }} }}
+                        "KHR_materials_ior": {{ "ior": 1.33 }},
+                        "KHR_materials_dispersion": {{ "dispersion": 0.5 }} }} }}
   ],
   "buffers": [{{ {uri}"byteLength": {buffer_len} }}],
   "bufferViews": [
@@ -646,6 +647,8 @@ fn check_gltf_scene(data: &SceneData) {
     let (glass_id, glass) = material_named(data, "glass");
     assert_eq!(glass.kind, MaterialKind::MetallicRoughness);
     assert_eq!((glass.ior, glass.transmission), (1.33, 1.0));
+    // KHR_materials_dispersion's 20 / V_d.
+    assert_eq!((glass.abbe_number, lamp.abbe_number), (40.0, 0.0));
     assert_eq!(glass.emission, [0.0; 3]);
     assert_eq!(data.material_ids, [lamp_id, lamp_id, glass_id, glass_id]);
 
@@ -685,6 +688,23 @@ fn check_gltf_scene(data: &SceneData) {
         camera.camera
     );
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
+/// A negative `KHR_materials_dispersion` is refused with a message naming it.
+#[test]
+fn gltf_with_negative_dispersion_is_refused() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json =
+        gltf_json(Some(&uri), buffer.len()).replace(r#""dispersion": 0.5"#, r#""dispersion": -1"#);
+    let path = temp_path("negative-dispersion.gltf");
+    std::fs::write(&path, json).unwrap();
+    let error = io::load_scene(&path).unwrap_err().to_string();
+    std::fs::remove_file(&path).unwrap();
+    assert!(
+        error.contains("KHR_materials_dispersion") && error.contains(">= 0"),
+        "{error}"
+    );
 }
 
 #[test]
