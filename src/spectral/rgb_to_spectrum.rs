@@ -52,10 +52,11 @@ pub(crate) struct SigmoidPolynomial {
     pub c2: f32,
 }
 
-/// The algebraic sigmoid ½ + x / (2√(1 + x²)), in [0, 1]; S(±∞) = 1 and 0.
+/// The algebraic sigmoid ½ + x / (2√(1 + x²)), in [0, 1]; S(±∞) = 1 and 0. Beyond
+/// |x| = 10¹⁸ (where x² would overflow) it is within 10⁻³⁶ of its limit, so returns it.
 #[inline]
 fn sigmoid(x: f32) -> f32 {
-    if x.is_infinite() {
+    if x.abs() >= 1e18 {
         return if x > 0.0 { 1.0 } else { 0.0 };
     }
     0.5 + x / (2.0 * (1.0 + x * x).sqrt())
@@ -857,6 +858,16 @@ mod tests {
         for l in 360..=830 {
             assert_eq!(black.eval(l as f32), 0.0);
             assert_eq!(white.eval(l as f32), 1.0);
+        }
+        // The darkest f32 grey, and coefficients whose square overflows an f32.
+        assert!(reflectance_coefficients([1e-45; 3]).eval(500.0) < 1e-30);
+        for (x, limit) in [(-1e30, 0.0), (1e30, 1.0), (-1e19, 0.0), (1e19, 1.0)] {
+            let c = SigmoidPolynomial {
+                c0: 0.0,
+                c1: 0.0,
+                c2: x,
+            };
+            assert_eq!(c.eval(500.0), limit, "{x}");
         }
         // Out of range and NaN clamp to black and white.
         assert_eq!(reflectance_coefficients([-1.0, f32::NAN, 0.0]), black);
