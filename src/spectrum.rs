@@ -10,7 +10,7 @@
 //! defined as on the three channels, and RGB results are those of three-channel
 //! arithmetic; in spectral mode the radiance at the path's four sampled wavelengths.
 //!
-//! Where colour leaves the kernel it becomes plain RGB again (`Channels::to_rgb`): the
+//! Where colour leaves the kernel it becomes plain RGB again (`Channels::rgb_of`): the
 //! film and the filter keep `f32`/`f64` triples (`to_array`, indexing), the C ABI and the
 //! Rust API take and give `[f32; 3]`.
 //!

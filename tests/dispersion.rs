@@ -64,7 +64,7 @@ fn face_normal(a: DVec3, b: DVec3) -> DVec3 {
 fn hit_face(origin: DVec3, dir: DVec3, a: DVec3, b: DVec3) -> Option<(f64, DVec3)> {
     let n = face_normal(a, b);
     let t = (a - origin).dot(n) / dir.dot(n);
-    if !(t > 1e-9) {
+    if t.is_nan() || t <= 1e-9 {
         return None;
     }
     let p = origin + dir * t;

@@ -698,7 +698,7 @@ impl Bdpt<'_> {
         let channels = scratch.channels;
         let mut contribution =
             self.connect_in_channels(camera_model, scratch, s, t, &channels, sampler, counters)?;
-        contribution.value = channels.to_rgb(contribution.value);
+        contribution.value = channels.rgb_of(contribution.value);
         Some(contribution)
     }
 

@@ -129,7 +129,7 @@ impl PathTracer<'_> {
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
         }
-        channels.to_rgb(radiance)
+        channels.rgb_of(radiance)
     }
 
     /// Next-event estimation: one light (chosen by power) and a point or direction on it,

@@ -64,7 +64,7 @@ impl Channels {
             Channels::Rgb => Spectrum::from(rgb),
             Channels::Wavelengths(w) => {
                 let m = rgb[0].max(rgb[1]).max(rgb[2]);
-                if !(m > 0.0) {
+                if m.is_nan() || m <= 0.0 {
                     return Spectrum::ZERO;
                 }
                 // Halved so that the fitted chromaticity stays inside the table's interior,
@@ -81,7 +81,7 @@ impl Channels {
     /// spectral mode the Monte Carlo estimate of its CIE XYZ over the wavelengths still
     /// carried, Σ value·(x̄, ȳ, z̄)/p / `WAVELENGTHS`, through the XYZ → sRGB matrix.
     #[inline]
-    pub fn to_rgb(&self, value: Spectrum) -> Spectrum {
+    pub fn rgb_of(&self, value: Spectrum) -> Spectrum {
         match self {
             Channels::Rgb => value,
             Channels::Wavelengths(w) => {

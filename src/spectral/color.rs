@@ -39,7 +39,8 @@ pub(crate) fn linear_srgb_from_xyz(xyz: [f64; 3]) -> [f64; 3] {
     (matrices().1 * DVec3::from(xyz)).into()
 }
 
-/// XYZ of the linear sRGB colour `rgb`.
+/// XYZ of the linear sRGB colour `rgb` (what the RGB → spectrum fit aims at).
+#[cfg(test)]
 pub(crate) fn xyz_from_linear_srgb(rgb: [f64; 3]) -> [f64; 3] {
     (matrices().0 * DVec3::from(rgb)).into()
 }

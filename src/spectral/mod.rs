@@ -1,7 +1,7 @@
-//! Spectral transport (issue 19, in progress): the wavelengths a camera path carries.
-//! Not yet used by the integrators.
-// Until the integrators use it.
-#![cfg_attr(not(test), allow(dead_code))]
+//! Spectral transport (`RenderSettings::spectral`): the wavelengths a camera path carries
+//! (`wavelengths.rs`), the CIE tables (`cie.rs`), the conversions between RGB and spectra
+//! (`rgb_to_spectrum.rs`, `color.rs`) and what a path's spectrum lanes mean
+//! (`channels.rs`, the one type the rest of the crate uses).
 
 mod channels;
 mod cie;
@@ -12,11 +12,3 @@ mod wavelengths;
 
 pub(crate) use channels::Channels;
 pub use channels::white_light_srgb_per_nm;
-#[allow(unused_imports)]
-pub(crate) use cie::{cie_1931_xyz, d65};
-#[allow(unused_imports)]
-pub(crate) use color::{d65_white, linear_srgb_from_xyz, xyz_from_linear_srgb};
-#[allow(unused_imports)]
-pub(crate) use wavelengths::{
-    LAMBDA_MAX, LAMBDA_MIN, SampledWavelengths, WAVELENGTHS, visible_wavelength_pdf,
-};

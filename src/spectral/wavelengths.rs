@@ -92,6 +92,7 @@ impl SampledWavelengths {
     }
 
     /// Whether the other wavelengths were dropped.
+    #[cfg(test)]
     pub fn hero_only(&self) -> bool {
         self.pdf[1..].iter().all(|&p| p == 0.0)
     }
