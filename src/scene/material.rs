@@ -296,7 +296,7 @@ impl Material {
 impl Material {
     /// Whether light of different wavelengths refracts differently at this material in a
     /// spectral render: a dispersion is set and the model has a dielectric interface.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn disperses(&self, channels: &Channels) -> bool {
         self.abbe_number > 0.0
             && matches!(
@@ -308,7 +308,7 @@ impl Material {
 
     /// The index of refraction for a path in `channels`: at the hero wavelength where the
     /// material disperses (Cauchy's form, see `abbe_number`, never below 1), else `ior`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn ior_in(&self, channels: &Channels) -> f32 {
         match channels.hero() {
             Some(lambda) if self.abbe_number > 0.0 => {

@@ -291,7 +291,7 @@ impl Scene {
 
     /// The BSDF at barycentrics `barycentrics` of internal triangle `triangle`: its
     /// material with textures and vertex colours applied, in the shading frame there.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn bsdf_at(
         &self,
         triangle: u32,

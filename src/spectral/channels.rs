@@ -38,67 +38,34 @@ impl Channels {
     /// The reflectance (or transmittance) given as linear sRGB `rgb`: each channel within
     /// [0, 1] by the smooth, bounded upsampling; above 1 the spectrum of the colour divided
     /// by its largest channel, scaled back up.
-    #[inline]
+    // The RGB case inline and the spectral one out of line: RGB renders pay one branch.
+    #[inline(always)]
     pub fn reflectance(&self, rgb: [f32; 3]) -> Spectrum {
         match self {
             Channels::Rgb => Spectrum::from(rgb),
-            Channels::Wavelengths(w) => {
-                let m = rgb[0].max(rgb[1]).max(rgb[2]);
-                if m <= 1.0 {
-                    let fit = reflectance_coefficients(rgb);
-                    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l)))
-                } else {
-                    let fit = reflectance_coefficients(rgb.map(|c| c / m));
-                    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l))) * m
-                }
-            }
+            Channels::Wavelengths(w) => spectral_reflectance(w, rgb),
         }
     }
 
     /// The emitted radiance given as linear sRGB `rgb` (unbounded): a smooth spectrum of
     /// the colour's chromaticity times sRGB's illuminant, D65, scaled so that a light of
     /// RGB (1, 1, 1) comes out as RGB (1, 1, 1).
-    #[inline]
+    #[inline(always)]
     pub fn illuminant(&self, rgb: [f32; 3]) -> Spectrum {
         match self {
             Channels::Rgb => Spectrum::from(rgb),
-            Channels::Wavelengths(w) => {
-                let m = rgb[0].max(rgb[1]).max(rgb[2]);
-                if m.is_nan() || m <= 0.0 {
-                    return Spectrum::ZERO;
-                }
-                // Halved so that the fitted chromaticity stays inside the table's interior,
-                // where the spectra are smooth.
-                let scale = 2.0 * m;
-                let fit = reflectance_coefficients(rgb.map(|c| c / scale));
-                let per_y = *d65_per_luminance();
-                Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l) * d65(l) * per_y)) * scale
-            }
+            Channels::Wavelengths(w) => spectral_illuminant(w, rgb),
         }
     }
 
     /// The linear sRGB of `value`, a spectrum in these channels (as an RGB spectrum): in
     /// spectral mode the Monte Carlo estimate of its CIE XYZ over the wavelengths still
     /// carried, Σ value·(x̄, ȳ, z̄)/p / `WAVELENGTHS`, through the XYZ → sRGB matrix.
-    #[inline]
+    #[inline(always)]
     pub fn rgb_of(&self, value: Spectrum) -> Spectrum {
         match self {
             Channels::Rgb => value,
-            Channels::Wavelengths(w) => {
-                let mut xyz = [0.0f64; 3];
-                for ((&lambda, &pdf), v) in w.lambda.iter().zip(&w.pdf).zip(value.lanes()) {
-                    if pdf > 0.0 && v != 0.0 {
-                        let cmf = cie_1931_xyz(lambda);
-                        let weight = (v / pdf) as f64;
-                        for (sum, c) in xyz.iter_mut().zip(cmf) {
-                            *sum += weight * c as f64;
-                        }
-                    }
-                }
-                let [r, g, b] =
-                    linear_srgb_from_xyz(xyz.map(|c| c / WAVELENGTHS as f64)).map(|c| c as f32);
-                Spectrum::new(r, g, b)
-            }
+            Channels::Wavelengths(w) => rgb_of_sampled(w, value),
         }
     }
 
@@ -119,6 +86,48 @@ impl Channels {
             Channels::Wavelengths(w) => Some(w.lambda[0]),
         }
     }
+}
+
+#[inline(never)]
+fn spectral_reflectance(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m <= 1.0 {
+        let fit = reflectance_coefficients(rgb);
+        Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l)))
+    } else {
+        let fit = reflectance_coefficients(rgb.map(|c| c / m));
+        Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l))) * m
+    }
+}
+
+#[inline(never)]
+fn spectral_illuminant(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m.is_nan() || m <= 0.0 {
+        return Spectrum::ZERO;
+    }
+    // Halved so that the fitted chromaticity stays inside the table's interior, where the
+    // spectra are smooth.
+    let scale = 2.0 * m;
+    let fit = reflectance_coefficients(rgb.map(|c| c / scale));
+    let per_y = *d65_per_luminance();
+    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l) * d65(l) * per_y)) * scale
+}
+
+#[inline(never)]
+fn rgb_of_sampled(w: &SampledWavelengths, value: Spectrum) -> Spectrum {
+    let mut xyz = [0.0f64; 3];
+    for ((&lambda, &pdf), v) in w.lambda.iter().zip(&w.pdf).zip(value.lanes()) {
+        if pdf > 0.0 && v != 0.0 {
+            let cmf = cie_1931_xyz(lambda);
+            let weight = (v / pdf) as f64;
+            for (sum, c) in xyz.iter_mut().zip(cmf) {
+                *sum += weight * c as f64;
+            }
+        }
+    }
+    let [r, g, b] = linear_srgb_from_xyz(xyz.map(|c| c / WAVELENGTHS as f64)).map(|c| c as f32);
+    Spectrum::new(r, g, b)
 }
 
 /// The linear sRGB that a white light (emission RGB (1, 1, 1), whose spectrum in a spectral
