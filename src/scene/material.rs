@@ -319,7 +319,7 @@ impl Material {
     }
 
     /// The scattering model of the untextured material.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn bsdf_model(&self, channels: &Channels) -> BsdfModel {
         self.textured_bsdf_model(
             channels.reflectance(self.color),

@@ -115,6 +115,8 @@ pub struct Scene {
     attributes: surface::SurfaceAttributes,
     textures: Vec<Texture>,
     pub(crate) materials: Vec<Material>,
+    /// Each material's constant colour and emission with their spectral fits.
+    material_colours: Vec<surface::MaterialColours>,
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
     /// lights, a delta sun, the lights at infinity; with their selection distribution.
     pub(crate) lights: lights::SceneLights,
@@ -229,13 +231,20 @@ impl Scene {
                 id,
             );
         }
+        let material_colours: Vec<surface::MaterialColours> = desc
+            .materials
+            .iter()
+            .map(surface::MaterialColours::new)
+            .collect();
         for light in &mut lights {
-            let material = &desc.materials[shading[light.triangle as usize].material as usize];
+            let index = shading[light.triangle as usize].material as usize;
+            let material = &desc.materials[index];
             if material.emission_texture.is_some() {
                 let point = |barycentrics| surface::SurfacePoint {
                     attributes: &attributes,
                     textures: &textures,
                     material,
+                    colours: &material_colours[index],
                     triangle: light.triangle,
                     barycentrics,
                 };
@@ -275,6 +284,7 @@ impl Scene {
             attributes,
             textures,
             materials: desc.materials.to_vec(),
+            material_colours,
             lights: scene_lights,
             internal_to_input,
             ray_epsilon: magnitude * 2e-5,
@@ -363,10 +373,12 @@ impl Scene {
         triangle: u32,
         barycentrics: [f32; 2],
     ) -> surface::SurfacePoint<'_> {
+        let material = self.shading[triangle as usize].material as usize;
         surface::SurfacePoint {
             attributes: &self.attributes,
             textures: &self.textures,
-            material: &self.materials[self.shading[triangle as usize].material as usize],
+            material: &self.materials[material],
+            colours: &self.material_colours[material],
             triangle,
             barycentrics,
         }
@@ -403,11 +415,11 @@ impl Scene {
                 emission,
                 ..
             } => {
-                *emission = if self.emission_is_textured(*triangle) {
-                    self.emission(*triangle, *barycentrics, channels)
-                } else {
-                    channels.illuminant(emission.to_array())
-                };
+                // In RGB the light's own emission, unless textured; spectra from the
+                // material's fit.
+                if self.emission_is_textured(*triangle) || *channels != Channels::Rgb {
+                    *emission = self.emission(*triangle, *barycentrics, channels);
+                }
             }
             lights::LightSample::Direction { radiance, .. } => {
                 *radiance = channels.illuminant(radiance.to_array());
@@ -431,7 +443,7 @@ impl Scene {
             .lights
             .sample_emission(u_select, u_point, u_direction)?;
         if let lights::Emitter::Area(triangle) = sample.emitter
-            && self.emission_is_textured(triangle)
+            && (self.emission_is_textured(triangle) || *channels != Channels::Rgb)
         {
             sample.emission = self.emission(triangle, sample.barycentrics, channels);
             let cos = sample.direction.dot(sample.normal);

@@ -8,7 +8,7 @@
 use super::material::{Material, TextureRef};
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
-use crate::spectral::Channels;
+use crate::spectral::{Channels, FittedColour};
 use crate::spectrum::Spectrum;
 use crate::texture::Texture;
 use glam::{Vec3A, Vec4};
@@ -210,12 +210,28 @@ fn lookup(textures: &[Texture], texture: &TextureRef, uv: [f32; 2]) -> Vec4 {
     Vec4::from_array(textures[texture.texture as usize].sample(uv))
 }
 
+/// A material's constant colour and emission with their spectral fits, made once per scene.
+pub(crate) struct MaterialColours {
+    color: FittedColour,
+    emission: FittedColour,
+}
+
+impl MaterialColours {
+    pub fn new(material: &Material) -> Self {
+        MaterialColours {
+            color: FittedColour::reflectance(material.color),
+            emission: FittedColour::illuminant(material.emission),
+        }
+    }
+}
+
 /// A surface point's look: what its material's textures and the vertex attributes make of
 /// it there.
 pub(crate) struct SurfacePoint<'a> {
     pub attributes: &'a SurfaceAttributes,
     pub textures: &'a [Texture],
     pub material: &'a Material,
+    pub colours: &'a MaterialColours,
     pub triangle: u32,
     pub barycentrics: [f32; 2],
 }
@@ -248,16 +264,15 @@ impl SurfacePoint<'_> {
     #[inline]
     pub fn emission(&self, channels: &Channels) -> Spectrum {
         let m = self.material;
-        let mut emission = m.emission;
-        if let Some(texture) = &m.emission_texture {
-            let texel = lookup(self.textures, texture, self.texcoord());
-            emission = [
-                emission[0] * texel.x,
-                emission[1] * texel.y,
-                emission[2] * texel.z,
-            ];
-        }
-        channels.illuminant(emission)
+        let Some(texture) = &m.emission_texture else {
+            return channels.fitted_illuminant(&self.colours.emission);
+        };
+        let texel = lookup(self.textures, texture, self.texcoord());
+        channels.illuminant([
+            m.emission[0] * texel.x,
+            m.emission[1] * texel.y,
+            m.emission[2] * texel.z,
+        ])
     }
 
     /// The shading normal: interpolated, then bent by the normal map (tangent space, x and
@@ -301,12 +316,15 @@ impl SurfacePoint<'_> {
     pub fn bsdf(&self, geometric_normal: Vec3A, channels: &Channels) -> Bsdf {
         let dispersive = self.material.disperses(channels);
         if self.attributes.is_flat(self.material) {
-            return Bsdf::new(
-                self.material.bsdf_model(channels),
-                geometric_normal,
-                geometric_normal,
-            )
-            .with_dispersion(dispersive);
+            let m = self.material;
+            let model = m.textured_bsdf_model(
+                channels.fitted_reflectance(&self.colours.color),
+                m.metallic,
+                m.roughness,
+                m.ior_in(channels),
+            );
+            return Bsdf::new(model, geometric_normal, geometric_normal)
+                .with_dispersion(dispersive);
         }
         let base = self.base_color();
         let color = channels.reflectance([base.x, base.y, base.z]);

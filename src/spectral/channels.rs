@@ -9,7 +9,7 @@
 
 use super::cie::{cie_1931_xyz, d65};
 use super::color::linear_srgb_from_xyz;
-use super::rgb_to_spectrum::reflectance_coefficients;
+use super::rgb_to_spectrum::{SigmoidPolynomial, reflectance_coefficients};
 use super::wavelengths::{SampledWavelengths, WAVELENGTHS};
 use crate::spectrum::Spectrum;
 use std::sync::OnceLock;
@@ -88,30 +88,85 @@ impl Channels {
     }
 }
 
-#[inline(never)]
-fn spectral_reflectance(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
-    let m = rgb[0].max(rgb[1]).max(rgb[2]);
-    if m <= 1.0 {
-        let fit = reflectance_coefficients(rgb);
-        Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l)))
-    } else {
-        let fit = reflectance_coefficients(rgb.map(|c| c / m));
-        Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l))) * m
+/// A colour with its spectral fit made once (a material's constant colour or emission),
+/// so that spectral renders do not look the fit up at every hit.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FittedColour {
+    rgb: [f32; 3],
+    fit: SigmoidPolynomial,
+    /// What the fitted spectrum is multiplied by.
+    scale: f32,
+}
+
+impl FittedColour {
+    /// A reflectance, as `Channels::reflectance` fits it.
+    pub fn reflectance(rgb: [f32; 3]) -> Self {
+        let m = rgb[0].max(rgb[1]).max(rgb[2]);
+        let scale = if m > 1.0 { m } else { 1.0 };
+        FittedColour {
+            rgb,
+            fit: reflectance_coefficients(rgb.map(|c| c / scale)),
+            scale,
+        }
+    }
+
+    /// An emission, as `Channels::illuminant` fits it.
+    pub fn illuminant(rgb: [f32; 3]) -> Self {
+        let m = rgb[0].max(rgb[1]).max(rgb[2]);
+        if m.is_nan() || m <= 0.0 {
+            return FittedColour {
+                rgb,
+                fit: SigmoidPolynomial::constant(0.0),
+                scale: 0.0,
+            };
+        }
+        let scale = 2.0 * m;
+        FittedColour {
+            rgb,
+            fit: reflectance_coefficients(rgb.map(|c| c / scale)),
+            scale,
+        }
+    }
+}
+
+impl Channels {
+    /// `Channels::reflectance` of a colour fitted beforehand.
+    #[inline(always)]
+    pub fn fitted_reflectance(&self, colour: &FittedColour) -> Spectrum {
+        match self {
+            Channels::Rgb => Spectrum::from(colour.rgb),
+            Channels::Wavelengths(w) => {
+                Spectrum::from_lanes(w.lambda.map(|l| colour.fit.eval(l))) * colour.scale
+            }
+        }
+    }
+
+    /// `Channels::illuminant` of an emission fitted beforehand.
+    #[inline(always)]
+    pub fn fitted_illuminant(&self, colour: &FittedColour) -> Spectrum {
+        match self {
+            Channels::Rgb => Spectrum::from(colour.rgb),
+            Channels::Wavelengths(w) => fitted_illuminant_at(w, colour),
+        }
     }
 }
 
 #[inline(never)]
-fn spectral_illuminant(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
-    let m = rgb[0].max(rgb[1]).max(rgb[2]);
-    if m.is_nan() || m <= 0.0 {
-        return Spectrum::ZERO;
-    }
-    // Halved so that the fitted chromaticity stays inside the table's interior, where the
-    // spectra are smooth.
-    let scale = 2.0 * m;
-    let fit = reflectance_coefficients(rgb.map(|c| c / scale));
+fn fitted_illuminant_at(w: &SampledWavelengths, colour: &FittedColour) -> Spectrum {
     let per_y = *d65_per_luminance();
-    Spectrum::from_lanes(w.lambda.map(|l| fit.eval(l) * d65(l) * per_y)) * scale
+    Spectrum::from_lanes(w.lambda.map(|l| colour.fit.eval(l) * d65(l) * per_y)) * colour.scale
+}
+
+#[inline(never)]
+fn spectral_reflectance(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
+    Channels::Wavelengths(*w).fitted_reflectance(&FittedColour::reflectance(rgb))
+}
+
+#[inline(never)]
+fn spectral_illuminant(w: &SampledWavelengths, rgb: [f32; 3]) -> Spectrum {
+    // The chromaticity fitted at half the largest channel, inside the table's interior
+    // where the spectra are smooth (see `FittedColour::illuminant`).
+    fitted_illuminant_at(w, &FittedColour::illuminant(rgb))
 }
 
 #[inline(never)]

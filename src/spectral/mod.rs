@@ -10,5 +10,5 @@ mod color;
 mod rgb_to_spectrum;
 mod wavelengths;
 
-pub(crate) use channels::Channels;
 pub use channels::white_light_srgb_per_nm;
+pub(crate) use channels::{Channels, FittedColour};

@@ -10,6 +10,8 @@
 //! Radziszewski et al. 2009). Its CDF is a tanh, so sampling inverts it in closed form.
 //! (To do once the matching functions are in: measure its variance against theirs.)
 
+use std::sync::OnceLock;
+
 /// The wavelengths a path carries.
 pub(crate) const WAVELENGTHS: usize = 4;
 
@@ -22,32 +24,44 @@ pub(crate) const LAMBDA_MAX: f32 = 830.0;
 const WIDTH: f32 = 0.0072;
 const CENTRE: f32 = 538.0;
 
-/// tanh of the range's ends in the density's coordinate: the CDF's values there.
+/// tanh of the range's ends in the density's coordinate: the CDF's values there (computed
+/// once: every path samples four wavelengths).
 #[inline]
 fn cdf_ends() -> (f32, f32) {
-    (
-        (WIDTH * (LAMBDA_MIN - CENTRE)).tanh(),
-        (WIDTH * (LAMBDA_MAX - CENTRE)).tanh(),
-    )
+    static ENDS: OnceLock<(f32, f32)> = OnceLock::new();
+    *ENDS.get_or_init(|| {
+        (
+            (WIDTH * (LAMBDA_MIN - CENTRE)).tanh(),
+            (WIDTH * (LAMBDA_MAX - CENTRE)).tanh(),
+        )
+    })
 }
 
-/// The importance density of wavelength `lambda` (per nm); 0 outside the range.
+/// The density at the wavelength whose tanh coordinate is `t` = tanh(B (λ − C)):
+/// sech² = 1 − tanh², so sampling gets its density without a cosh.
 #[inline]
+fn pdf_of_tanh(t: f32) -> f32 {
+    let (low, high) = cdf_ends();
+    WIDTH * (1.0 - t * t) / (high - low)
+}
+
+/// The importance density of wavelength `lambda` (per nm); 0 outside the range (what the
+/// tests check the sampled wavelengths against).
+#[cfg(test)]
 pub(crate) fn visible_wavelength_pdf(lambda: f32) -> f32 {
     if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda) {
         return 0.0;
     }
-    let (low, high) = cdf_ends();
-    let c = (WIDTH * (lambda - CENTRE)).cosh();
-    WIDTH / ((high - low) * c * c)
+    pdf_of_tanh((WIDTH * (lambda - CENTRE)).tanh())
 }
 
-/// The wavelength at which the density's CDF is `u` in [0, 1].
+/// The wavelength at which the density's CDF is `u` in [0, 1], and its density.
 #[inline]
-fn sample_visible_wavelength(u: f32) -> f32 {
+fn sample_visible_wavelength(u: f32) -> (f32, f32) {
     let (low, high) = cdf_ends();
     let t = low + u * (high - low);
-    (CENTRE + t.atanh() / WIDTH).clamp(LAMBDA_MIN, LAMBDA_MAX)
+    let lambda = (CENTRE + t.atanh() / WIDTH).clamp(LAMBDA_MIN, LAMBDA_MAX);
+    (lambda, pdf_of_tanh(t))
 }
 
 /// The wavelengths of a path and the density each was drawn with. A dropped wavelength
@@ -63,7 +77,7 @@ impl SampledWavelengths {
     /// u + i / `WAVELENGTHS` (wrapped), so each is distributed by the density and together
     /// they are stratified.
     pub fn sample(u: f32) -> Self {
-        let lambda = std::array::from_fn(|i| {
+        let samples: [(f32, f32); WAVELENGTHS] = std::array::from_fn(|i| {
             let shifted = u + i as f32 / WAVELENGTHS as f32;
             let wrapped = if shifted >= 1.0 {
                 shifted - 1.0
@@ -73,8 +87,8 @@ impl SampledWavelengths {
             sample_visible_wavelength(wrapped)
         });
         SampledWavelengths {
-            lambda,
-            pdf: lambda.map(visible_wavelength_pdf),
+            lambda: samples.map(|(lambda, _)| lambda),
+            pdf: samples.map(|(_, pdf)| pdf),
         }
     }
 
@@ -180,7 +194,12 @@ mod tests {
                     (cdf(lambda) - expected).abs() < 1e-4,
                     "u {u} i {i}: {lambda}"
                 );
-                assert_eq!(s.pdf[i], visible_wavelength_pdf(lambda));
+                let pdf = visible_wavelength_pdf(lambda);
+                assert!(
+                    (s.pdf[i] - pdf).abs() <= 1e-4 * pdf,
+                    "{} vs {pdf}",
+                    s.pdf[i]
+                );
             }
         }
     }
