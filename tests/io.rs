@@ -282,11 +282,28 @@ fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// The dispersion example scene (written by `tools/prism_scene.py`): a flint prism (`Vd 20`),
+/// one lamp, and its camera.
+#[test]
+fn prism_scene_has_a_dispersive_prism_and_one_lamp() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/prism.obj");
+    let data = io::load_scene(&path).unwrap();
+    let (_, flint) = material_named(&data, "flint");
+    assert_eq!(
+        (flint.kind, flint.ior, flint.abbe_number),
+        (MaterialKind::Dielectric, 1.5, 20.0)
+    );
+    let lamps = data.materials.iter().filter(|m| m.is_emissive()).count();
+    assert_eq!(lamps, 1);
+    assert!(data.camera.is_some());
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
 #[test]
 fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\
         newmtl tf\nTf 0.5 0.6 0.7\nNi 1.33\nillum 2\n\
-        newmtl glass7\nillum 7\n\
+        newmtl glass7\nillum 7\nVd 36\n\
         newmtl emissive_mirror\nillum 3\nKe 1 2 3\n\
         newmtl bare\n";
     let obj = b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
@@ -305,9 +322,10 @@ fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     );
     let g = material_named(&data, "glass7").1;
     assert_eq!(
-        (g.kind, g.color, g.ior),
-        (MaterialKind::Dielectric, [1.0; 3], 1.5)
+        (g.kind, g.color, g.ior, g.abbe_number),
+        (MaterialKind::Dielectric, [1.0; 3], 1.5, 36.0)
     );
+    assert_eq!(tf.abbe_number, 0.0);
     let em = material_named(&data, "emissive_mirror").1;
     assert_eq!(
         (em.kind, em.emission),

@@ -25,7 +25,9 @@
 //!   roughness = (2 / (Ns + 2))^¼ (Walter et al. 2007's α = sqrt(2 / (Ns + 2)), and glTF's
 //!   α = roughness²); `Ks`'s colour itself is not used (the dielectric's Fresnel is);
 //! - anything else: Lambertian with albedo `Kd` (0.8 grey if absent);
-//! - `Ke` on any material makes its triangles area lights.
+//! - `Ke` on any material makes its triangles area lights;
+//! - `Vd` (mlt's own keyword; MTL has none for it) on a dielectric or metallic-roughness
+//!   material: its Abbe number, the dispersion `Material::abbe_number` describes.
 //!
 //! Textures: `map_Kd` (base colour, sRGB), `map_Ke` (emission, sRGB; emission 1 if `Ke` is
 //! absent), `norm`, `map_Bump` or `bump` (a tangent-space normal map with `-bm` as its scale;

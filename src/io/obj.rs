@@ -141,6 +141,7 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         }
     };
     let (roughness, metallic) = (number("Pr")?, number("Pm")?);
+    let abbe_number = number("Vd")?.unwrap_or(0.0);
     let pbr = roughness.is_some()
         || metallic.is_some()
         || m.unknown_param.contains_key("map_Pr")
@@ -175,6 +176,13 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         }
     } else {
         Material::diffuse(diffuse)
+    };
+    let material = match material.kind {
+        MaterialKind::Dielectric | MaterialKind::MetallicRoughness => Material {
+            abbe_number,
+            ..material
+        },
+        _ => material,
     };
     Ok(material.with_emission(m.emissive.unwrap_or([0.0; 3])))
 }
