@@ -50,7 +50,6 @@ use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
 use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
-use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::TAU;
@@ -237,7 +236,7 @@ impl Bidirectional {
                 }
                 // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
                 // which are `sample_emission`'s).
-                match scene.sample_light(rng.uniform(), rng.uniform2(), &Channels::Rgb)? {
+                match scene.sample_light(rng.uniform(), rng.uniform2(), &space.channels)? {
                     LightSample::Area {
                         point,
                         normal,
@@ -400,6 +399,7 @@ mod tests {
         Z_999, Z_9999, quantile as chi_square_quantile, statistic as chi_square,
     };
     use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
+    use crate::spectral::Channels;
     use glam::DVec3;
     use std::f64::consts::PI;
 
@@ -967,6 +967,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let pinhole = Pinhole::new();
         let [light, wall, floor, lens] = vertices(&space);
@@ -1129,6 +1130,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let pinhole = Pinhole::new();
         let [light, wall, floor, lens] = vertices(&space);
@@ -1396,6 +1398,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let pinhole = Pinhole::new();
         let [light, wall, floor, lens] = vertices(&space);

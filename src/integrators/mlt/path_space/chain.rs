@@ -18,6 +18,7 @@ use crate::integrators::mlt::primary_space::{self, MetropolisSettings, PathSampl
 use crate::integrators::mlt::targets::BdptAllStrategies;
 use crate::sampling::Rng;
 use crate::scene::CameraModel;
+use crate::spectral::Channels;
 use rayon::prelude::*;
 use std::marker::PhantomData;
 
@@ -40,6 +41,8 @@ impl PathSpaceTarget<'_> {
         PathSpace {
             scene: self.bdpt.0.scene,
             camera: &self.camera,
+            // Path-space chains carry RGB for now: the settings refuse spectral renders.
+            channels: Channels::Rgb,
         }
     }
 

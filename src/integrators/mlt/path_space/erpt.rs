@@ -398,6 +398,8 @@ pub(crate) fn run(
         space: PathSpace {
             scene: bdpt.scene,
             camera,
+            // ERPT carries RGB for now: the settings refuse spectral renders.
+            channels: crate::spectral::Channels::Rgb,
         },
         sizes: PerturbationSizes::for_image(width, height),
         perturb_in_sample_space: settings.perturb_in_sample_space,

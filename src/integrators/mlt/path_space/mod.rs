@@ -53,7 +53,6 @@ pub(crate) use perturbation::PerturbationSizes;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrators::PathVertex;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
-// Path-space MLT and ERPT render RGB: the settings refuse them in spectral mode.
 use crate::scene::lights::{Emitter, Light};
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
@@ -69,10 +68,12 @@ pub(crate) enum VertexClass {
     Specular,
 }
 
-/// The scene and camera a path lives in, with the functions that evaluate paths.
+/// The scene and camera a path lives in, with the functions that evaluate paths, and the
+/// channels its spectra are in (the path's wavelengths in a spectral render).
 pub(crate) struct PathSpace<'a> {
     pub scene: &'a Scene,
     pub camera: &'a CameraModel,
+    pub channels: Channels,
 }
 
 /// The unit direction from `from` to `to` and the squared distance (infinite towards or
@@ -94,7 +95,7 @@ impl PathSpace<'_> {
     /// The BSDF of surface vertex `v`.
     #[inline]
     fn surface_bsdf(&self, v: &PathVertex) -> Bsdf {
-        vertex_bsdf(self.scene, v.triangle, v.barycentrics, &Channels::Rgb)
+        vertex_bsdf(self.scene, v.triangle, v.barycentrics, &self.channels)
     }
 
     /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
@@ -255,7 +256,7 @@ impl PathSpace<'_> {
                 }
                 let emission =
                     self.scene
-                        .emission(light.triangle, light.barycentrics, &Channels::Rgb);
+                        .emission(light.triangle, light.barycentrics, &self.channels);
                 // The light leaves its front side only.
                 let (w_light, _) = direction(&path[0], &path[1])?;
                 if w_light.dot(light.normal) <= 0.0 {
@@ -271,7 +272,7 @@ impl PathSpace<'_> {
                     .scene
                     .lights
                     .point_light(index)
-                    .intensity(w, &Channels::Rgb);
+                    .intensity(w, &self.channels);
                 (intensity, self.scene.lights.light_select_pdf(index))
             }
             Some(Emitter::Directional(index)) => match &self.scene.lights.lights[index as usize] {
@@ -283,7 +284,7 @@ impl PathSpace<'_> {
             Some(Emitter::Infinite) => (
                 self.scene
                     .lights
-                    .infinite_radiance(light.normal, &Channels::Rgb),
+                    .infinite_radiance(light.normal, &self.channels),
                 self.scene.lights.infinite_pdf(light.normal),
             ),
             Some(Emitter::Area(_)) => return None,
@@ -382,6 +383,7 @@ impl PathSpace<'_> {
                 * self.bsdf(&path[s + 1], pt, qs, TransportMode::Radiance)?
                 * beta_eye
         };
+        let value = self.channels.rgb_of(value);
         (value.max_component() > 0.0 && value.is_finite()).then_some((value, pixel))
     }
 }
@@ -436,6 +438,7 @@ mod tests {
         let space = PathSpace {
             scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
         let mut counters = SampleCounters::default();
@@ -732,6 +735,7 @@ mod tests {
             let space = PathSpace {
                 scene: &scene,
                 camera: &camera,
+                channels: Channels::Rgb,
             };
             let bdpt = Bdpt {
                 scene: &scene,

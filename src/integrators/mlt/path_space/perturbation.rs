@@ -627,6 +627,7 @@ mod tests {
     use crate::accel::Backend;
     use crate::bsdf;
     use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
+    use crate::spectral::Channels;
 
     /// Fixed moves, to set up a given proposal: a film offset, and directions turned by a
     /// fixed rotation.
@@ -757,6 +758,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let eye = eye(&camera);
         // Lens → mirror → floor, then the wall and the light by hand.
@@ -807,6 +809,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let eye = eye(&camera);
         let light = vertex(
@@ -867,6 +870,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let eye = eye(&camera);
         let (near_mirror, floor) = mirror_then_floor(&space);
@@ -1416,6 +1420,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let starts = family_paths(&space, Family::Mirrored, CHAINS);
         assert!(starts.iter().all(|x| applicable(&space, x).caustic));
@@ -1461,6 +1466,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let starts = family_paths(&space, Family::Mirrored, CHAINS);
         assert!(starts.iter().all(|x| !applicable(&space, x).lens));
@@ -1497,6 +1503,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let target = converged_target(Family::Direct);
         let starts = family_paths(&space, Family::Direct, CHAINS);
@@ -1550,6 +1557,7 @@ mod tests {
         let space = PathSpace {
             scene: &scene,
             camera: &camera,
+            channels: Channels::Rgb,
         };
         let starts = family_paths(&space, Family::Glossy, CHAINS);
         assert!(
