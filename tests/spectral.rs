@@ -12,15 +12,17 @@
 mod common;
 
 use common::*;
-use mlt::{Algorithm, RenderSettings, render};
+use mlt::{Algorithm, RenderSettings};
 
-/// Every algorithm that renders spectrally.
-const SPECTRAL_ALGORITHMS: [Algorithm; 5] = [
+/// Every algorithm (all render spectrally).
+const SPECTRAL_ALGORITHMS: [Algorithm; 7] = [
     Algorithm::Path,
     Algorithm::Bdpt,
     Algorithm::Pssmlt,
     Algorithm::Mmlt,
     Algorithm::PssmltBdpt,
+    Algorithm::PathSpaceMlt,
+    Algorithm::Erpt,
 ];
 
 fn spectral_settings(algorithm: Algorithm, size: u32, depth: u32, seed: u64) -> RenderSettings {
@@ -100,20 +102,6 @@ fn emission_colour_round_trips() {
             emission[c]
         );
         assert_sharp(&format!("channel {c}"), emission[c] as f64, error[c], 4.0);
-    }
-}
-
-/// Path-space MLT and ERPT do not carry wavelengths yet: a spectral render is refused with a
-/// clear status, never rendered wrong.
-#[test]
-fn path_space_algorithms_refuse_spectral_mode() {
-    let scene = furnace_scene([0.5; 3], [1.0; 3]);
-    for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
-        let settings = spectral_settings(algorithm, 8, 2, 1);
-        let mut image = vec![0.0; 8 * 8 * 3];
-        let error = render(&scene, &furnace_camera(), &settings, &mut image, None).unwrap_err();
-        assert_eq!(error.status, mlt::error::MLT_STATUS_UNSUPPORTED);
-        assert!(error.message.contains("spectral"), "{}", error.message);
     }
 }
 

@@ -142,6 +142,17 @@ pub struct BdptScratch {
     connection: Vertex,
     /// What the subpaths' spectra are: RGB, or the wavelengths both subpaths carry.
     channels: Channels,
+    /// The channels as drawn for the sample, before a dispersive vertex kept the hero
+    /// alone: what a path-space state built from the sample carries.
+    drawn_channels: Channels,
+}
+
+impl BdptScratch {
+    /// The channels drawn for the last sample (see `drawn_channels`).
+    #[inline]
+    pub(crate) fn drawn_channels(&self) -> Channels {
+        self.drawn_channels
+    }
 }
 
 /// Converts a solid-angle density at `from` of the direction towards `to` into an area
@@ -607,7 +618,8 @@ impl Bdpt<'_> {
         scratch: &mut BdptScratch,
         counters: &mut SampleCounters,
     ) -> (usize, usize) {
-        scratch.channels = Channels::new(self.spectral, || sampler.uniform());
+        scratch.drawn_channels = Channels::new(self.spectral, || sampler.uniform());
+        scratch.channels = scratch.drawn_channels;
         let n_camera = self.camera_subpath(
             camera_model,
             x,
@@ -973,6 +985,7 @@ impl PixelEstimator for Bdpt<'_> {
             light: vec![Vertex::EMPTY; n],
             connection: Vertex::EMPTY,
             channels: Channels::Rgb,
+            drawn_channels: Channels::Rgb,
         }
     }
 

@@ -247,20 +247,6 @@ fn render_into(
         min_depth,
         spectral: settings.spectral,
     };
-    if settings.spectral
-        && matches!(
-            settings.algorithm,
-            Algorithm::PathSpaceMlt | Algorithm::Erpt
-        )
-    {
-        return Err(crate::error::Error::new(
-            crate::error::MLT_STATUS_UNSUPPORTED,
-            format!(
-                "{:?} does not render in spectral mode yet (its path-space mutations carry RGB); use path tracing, BDPT, PSSMLT, MMLT or PSSMLT over BDPT, or turn spectral off",
-                settings.algorithm
-            ),
-        ));
-    }
     if matches!(
         settings.algorithm,
         Algorithm::PathSpaceMlt | Algorithm::Erpt

@@ -313,6 +313,14 @@ impl Scene {
             .bsdf(normal, channels)
     }
 
+    /// Whether internal triangle `triangle`'s material disperses light in `channels` (see
+    /// `Material::disperses`).
+    #[inline]
+    pub(crate) fn disperses(&self, triangle: u32, channels: &Channels) -> bool {
+        let material = self.shading[triangle as usize].material as usize;
+        self.materials[material].disperses(channels)
+    }
+
     /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
     /// somewhere (metallic-roughness at roughness 0 with a dielectric part: a smooth coat
     /// over a diffuse base), which path-space MLT and ERPT do not explore correctly.

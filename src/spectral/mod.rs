@@ -12,3 +12,4 @@ mod wavelengths;
 
 pub use channels::white_light_srgb_per_nm;
 pub(crate) use channels::{Channels, FittedColour};
+pub(crate) use wavelengths::SampledWavelengths;

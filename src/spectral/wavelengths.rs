@@ -70,6 +70,8 @@ fn sample_visible_wavelength(u: f32) -> (f32, f32) {
 pub(crate) struct SampledWavelengths {
     pub lambda: [f32; WAVELENGTHS],
     pub pdf: [f32; WAVELENGTHS],
+    /// The random number they were drawn from (`sample`): what a Metropolis move steps.
+    pub u: f32,
 }
 
 impl SampledWavelengths {
@@ -89,6 +91,7 @@ impl SampledWavelengths {
         SampledWavelengths {
             lambda: samples.map(|(lambda, _)| lambda),
             pdf: samples.map(|(_, pdf)| pdf),
+            u,
         }
     }
 

@@ -121,6 +121,13 @@ pub(crate) struct BdptTargetScratch {
     strategies: Vec<(usize, Contribution, f32)>,
 }
 
+impl BdptTargetScratch {
+    /// The channels the last sample drew (`BdptScratch::drawn_channels`).
+    pub(crate) fn drawn_channels(&self) -> crate::spectral::Channels {
+        self.paths.drawn_channels()
+    }
+}
+
 fn bdpt_scratch(bdpt: &Bdpt) -> BdptTargetScratch {
     BdptTargetScratch {
         paths: bdpt.scratch(),

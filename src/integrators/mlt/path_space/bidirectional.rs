@@ -50,6 +50,7 @@ use crate::bsdf::TransportMode;
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
 use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
+use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 use std::f32::consts::TAU;
@@ -130,6 +131,8 @@ pub(crate) struct Proposal {
     pub ratio: f32,
     pub value: Spectrum,
     pub pixel: u32,
+    /// The wavelengths y carries (x's, unless the mutation drew new ones).
+    pub channels: Channels,
 }
 
 /// The mutation over paths of `min_vertices..=max_vertices` vertices.
@@ -177,6 +180,24 @@ impl Bidirectional {
         if added > 0 && b == 0 && x[0].light.is_some() {
             return None;
         }
+        // In a spectral render y gets new wavelengths unless a kept vertex disperses (then
+        // the kept vertices exist at x's hero wavelength alone). The rule depends only on the
+        // kept vertices, which x and y share, so the reverse move draws x's wavelengths with
+        // the same (uniform) density and it cancels: y is sampled and measured at its own
+        // wavelengths, x at its own.
+        let resampled;
+        let space_y = if space.channels.hero().is_some()
+            && !(0..=a)
+                .chain(b..n as isize)
+                .any(|k| space.disperses_at(x, k as usize))
+        {
+            resampled = space.with_channels(Channels::new(true, || rng.uniform()));
+            &resampled
+        } else {
+            space
+        };
+        let space_x = space;
+        let space = space_y;
 
         // Light side: the kept prefix, then `from_light` sampled vertices.
         y.clear();
@@ -207,7 +228,7 @@ impl Bidirectional {
         }
         let (value, pixel) = space.unweighted_contribution(y, s, true)?;
         let h_y = split_density_sum(space, y, a, added);
-        let h_x = split_density_sum(space, x, a, deleted);
+        let h_x = split_density_sum(space_x, x, a, deleted);
         let b_new = a + added as isize + 1;
         let ratio = (added + 1) as f32 * deletion_probability(a, b_new, n_new) * h_x
             / ((deleted + 1) as f32 * deletion_probability(a, b, n) * h_y);
@@ -215,6 +236,7 @@ impl Bidirectional {
             ratio,
             value,
             pixel,
+            channels: space.channels,
         })
     }
 

@@ -37,12 +37,12 @@ pub(crate) struct PathSpaceTarget<'a> {
 }
 
 impl PathSpaceTarget<'_> {
-    fn space(&self) -> PathSpace<'_> {
+    /// The space of a state that carries `channels`.
+    fn space(&self, channels: Channels) -> PathSpace<'_> {
         PathSpace {
             scene: self.bdpt.0.scene,
             camera: &self.camera,
-            // Path-space chains carry RGB for now: the settings refuse spectral renders.
-            channels: Channels::Rgb,
+            channels,
         }
     }
 
@@ -68,10 +68,12 @@ impl PathSpaceTarget<'_> {
     }
 }
 
-/// A chain's state: the current path and its contribution, and room for a proposal.
+/// A chain's state: the current path, its wavelengths and its contribution, and room for a
+/// proposal.
 pub(crate) struct PathChain<'a> {
     rng: Rng,
     current: Vec<PathVertex>,
+    current_channels: Channels,
     current_sample: PathSample,
     proposal: Vec<PathVertex>,
     proposal_sample: PathSample,
@@ -87,7 +89,7 @@ impl<'a> MarkovChain for PathChain<'a> {
 
     #[inline]
     fn mutate(&mut self, target: &PathSpaceTarget<'a>, _: &CameraModel, deposits: &mut Deposits) {
-        let space = target.space();
+        let space = target.space(self.current_channels);
         self.proposal_sample.clear();
         // Pick a mutation among those the current path admits.
         let probabilities = if self.current.len() >= 2 {
@@ -113,7 +115,8 @@ impl<'a> MarkovChain for PathChain<'a> {
                 .map(|mut p| {
                     // The bidirectional mutation may change which perturbations apply, and
                     // with them its own probability of being picked.
-                    let reverse = target.mutation_probabilities(&space, y)[0];
+                    let space_y = target.space(p.channels);
+                    let reverse = target.mutation_probabilities(&space_y, y)[0];
                     p.ratio *= reverse / probabilities[0];
                     p
                 }),
@@ -135,6 +138,7 @@ impl<'a> MarkovChain for PathChain<'a> {
                 perturbation::caustic(&space, &mut kernel, x, y, rays)
             }
         };
+        let proposal_channels = proposal.as_ref().map(|p| p.channels);
         let a = match proposal {
             Some(proposal) => {
                 self.proposal_sample.push(proposal.pixel, proposal.value);
@@ -159,6 +163,9 @@ impl<'a> MarkovChain for PathChain<'a> {
         if self.rng.uniform() < a {
             std::mem::swap(&mut self.current, &mut self.proposal);
             std::mem::swap(&mut self.current_sample, &mut self.proposal_sample);
+            if let Some(channels) = proposal_channels {
+                self.current_channels = channels;
+            }
             self.accepted += 1;
             self.counts.accepted[mutation as usize] += 1;
         }
@@ -345,7 +352,6 @@ fn seed_chain<'a>(
     stream: u64,
 ) -> PathChain<'a> {
     let camera = &target.camera;
-    let space = target.space();
     let max_vertices = target.bdpt.0.max_depth as usize + 2;
     let mut sampler = primary_space::new_sampler(&target.bdpt, settings);
     driver::restart_as_bootstrap(&mut sampler, settings, camera, index, bootstrap_samples);
@@ -362,14 +368,19 @@ fn seed_chain<'a>(
         &mut current,
         &mut rays,
     );
-    if let Some((value, pixel)) =
-        seeded.and_then(|s| space.unweighted_contribution(&current, s, true))
-    {
+    // The state carries the wavelengths the bootstrap sample drew.
+    let channels = scratch.drawn_channels();
+    if let Some((value, pixel)) = seeded.and_then(|s| {
+        target
+            .space(channels)
+            .unweighted_contribution(&current, s, true)
+    }) {
         current_sample.push(pixel, value);
     }
     PathChain {
         rng: Rng::new(settings.seed, CHAIN_STREAM + stream),
         current,
+        current_channels: channels,
         current_sample,
         proposal: Vec::with_capacity(max_vertices),
         proposal_sample: PathSample::with_capacity(1),

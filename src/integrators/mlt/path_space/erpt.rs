@@ -35,7 +35,7 @@
 //! # Determinism
 //!
 //! Each (pixel, sample) has its own random stream for its BDPT sample and its chains, and
-//! deposits go to per-pixel fixed-point (integer) accumulators, whose sums do not depend on
+//! deposits go to per-pixel fixed-point (signed integer) accumulators, whose sums do not depend on
 //! the order of addition: the image is the same for any thread count. Deposits are rounded to
 //! 2⁻²⁴ e_d; summed over a chain's consecutive deposits in the same pixel before rounding.
 //!
@@ -61,7 +61,7 @@ use crate::sampling::Rng;
 use crate::scene::CameraModel;
 use crate::spectrum::Spectrum;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicI64, Ordering};
 
 /// Stream offsets: the per-pixel shifts of the camera samples, and the pre-pass.
 const PIXEL_SHIFT_STREAM: u64 = 0x5eed_e397_0000_0000;
@@ -125,7 +125,7 @@ struct Redistributor<'a> {
     chain_length: u32,
     deposit_energy: f32,
     /// Fixed-point sums per pixel, partial image (`buffers` per pixel) and channel.
-    sums: &'a [[AtomicU64; 3]],
+    sums: &'a [[AtomicI64; 3]],
     buffers: usize,
     scale: f64,
 }
@@ -142,8 +142,10 @@ impl Redistributor<'_> {
         let sums = &self.sums[pending.pixel as usize * self.buffers + pending.buffer];
         for (sum, value) in sums.iter().zip(pending.value) {
             // `as` saturates; so does the sum (only reachable with an absurdly small e_d).
-            let units = (value * self.scale).round() as u64;
-            if units > 0 {
+            // Signed: in a spectral render a path's colour at few wavelengths can lie outside
+            // sRGB's gamut, with a negative channel that the other deposits make up for.
+            let units = (value * self.scale).round() as i64;
+            if units != 0 {
                 let _ = sum.fetch_update(Ordering::Relaxed, Ordering::Relaxed, |s| {
                     Some(s.saturating_add(units))
                 });
@@ -164,11 +166,13 @@ impl Redistributor<'_> {
     }
 
     /// Runs `chains` chains of L perturbations from path `initial` (contribution colour
-    /// `colour` at unit luminance, in `pixel`). On a stop, the remaining energy goes to
-    /// the current state. Returns the mutations made.
+    /// `colour` at unit luminance, in `pixel`) in `space` (the sample's wavelengths, which
+    /// the perturbations keep). On a stop, the remaining energy goes to the current state.
+    /// Returns the mutations made.
     #[allow(clippy::too_many_arguments)]
     fn redistribute(
         &self,
+        space: &PathSpace,
         chains: u64,
         pixel: u32,
         buffer: usize,
@@ -185,7 +189,7 @@ impl Redistributor<'_> {
             buffer,
             value: [0.0; 3],
         };
-        let admits = perturbation::applicable(&self.space, &scratch.initial);
+        let admits = perturbation::applicable(space, &scratch.initial);
         let [_, lens, caustic, multi] = self.weights.0;
         // Perturbations keep the pattern of specular vertices, so these probabilities are
         // the same at every state of the chain (and at its proposals).
@@ -228,9 +232,9 @@ impl Redistributor<'_> {
                 };
                 let (x, y) = (&scratch.current, &mut scratch.proposal);
                 let proposal = match pick {
-                    0 => perturbation::lens(&self.space, &mut kernel, false, x, y, rays),
-                    1 => perturbation::caustic(&self.space, &mut kernel, x, y, rays),
-                    _ => perturbation::lens(&self.space, &mut kernel, true, x, y, rays),
+                    0 => perturbation::lens(space, &mut kernel, false, x, y, rays),
+                    1 => perturbation::caustic(space, &mut kernel, x, y, rays),
+                    _ => perturbation::lens(space, &mut kernel, true, x, y, rays),
                 };
                 scratch.counts.proposed[pick + 1] += 1;
                 mutations += 1;
@@ -288,6 +292,7 @@ impl Redistributor<'_> {
             &mut scratch.bdpt,
             counters,
         );
+        let space = self.space.with_channels(scratch.bdpt.drawn_channels());
         let per_chain = self.chain_length as f64 * self.deposit_energy as f64;
         let (mut mutations, mut accepted, mut valid) = (0, 0, true);
         for t in 1..=n_camera {
@@ -312,11 +317,12 @@ impl Redistributor<'_> {
                 if chains == 0 {
                     continue;
                 }
-                let pixel = self.space.pixel(&scratch.initial).or(c.splat_pixel);
+                let pixel = space.pixel(&scratch.initial).or(c.splat_pixel);
                 let Some(pixel) = pixel else {
                     continue;
                 };
                 let (m, a) = self.redistribute(
+                    &space,
                     chains,
                     pixel,
                     buffer,
@@ -392,13 +398,13 @@ pub(crate) fn run(
     // (by a hash of pixel and sample, so every partial sees every region); the film's
     // splats are the partials' sums.
     let buffers = film.filter_buffers().max(1);
-    let sums: Vec<[AtomicU64; 3]> = (0..pixels * buffers).map(|_| Default::default()).collect();
+    let sums: Vec<[AtomicI64; 3]> = (0..pixels * buffers).map(|_| Default::default()).collect();
     let redistributor = Redistributor {
         bdpt,
         space: PathSpace {
             scene: bdpt.scene,
             camera,
-            // ERPT carries RGB for now: the settings refuse spectral renders.
+            // Each camera sample's chains carry the wavelengths it drew (`sample`).
             channels: crate::spectral::Channels::Rgb,
         },
         sizes: PerturbationSizes::for_image(width, height),
@@ -500,7 +506,7 @@ pub(crate) fn run(
     outcome.mutation_weights = settings.weights;
     // The film divides splats by (samples taken / pixels): one camera sample per pixel.
     let unit = deposit_energy as f64 / FIXED_POINT;
-    let value = |s: &[AtomicU64; 3]| -> [f64; 3] {
+    let value = |s: &[AtomicI64; 3]| -> [f64; 3] {
         std::array::from_fn(|c| s[c].load(Ordering::Relaxed) as f64 * unit)
     };
     film.add_splat_sums(
@@ -510,7 +516,7 @@ pub(crate) fn run(
                 pixel
                     .iter()
                     .map(|s| s[c].load(Ordering::Relaxed))
-                    .fold(0u64, u64::saturating_add) as f64
+                    .fold(0i64, i64::saturating_add) as f64
                     * unit
             })
         }),

@@ -69,7 +69,9 @@ pub(crate) enum VertexClass {
 }
 
 /// The scene and camera a path lives in, with the functions that evaluate paths, and the
-/// channels its spectra are in (the path's wavelengths in a spectral render).
+/// channels its spectra are in: in a spectral render the wavelengths the chain's state
+/// carries with its path (see "Wavelengths" in the module documentation).
+#[derive(Clone, Copy)]
 pub(crate) struct PathSpace<'a> {
     pub scene: &'a Scene,
     pub camera: &'a CameraModel,
@@ -92,6 +94,32 @@ fn direction(from: &PathVertex, to: &PathVertex) -> Option<(Vec3A, f32)> {
 }
 
 impl PathSpace<'_> {
+    /// The same space with a state's other wavelengths.
+    #[inline]
+    fn with_channels(&self, channels: Channels) -> Self {
+        PathSpace { channels, ..*self }
+    }
+
+    /// Whether vertex `k` of `path` is a surface whose index of refraction depends on the
+    /// wavelength (never the lens, the last vertex, nor a light that is not a triangle).
+    #[inline]
+    fn disperses_at(&self, path: &[PathVertex], k: usize) -> bool {
+        let v = &path[k];
+        k + 1 < path.len() && v.light.is_none() && self.scene.disperses(v.triangle, &self.channels)
+    }
+
+    /// The channels `path`'s contribution is measured in: the state's wavelengths, or its
+    /// hero alone (with its density divided by their number) where a vertex disperses, since
+    /// such a path exists at that one wavelength.
+    #[inline]
+    fn channels_of(&self, path: &[PathVertex]) -> Channels {
+        let mut channels = self.channels;
+        if channels.hero().is_some() && (0..path.len()).any(|k| self.disperses_at(path, k)) {
+            channels.keep_hero_only();
+        }
+        channels
+    }
+
     /// The BSDF of surface vertex `v`.
     #[inline]
     fn surface_bsdf(&self, v: &PathVertex) -> Bsdf {
@@ -383,7 +411,7 @@ impl PathSpace<'_> {
                 * self.bsdf(&path[s + 1], pt, qs, TransportMode::Radiance)?
                 * beta_eye
         };
-        let value = self.channels.rgb_of(value);
+        let value = self.channels_of(path).rgb_of(value);
         (value.max_component() > 0.0 && value.is_finite()).then_some((value, pixel))
     }
 }
@@ -680,6 +708,9 @@ mod tests {
         }
         fn in_sample_space(&self) -> bool {
             false
+        }
+        fn wavelength_step(&mut self, u: f32) -> f32 {
+            u
         }
     }
 

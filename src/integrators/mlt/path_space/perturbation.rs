@@ -79,6 +79,7 @@ use crate::bsdf::{Microfacet, SpecularLobe};
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
 use crate::scene::lights::Emitter;
+use crate::spectral::{Channels, SampledWavelengths};
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -182,7 +183,16 @@ pub(crate) trait Kernel {
     /// Whether directions and microfacets move in their samplings' coordinates (`step`)
     /// rather than by turns (see the module docs).
     fn in_sample_space(&self) -> bool;
+    /// The random number a path's wavelengths are drawn from (`SampledWavelengths::u`)
+    /// moved by a small step, wrapped into [0, 1).
+    fn wavelength_step(&mut self, u: f32) -> f32;
 }
+
+/// Steps of the wavelengths' random number range from this length …
+const WAVELENGTH_STEP_MIN: f32 = 1e-4;
+/// … to this one (a tenth of the visible range's probability, about 25 nm about green),
+/// with density ∝ 1/length.
+const WAVELENGTH_STEP_MAX: f32 = 0.1;
 
 /// The perturbations' kernels: symmetric, of the given sizes; directions turned within a
 /// cone or, `in_sample_space`, stepped in the vertex's sample space (module docs).
@@ -223,6 +233,19 @@ impl Kernel for RandomKernel<'_> {
     fn in_sample_space(&self) -> bool {
         self.in_sample_space
     }
+
+    #[inline]
+    fn wavelength_step(&mut self, u: f32) -> f32 {
+        let length = log_uniform(WAVELENGTH_STEP_MIN, WAVELENGTH_STEP_MAX, self.rng.uniform());
+        let signed = if self.rng.uniform() < 0.5 {
+            -length
+        } else {
+            length
+        };
+        let wrapped = (u + signed).rem_euclid(1.0);
+        // rem_euclid of a tiny negative number rounds to 1.
+        if wrapped < 1.0 { wrapped } else { 0.0 }
+    }
 }
 
 /// A direction near `old`, which left a diffuse vertex (or a light) sampling directions
@@ -244,14 +267,14 @@ fn perturbed_direction(
     (u1 < 1.0).then(|| from_sample_space(new_side, [u1, u2]))
 }
 
-/// The direction onwards from glossy vertex `at` of y, arrived at from `from`: through x's
-/// microfacet at its vertex (`x_at`, between `x_from` and `x_onwards`), moved by the
-/// kernel (turned, or stepped in the coordinates of the normals visible from y's
+/// The direction onwards from glossy vertex `at` of y (in `space_y`), arrived at from
+/// `from`: through x's microfacet (in `space_x`) at its vertex (`x_at`, between `x_from`
+/// and `x_onwards`), moved by the kernel (turned, or stepped in the coordinates of the normals visible from y's
 /// direction back), keeping its reflection or refraction. `None` if the moved microfacet
 /// does not scatter the path onwards.
 #[inline]
 fn glossy_onwards(
-    space: &PathSpace,
+    [space_x, space_y]: [&PathSpace; 2],
     kernel: &mut impl Kernel,
     [x_from, x_at, x_onwards]: [&PathVertex; 3],
     from: &PathVertex,
@@ -259,10 +282,10 @@ fn glossy_onwards(
 ) -> Option<Vec3A> {
     let (wo_x, _) = direction(x_at, x_from)?;
     let (wi_x, _) = direction(x_at, x_onwards)?;
-    let bsdf_x = space.surface_bsdf(x_at);
+    let bsdf_x = space_x.surface_bsdf(x_at);
     let microfacet = bsdf_x.microfacet(wo_x, wi_x)?;
     let (wo, _) = direction(at, from)?;
-    let bsdf = space.surface_bsdf(at);
+    let bsdf = space_y.surface_bsdf(at);
     let moved = if kernel.in_sample_space() {
         // The sampling's coordinates are (azimuth, cap height): step folds the second.
         let [azimuth, height] = bsdf_x.microfacet_coordinates(wo_x, microfacet.normal)?;
@@ -302,6 +325,24 @@ fn first_diffuse_from_lens(space: &PathSpace, x: &[PathVertex]) -> usize {
         .rev()
         .find(|&k| space.class(&x[k]) == VertexClass::Diffuse)
         .unwrap_or(0)
+}
+
+/// The space of a perturbation's proposal: x's, or in a spectral render, where none of the
+/// vertices the move keeps (x_0 … x_{first_moved − 1}, and the lens) disperses, x's
+/// wavelengths moved by the kernel's symmetric step (module docs, "Wavelengths").
+fn proposal_space<'a>(
+    space: &PathSpace<'a>,
+    kernel: &mut impl Kernel,
+    x: &[PathVertex],
+    first_moved: usize,
+) -> PathSpace<'a> {
+    match space.channels {
+        Channels::Wavelengths(w) if !(0..first_moved).any(|k| space.disperses_at(x, k)) => {
+            let u = kernel.wavelength_step(w.u);
+            space.with_channels(Channels::Wavelengths(SampledWavelengths::sample(u)))
+        }
+        _ => *space,
+    }
 }
 
 /// Which perturbations a path admits. Perturbations keep the path's pattern of vertex
@@ -410,6 +451,15 @@ pub(crate) fn lens(
     if applicable(space, x).lens == multi_chain {
         return None;
     }
+    // The move traces from the lens back to the first diffuse vertex it can connect from
+    // (one whose predecessor is not specular), or to the light.
+    let first_moved = (1..n - 1)
+        .rev()
+        .find(|&k| space.class(&x[k]) == VertexClass::Diffuse && !space.is_specular(&x[k - 1]))
+        .unwrap_or(0);
+    let space_x = space;
+    let space_y = &proposal_space(space, kernel, x, first_moved);
+    let space = space_y;
     let camera = space.camera;
     let lens = &x[n - 1];
     let (to_scene, _) = direction(lens, &x[n - 2])?;
@@ -457,7 +507,7 @@ pub(crate) fn lens(
         }
         let v = space.trace(&ray, rays)?;
         let class = space.class(&v);
-        if class != space.class(&x[k]) {
+        if class != space_x.class(&x[k]) {
             return None;
         }
         y[k] = v;
@@ -468,11 +518,15 @@ pub(crate) fn lens(
                     .surface_bsdf(&v)
                     .specular_direction(wo, lobe_at(x, k)?)?
             }
-            VertexClass::Glossy => {
-                glossy_onwards(space, kernel, [&x[k + 1], &x[k], &x[k - 1]], &y[k + 1], &v)?
-            }
+            VertexClass::Glossy => glossy_onwards(
+                [space_x, space_y],
+                kernel,
+                [&x[k + 1], &x[k], &x[k - 1]],
+                &y[k + 1],
+                &v,
+            )?,
             VertexClass::Diffuse => {
-                if !space.is_specular(&x[k - 1]) {
+                if !space_x.is_specular(&x[k - 1]) {
                     // Connect to the kept vertex before it.
                     if !space.visible(&y[k], &y[k - 1], false, rays) {
                         return None;
@@ -492,10 +546,11 @@ pub(crate) fn lens(
         ray = spawn_ray(space.scene, v.p, v.normal, next);
         k -= 1;
     };
+    debug_assert_eq!(s, first_moved);
     let in_sample_space = kernel.in_sample_space();
-    let density_y = lens_side_factors(space, in_sample_space, y, s);
-    let density_x = lens_side_factors(space, in_sample_space, x, s);
-    proposal(space, x, y, s, density_x, density_y)
+    let density_y = lens_side_factors(space_y, in_sample_space, y, s);
+    let density_x = lens_side_factors(space_x, in_sample_space, x, s);
+    proposal([space_x, space_y], x, y, s, density_x, density_y)
 }
 
 /// The product of `moved_direction_factor` over the lens-side vertices (after the first s)
@@ -541,6 +596,9 @@ pub(crate) fn caustic(
     }
     // The diffuse vertex the chain before x_{n-2} starts from.
     let c = caustic_start(space, x);
+    let space_x = space;
+    let space_y = &proposal_space(space, kernel, x, c + 1);
+    let space = space_y;
     let (old, _) = direction(&x[c], &x[c + 1])?;
     let from = c.checked_sub(1).map(|i| &x[i]);
     let side = sampling_side(from, &x[c]);
@@ -554,7 +612,7 @@ pub(crate) fn caustic(
     for k in c + 1..=n - 2 {
         let v = space.trace(&ray, rays)?;
         let class = space.class(&v);
-        if class != space.class(&x[k]) {
+        if class != space_x.class(&x[k]) {
             return None;
         }
         y[k] = v;
@@ -562,7 +620,13 @@ pub(crate) fn caustic(
             break;
         }
         let next = if class == VertexClass::Glossy {
-            glossy_onwards(space, kernel, [&x[k - 1], &x[k], &x[k + 1]], &y[k - 1], &v)?
+            glossy_onwards(
+                [space_x, space_y],
+                kernel,
+                [&x[k - 1], &x[k], &x[k + 1]],
+                &y[k - 1],
+                &v,
+            )?
         } else {
             let (wo, _) = direction(&y[k], &y[k - 1])?;
             // x's lobe at k, seen from the light side (x_{k-1} → x_k → x_{k+1}).
@@ -579,7 +643,7 @@ pub(crate) fn caustic(
     // The factors of the moved directions: at x_c and at the glossy vertices after it, from
     // the light side, as C_s takes them.
     let in_sample_space = kernel.in_sample_space();
-    let factors = |path: &[PathVertex]| {
+    let factors = |space: &PathSpace, path: &[PathVertex]| {
         let at_start = moved_direction_factor(space, in_sample_space, from, &path[c], &path[c + 1]);
         (c + 1..n - 2)
             .filter(|&k| space.class(&path[k]) == VertexClass::Glossy)
@@ -595,13 +659,14 @@ pub(crate) fn caustic(
             .product::<f32>()
             * at_start
     };
-    proposal(space, x, y, n - 1, factors(x), factors(y))
+    let (density_x, density_y) = (factors(space_x, x), factors(space_y, y));
+    proposal([space_x, space_y], x, y, n - 1, density_x, density_y)
 }
 
 /// The proposal y of a perturbation of x that kept s light vertices, with the densities of
 /// the perturbed directions (see the module documentation for the ratio).
 fn proposal(
-    space: &PathSpace,
+    [space_x, space_y]: [&PathSpace; 2],
     x: &[PathVertex],
     y: &[PathVertex],
     s: usize,
@@ -611,13 +676,14 @@ fn proposal(
     if !(density_x > 0.0 && density_y > 0.0) {
         return None;
     }
-    let (value, pixel) = space.unweighted_contribution(y, s, false)?;
-    let (value_x, _) = space.unweighted_contribution(x, s, false)?;
+    let (value, pixel) = space_y.unweighted_contribution(y, s, false)?;
+    let (value_x, _) = space_x.unweighted_contribution(x, s, false)?;
     let ratio = value.luminance() * density_y / (value_x.luminance() * density_x);
     Some(Proposal {
         ratio,
         value,
         pixel,
+        channels: space_y.channels,
     })
 }
 
@@ -648,6 +714,9 @@ mod tests {
         }
         fn in_sample_space(&self) -> bool {
             false
+        }
+        fn wavelength_step(&mut self, u: f32) -> f32 {
+            u
         }
     }
 
