@@ -153,6 +153,13 @@ impl BdptScratch {
     pub(crate) fn drawn_channels(&self) -> Channels {
         self.drawn_channels
     }
+
+    /// The channels the last sample's subpaths ended in (the hero alone after a dispersive
+    /// vertex on either).
+    #[cfg(test)]
+    pub(crate) fn channels(&self) -> Channels {
+        self.channels
+    }
 }
 
 /// Converts a solid-angle density at `from` of the direction towards `to` into an area

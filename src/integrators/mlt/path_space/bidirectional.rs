@@ -294,7 +294,8 @@ impl Bidirectional {
                 }
             },
             [.., previous, end] => {
-                let wi = sample_direction(space, previous, end, TransportMode::Importance, rng)?;
+                let wo = arrival_back(space, previous, false, end);
+                let wi = sample_direction(space, wo, end, TransportMode::Importance, rng)?;
                 space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)
             }
         }
@@ -341,7 +342,11 @@ impl Bidirectional {
                 space.trace(&ray, rays)
             };
         };
-        let wi = sample_direction(space, previous, end, TransportMode::Radiance, rng)?;
+        let previous_is_lens = suffix
+            .last()
+            .is_some_and(|lens| std::ptr::eq(lens, previous));
+        let wo = arrival_back(space, previous, previous_is_lens, end);
+        let wi = sample_direction(space, wo, end, TransportMode::Radiance, rng)?;
         let ray = spawn_ray(space.scene, end.p, end.normal, wi);
         if is_light {
             space.trace_or_escape(&ray, rays)
@@ -391,20 +396,37 @@ fn emission_ray(scene: &crate::scene::Scene, light: &PathVertex, u: [f32; 2]) ->
     }
 }
 
-/// A scattering direction at `at`, arrived at from `from`, sampled by its BSDF.
+/// The unit direction from `at` back along the ray that reached it from `from`. That ray
+/// left from `from`'s offset origin (`spawn_ray`), unless `from` is the lens or a light that
+/// is not a triangle: a direction rebuilt from the two points alone would bend a specular
+/// chain sampled on from `at` (against BDPT's, which goes on from its rays).
+#[inline]
+fn arrival_back(
+    space: &PathSpace,
+    from: &PathVertex,
+    from_is_lens: bool,
+    at: &PathVertex,
+) -> Vec3A {
+    if from.is_at_infinity() {
+        return from.normal;
+    }
+    let origin = if from_is_lens || from.light.is_some() {
+        from.p
+    } else {
+        spawn_ray(space.scene, from.p, from.normal, at.p - from.p).origin
+    };
+    (origin - at.p).normalize()
+}
+
+/// A scattering direction at `at`, arrived at along `-wo`, sampled by its BSDF.
 #[inline]
 fn sample_direction(
     space: &PathSpace,
-    from: &PathVertex,
+    wo: Vec3A,
     at: &PathVertex,
     mode: TransportMode,
     rng: &mut Rng,
 ) -> Option<Vec3A> {
-    let wo = if from.is_at_infinity() {
-        from.normal
-    } else {
-        (from.p - at.p).normalize()
-    };
     let s = space
         .surface_bsdf(at)
         .sample(wo, rng.uniform2(), rng.uniform(), mode)?;

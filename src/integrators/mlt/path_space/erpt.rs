@@ -211,6 +211,8 @@ impl Redistributor<'_> {
             scratch.current.clear();
             scratch.current.extend_from_slice(&scratch.initial);
             let mut current_pixel = pixel;
+            // The state's wavelengths: the sample's, then those of each accepted proposal.
+            let mut current_space = *space;
             let mut current_deposit = colour * e_d;
             for step in 0..length {
                 if step % 16 == 15 && control.should_stop() {
@@ -232,28 +234,29 @@ impl Redistributor<'_> {
                 };
                 let (x, y) = (&scratch.current, &mut scratch.proposal);
                 let proposal = match pick {
-                    0 => perturbation::lens(space, &mut kernel, false, x, y, rays),
-                    1 => perturbation::caustic(space, &mut kernel, x, y, rays),
-                    _ => perturbation::lens(space, &mut kernel, true, x, y, rays),
+                    0 => perturbation::lens(&current_space, &mut kernel, false, x, y, rays),
+                    1 => perturbation::caustic(&current_space, &mut kernel, x, y, rays),
+                    _ => perturbation::lens(&current_space, &mut kernel, true, x, y, rays),
                 };
                 scratch.counts.proposed[pick + 1] += 1;
                 mutations += 1;
                 let proposal = proposal.and_then(|p| {
                     let colour = unit_colour(p.value)?;
                     let a = acceptance(1.0, 1.0, p.ratio);
-                    (a > 0.0).then_some((a, colour * e_d, p.pixel))
+                    (a > 0.0).then_some((a, colour * e_d, p.pixel, p.channels))
                 });
                 let a = proposal.map_or(0.0, |(a, ..)| a);
-                if let Some((a, deposit, pixel)) = proposal {
+                if let Some((a, deposit, pixel, _)) = proposal {
                     self.deposit(&mut pending, pixel, deposit * a);
                 }
                 if a < 1.0 {
                     self.deposit(&mut pending, current_pixel, current_deposit * (1.0 - a));
                 }
-                if let Some((a, deposit, pixel)) = proposal
+                if let Some((a, deposit, pixel, channels)) = proposal
                     && rng.uniform() < a
                 {
                     std::mem::swap(&mut scratch.current, &mut scratch.proposal);
+                    current_space = space.with_channels(channels);
                     current_pixel = pixel;
                     current_deposit = deposit;
                     accepted += 1;

@@ -194,6 +194,18 @@ const WAVELENGTH_STEP_MIN: f32 = 1e-4;
 /// with density ∝ 1/length.
 const WAVELENGTH_STEP_MAX: f32 = 0.1;
 
+/// `u` (a path's wavelengths' random number) moved by a step of log-uniform length between
+/// `WAVELENGTH_STEP_MIN` and `WAVELENGTH_STEP_MAX` either way, wrapped into [0, 1): a
+/// symmetric move.
+#[inline]
+pub(crate) fn step_wavelength_number(u: f32, rng: &mut Rng) -> f32 {
+    let length = log_uniform(WAVELENGTH_STEP_MIN, WAVELENGTH_STEP_MAX, rng.uniform());
+    let signed = if rng.uniform() < 0.5 { -length } else { length };
+    let wrapped = (u + signed).rem_euclid(1.0);
+    // rem_euclid of a tiny negative number rounds to 1.
+    if wrapped < 1.0 { wrapped } else { 0.0 }
+}
+
 /// The perturbations' kernels: symmetric, of the given sizes; directions turned within a
 /// cone or, `in_sample_space`, stepped in the vertex's sample space (module docs).
 pub(crate) struct RandomKernel<'a> {
@@ -236,15 +248,7 @@ impl Kernel for RandomKernel<'_> {
 
     #[inline]
     fn wavelength_step(&mut self, u: f32) -> f32 {
-        let length = log_uniform(WAVELENGTH_STEP_MIN, WAVELENGTH_STEP_MAX, self.rng.uniform());
-        let signed = if self.rng.uniform() < 0.5 {
-            -length
-        } else {
-            length
-        };
-        let wrapped = (u + signed).rem_euclid(1.0);
-        // rem_euclid of a tiny negative number rounds to 1.
-        if wrapped < 1.0 { wrapped } else { 0.0 }
+        step_wavelength_number(u, self.rng)
     }
 }
 
@@ -267,8 +271,8 @@ fn perturbed_direction(
     (u1 < 1.0).then(|| from_sample_space(new_side, [u1, u2]))
 }
 
-/// The direction onwards from glossy vertex `at` of y (in `space_y`), arrived at from
-/// `from`: through x's microfacet (in `space_x`) at its vertex (`x_at`, between `x_from`
+/// The direction onwards from glossy vertex `at` of y (in `space_y`), arrived at along
+/// `-wo`: through x's microfacet (in `space_x`) at its vertex (`x_at`, between `x_from`
 /// and `x_onwards`), moved by the kernel (turned, or stepped in the coordinates of the normals visible from y's
 /// direction back), keeping its reflection or refraction. `None` if the moved microfacet
 /// does not scatter the path onwards.
@@ -277,14 +281,13 @@ fn glossy_onwards(
     [space_x, space_y]: [&PathSpace; 2],
     kernel: &mut impl Kernel,
     [x_from, x_at, x_onwards]: [&PathVertex; 3],
-    from: &PathVertex,
+    wo: Vec3A,
     at: &PathVertex,
 ) -> Option<Vec3A> {
     let (wo_x, _) = direction(x_at, x_from)?;
     let (wi_x, _) = direction(x_at, x_onwards)?;
     let bsdf_x = space_x.surface_bsdf(x_at);
     let microfacet = bsdf_x.microfacet(wo_x, wi_x)?;
-    let (wo, _) = direction(at, from)?;
     let bsdf = space_y.surface_bsdf(at);
     let moved = if kernel.in_sample_space() {
         // The sampling's coordinates are (azimuth, cap height): step folds the second.
@@ -511,18 +514,20 @@ pub(crate) fn lens(
             return None;
         }
         y[k] = v;
+        // Onwards from the direction the ray arrived along, not from the vertex before:
+        // the ray left that vertex's offset origin, and a direction rebuilt from the
+        // vertices would bend every specular chain slightly (against BDPT's, which goes on
+        // from its rays).
+        let wo = -ray.direction;
         let next = match class {
-            VertexClass::Specular => {
-                let (wo, _) = direction(&y[k], &y[k + 1])?;
-                space
-                    .surface_bsdf(&v)
-                    .specular_direction(wo, lobe_at(x, k)?)?
-            }
+            VertexClass::Specular => space
+                .surface_bsdf(&v)
+                .specular_direction(wo, lobe_at(x, k)?)?,
             VertexClass::Glossy => glossy_onwards(
                 [space_x, space_y],
                 kernel,
                 [&x[k + 1], &x[k], &x[k - 1]],
-                &y[k + 1],
+                wo,
                 &v,
             )?,
             VertexClass::Diffuse => {
@@ -619,16 +624,17 @@ pub(crate) fn caustic(
         if k == n - 2 {
             break;
         }
+        // Onwards from the ray's own direction (see `lens`).
+        let wo = -ray.direction;
         let next = if class == VertexClass::Glossy {
             glossy_onwards(
                 [space_x, space_y],
                 kernel,
                 [&x[k - 1], &x[k], &x[k + 1]],
-                &y[k - 1],
+                wo,
                 &v,
             )?
         } else {
-            let (wo, _) = direction(&y[k], &y[k - 1])?;
             // x's lobe at k, seen from the light side (x_{k-1} → x_k → x_{k+1}).
             let (wo_x, _) = direction(&x[k], &x[k - 1])?;
             let (wi_x, _) = direction(&x[k], &x[k + 1])?;
