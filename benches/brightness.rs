@@ -5,7 +5,8 @@
 //!
 //! `cargo bench --bench brightness` renders, for each scene, algorithm and value of
 //! `normalization_work_fraction`, one render per seed with the default settings (256²,
-//! max depth 5) and a fixed budget, and prints per render the image mean's difference to the
+//! max depth 5; spectral mode for a scene whose materials disperse, as in the equal-time
+//! bench) and a fixed budget, and prints per render the image mean's difference to the
 //! reference (luminance and R/G/B, in percent), the normalization b with its reported
 //! relative standard error, the samples it came from and the largest share one sample
 //! carried, and the RMSE (corrected for the reference's own noise); then per case the RMS
@@ -103,13 +104,16 @@ fn main() {
     );
 
     for name in &scenes {
-        let (scene, camera) = load_scene(name);
-        let reference = reference(name, &scene, &camera, reference_spp, &dir);
+        let bench = load_scene(name);
+        let (scene, camera) = (&bench.scene, &bench.camera);
+        let reference = reference(&bench, reference_spp, &dir);
         let reference_means = channel_means(&reference.image);
         let reference_luminance = luminance(reference_means);
         println!(
-            "\n{name}: reference BDPT {} spp, mean luminance {reference_luminance:.5}, RMSE ≈ {:.5}",
-            reference.spp, reference.rmse
+            "\n{name} ({}): reference BDPT {} spp, mean luminance {reference_luminance:.5}, RMSE ≈ {:.5}",
+            bench.mode(),
+            reference.spp,
+            reference.rmse
         );
         println!(
             "{:<15} {:>6} {:>8} {:>5} {:>8}  {:>22} {:>9} {:>8} {:>10} {:>8} {:>10} {:>8}",
@@ -146,9 +150,6 @@ fn main() {
                                 }
                                 let seed = i + 1;
                                 let mut settings = RenderSettings {
-                                    width: WIDTH,
-                                    height: HEIGHT,
-                                    max_depth: MAX_DEPTH,
                                     algorithm,
                                     threads,
                                     seed,
@@ -157,13 +158,13 @@ fn main() {
                                     mutations_per_pixel: mutations,
                                     normalization_work_fraction: ratio,
                                     bootstrap_samples: bootstrap,
-                                    ..Default::default()
+                                    ..bench.settings()
                                 };
                                 // A small fixed bootstrap caps the chains it seeds.
                                 settings.chains =
                                     settings.chains.min(settings.resolved_bootstrap_samples());
                                 let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
-                                let stats = render(&scene, &camera, &settings, &mut image, None)
+                                let stats = render(scene, camera, &settings, &mut image, None)
                                     .unwrap_or_else(|e| panic!("{algorithm_name}: {e}"));
                                 let means = channel_means(&image);
                                 let raw = rmse(&image, &reference.image);

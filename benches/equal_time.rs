@@ -3,8 +3,17 @@
 //! cornell-box, cornell-glass (caustics through a glass sphere), door-ajar (a room lit
 //! through the crack of a door), lamp-behind-glass (a room lit only through the glass
 //! cover of a recessed lamp), window-room (a room lit only by the sky and the sun
-//! through a small window: an environment map and a sun disc) and cornell-glossy (a rough
-//! metal floor and a rough gold block: glossy interreflection).
+//! through a small window: an environment map and a sun disc), cornell-glossy (a rough
+//! metal floor and a rough gold block: glossy interreflection) and prism (a lamp behind a slit
+//! and a flint prism of Abbe number 20 spreading a spectrum on the floor: a dispersive
+//! caustic, tests/scenes/prism.obj from tools/prism_scene.py).
+//!
+//! Spectral scenes: a scene whose materials disperse (an Abbe number above 0: prism) renders
+//! in spectral mode (`RenderSettings::spectral`), its reference and every compared render
+//! alike (`BenchScene::settings` in benches/common/reference.rs decides both); the others in
+//! RGB. An algorithm that refuses a scene's mode or materials (`MLT_STATUS_UNSUPPORTED`, e.g.
+//! path-space MLT and ERPT while they have no spectral mode) gets one row saying so and is
+//! skipped on that scene.
 //!
 //! `cargo bench --bench equal_time` prints a table (scene, algorithm, threads, time budget,
 //! actual seconds, camera samples and chain mutations per second, the share of mutations
@@ -32,14 +41,15 @@
 //! `tests/bdpt.rs`; it converges much faster on caustics and on light through a crack),
 //! rendered as two halves with different seeds and averaged. Half of the RMSE between the halves estimates the reference's own
 //! RMSE; the corrected RMSE is sqrt(max(0, RMSE² − reference RMSE²)). The halves are cached
-//! as PFM in `target/mlt-bench/` (named by scene, size, depth, spp and algorithm): delete them after a
-//! change to the renderer that changes its converged image.
+//! as PFM in `target/mlt-bench/` (named by scene, size, depth, spp, algorithm and, for a
+//! spectral scene, `spectral`: `reference-prism-256x256-depth5-2048spp-bdpt-spectral-a.pfm`):
+//! delete them after a change to the renderer that changes its converged image.
 //!
 //! Environment:
 //! - `MLT_BENCH_SECONDS`: the longest time budget in seconds (default 10).
 //! - `MLT_BENCH_REFERENCE_SPP`: total samples per pixel of the reference (default 2048).
 //! - `MLT_BENCH_SCENES`: comma-separated scenes of tests/scenes (default
-//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass,window-room,cornell-glossy`).
+//!   `cornell-box,cornell-glass,door-ajar,lamp-behind-glass,window-room,cornell-glossy,prism`).
 //! - `MLT_BENCH_ALGORITHMS`: comma-separated names from `ALGORITHMS` (default all).
 //! - `MLT_BENCH_REPEATS`: renders at the longest budget per thread count (default 1).
 //! - `MLT_BENCH_FONT`: a TrueType font for the plot's text (default: a few usual system
@@ -50,16 +60,15 @@
 mod common;
 
 use common::reference::{
-    DEFAULT_REFERENCE_SPP, HEIGHT, MAX_DEPTH, REFERENCE_ALGORITHM, Reference, WIDTH, channel_means,
-    load_scene, luminance, reference, rmse,
+    BenchScene, DEFAULT_REFERENCE_SPP, HEIGHT, MAX_DEPTH, REFERENCE_ALGORITHM, Reference, WIDTH,
+    channel_means, load_scene, luminance, reference, rmse,
 };
 use common::{
     FONT_FAMILY, draw_legend, env_names, env_value, output_dir, plot_font_or_color_key,
     series_color,
 };
-use mlt::{
-    Algorithm, Camera, RenderSettings, RenderStats, Scene, StopReason, render_with_unfiltered,
-};
+use mlt::error::MLT_STATUS_UNSUPPORTED;
+use mlt::{Algorithm, RenderSettings, RenderStats, StopReason, render_with_unfiltered};
 use plotters::prelude::*;
 use std::error::Error;
 use std::io::Write;
@@ -153,6 +162,7 @@ const DEFAULT_SCENES: &[&str] = &[
     "lamp-behind-glass",
     "window-room",
     "cornell-glossy",
+    "prism",
 ];
 const DEFAULT_MAX_SECONDS: f64 = 10.0;
 /// One time-limited render compared with the reference.
@@ -178,6 +188,7 @@ struct Measurement {
 
 struct SceneResult {
     scene: String,
+    spectral: bool,
     reference_rmse: f64,
     measurements: Vec<Measurement>,
 }
@@ -201,24 +212,21 @@ fn time_budgets(max_seconds: f64) -> Vec<f64> {
     budgets
 }
 
-/// Renders with `algorithm` until `budget_seconds` pass and compares with the reference.
+/// Renders with `algorithm` until `budget_seconds` pass and compares with the reference. Fails
+/// only when the render does (an algorithm that refuses the scene's mode: `Unsupported`).
 #[allow(clippy::too_many_arguments)]
 fn measure(
-    scene: &Scene,
-    camera: &Camera,
+    bench: &BenchScene,
     reference: &Reference,
     compared: Compared,
     threads: u32,
     budget_seconds: f64,
     seed: u64,
     repeat: u32,
-) -> Measurement {
+) -> mlt::Result<Measurement> {
     let name = compared.name;
-    // Everything else stays at the defaults: they are what is being judged.
+    // Everything else stays at the defaults (with the scene's mode): they are what is judged.
     let settings = RenderSettings {
-        width: WIDTH,
-        height: HEIGHT,
-        max_depth: MAX_DEPTH,
         algorithm: compared.algorithm,
         threads,
         seed,
@@ -235,12 +243,18 @@ fn measure(
         } else {
             0
         },
-        ..Default::default()
+        ..bench.settings()
     };
     let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
     let mut unfiltered = image.clone();
-    let stats = render_with_unfiltered(scene, camera, &settings, &mut image, &mut unfiltered, None)
-        .unwrap_or_else(|e| panic!("{name} fails to render: {e}"));
+    let stats = render_with_unfiltered(
+        &bench.scene,
+        &bench.camera,
+        &settings,
+        &mut image,
+        &mut unfiltered,
+        None,
+    )?;
     let corrected = |rmse: f64| {
         (rmse * rmse - reference.rmse * reference.rmse)
             .max(0.0)
@@ -270,7 +284,7 @@ fn measure(
     let rmse = rmse(&image, &reference.image);
     let means = channel_means(&image);
     let reference_means = channel_means(&reference.image);
-    Measurement {
+    Ok(Measurement {
         algorithm: name,
         threads,
         budget_seconds,
@@ -285,7 +299,7 @@ fn measure(
         unfiltered_corrected_rmse,
         filter_shift_percent,
         repeat,
-    }
+    })
 }
 
 /// Mean RGB of each cell of a 4 × 4 partition of a `WIDTH` × `HEIGHT` image, row-major.
@@ -357,6 +371,22 @@ fn print_row(scene: &str, m: &Measurement) {
         m.corrected_rmse,
     );
     // Rows appear as they are measured: a full run takes many minutes.
+    let _ = std::io::stdout().flush();
+}
+
+/// The row of an algorithm that refuses the scene (`Unsupported`): the reason, without the
+/// error's advice after the first semicolon.
+fn print_unsupported(bench: &BenchScene, algorithm: &str, error: &mlt::Error) {
+    let reason = error.message.split(';').next().unwrap_or_default();
+    let mode = if bench.spectral {
+        " in spectral mode"
+    } else {
+        ""
+    };
+    println!(
+        "{:<14} {algorithm:<28} unsupported{mode}, skipped: {reason}",
+        bench.name
+    );
     let _ = std::io::stdout().flush();
 }
 
@@ -495,8 +525,13 @@ fn plot(path: &Path, results: &[SceneResult], with_text: bool) -> Result<(), Box
         let mut builder = ChartBuilder::on(panel);
         builder.margin(16);
         if with_text {
+            let caption = if result.spectral {
+                format!("{} (spectral)", result.scene)
+            } else {
+                result.scene.clone()
+            };
             builder
-                .caption(&result.scene, (FONT_FAMILY, 20))
+                .caption(caption, (FONT_FAMILY, 20))
                 .x_label_area_size(44)
                 .y_label_area_size(64);
         }
@@ -596,12 +631,15 @@ fn main() {
 
     let mut results = Vec::new();
     for name in &scenes {
-        let (scene, camera) = load_scene(name);
-        let reference = reference(name, &scene, &camera, reference_spp, &dir);
+        let bench = load_scene(name);
+        let reference = reference(&bench, reference_spp, &dir);
         let [r, g, b] = channel_means(&reference.image);
         println!(
-            "{name}: reference {} {} spp (two halves), mean RGB {r:.4} {g:.4} {b:.4}, its own RMSE ≈ {:.5}",
-            REFERENCE_ALGORITHM.0, reference.spp, reference.rmse
+            "{name} ({}): reference {} {} spp (two halves), mean RGB {r:.4} {g:.4} {b:.4}, its own RMSE ≈ {:.5}",
+            bench.mode(),
+            REFERENCE_ALGORITHM.0,
+            reference.spp,
+            reference.rmse
         );
         print_header();
         let mut measurements = Vec::new();
@@ -614,18 +652,26 @@ fn main() {
                 .chain(extra)
                 .chain(two_threads);
             for (seed, (threads, budget, repeat)) in runs.enumerate() {
-                let m = measure(
-                    &scene,
-                    &camera,
+                match measure(
+                    &bench,
                     &reference,
                     algorithm,
                     threads,
                     budget,
                     seed as u64,
                     repeat,
-                );
-                print_row(name, &m);
-                measurements.push(m);
+                ) {
+                    Ok(m) => {
+                        print_row(name, &m);
+                        measurements.push(m);
+                    }
+                    // It would refuse every budget alike: one row, then the next algorithm.
+                    Err(e) if e.status == MLT_STATUS_UNSUPPORTED => {
+                        print_unsupported(&bench, algorithm.name, &e);
+                        break;
+                    }
+                    Err(e) => panic!("{} fails to render {name}: {e}", algorithm.name),
+                }
             }
         }
         if repeats > 1 {
@@ -633,6 +679,7 @@ fn main() {
         }
         results.push(SceneResult {
             scene: name.clone(),
+            spectral: bench.spectral,
             reference_rmse: reference.rmse,
             measurements,
         });

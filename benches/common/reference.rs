@@ -1,8 +1,15 @@
 //! The converged images the benches compare with: BDPT on every core, rendered as two halves
 //! with different seeds and cached as PFM in `target/mlt-bench/` (named by scene, size,
-//! depth, spp and algorithm; delete them after a change to the renderer that changes its
-//! converged image). BDPT is checked against the path tracer on the canonical scenes by
-//! `tests/bdpt.rs`, and converges much faster on caustics and on light through a crack.
+//! depth, spp, algorithm and, for a spectral scene, `spectral`; delete them after a change to
+//! the renderer that changes its converged image). BDPT is checked against the path tracer on
+//! the canonical scenes by `tests/bdpt.rs`, and converges much faster on caustics and on light
+//! through a crack.
+//!
+//! A scene renders in spectral mode (`RenderSettings::spectral`) when one of its materials
+//! disperses (an Abbe number above 0, e.g. the flint prism of tests/scenes/prism.obj): RGB
+//! mode ignores dispersion, so it would render another image. `BenchScene::settings` is the
+//! one place that decides the settings every render of a scene shares (size, depth, mode),
+//! for the reference and for the renders compared with it alike.
 
 use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
 use std::path::Path;
@@ -53,9 +60,38 @@ pub fn luminance(rgb: [f64; 3]) -> f64 {
     0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
+/// A scene as the benches render it: the scene, its camera and its transport mode.
+pub struct BenchScene {
+    pub name: String,
+    pub scene: Scene,
+    pub camera: Camera,
+    /// Spectral transport: one of the scene's materials disperses (see the module doc).
+    pub spectral: bool,
+}
+
+impl BenchScene {
+    /// The settings every render of this scene starts from, reference or compared: the bench
+    /// image (`WIDTH` × `HEIGHT`, `MAX_DEPTH`) in the scene's transport mode, everything else
+    /// at the defaults. Callers set the algorithm, seed, threads and budget.
+    pub fn settings(&self) -> RenderSettings {
+        RenderSettings {
+            width: WIDTH,
+            height: HEIGHT,
+            max_depth: MAX_DEPTH,
+            spectral: self.spectral,
+            ..Default::default()
+        }
+    }
+
+    /// The transport mode, for tables and plots: "spectral" or "RGB".
+    pub fn mode(&self) -> &'static str {
+        if self.spectral { "spectral" } else { "RGB" }
+    }
+}
+
 /// A scene of tests/scenes with its camera sidecar, on the BVH backend; the window room
-/// with its sky and sun (tests/common/window_room.rs).
-pub fn load_scene(name: &str) -> (Scene, Camera) {
+/// with its sky and sun (tests/common/window_room.rs). Spectral when a material disperses.
+pub fn load_scene(name: &str) -> BenchScene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/scenes")
         .join(format!("{name}.obj"));
@@ -66,41 +102,50 @@ pub fn load_scene(name: &str) -> (Scene, Camera) {
     if name == "window-room" {
         desc.lights = super::window_room::lights(&sky);
     }
+    let spectral = desc.materials.iter().any(|m| m.abbe_number > 0.0);
     let scene = Scene::new(&desc).expect("scene builds");
     let camera = data.camera.expect("camera sidecar").camera;
-    (scene, camera)
+    BenchScene {
+        name: name.to_string(),
+        scene,
+        camera,
+        spectral,
+    }
 }
 
-/// The two reference halves, read from the cache or rendered (and cached) when missing.
-pub fn reference(name: &str, scene: &Scene, camera: &Camera, spp: u32, dir: &Path) -> Reference {
+/// The two reference halves, read from the cache or rendered (and cached) when missing. The
+/// cache names of RGB scenes carry no mode (the names from before spectral mode, so old caches
+/// still hit); spectral ones end in `-spectral-a.pfm` / `-spectral-b.pfm`.
+pub fn reference(bench: &BenchScene, spp: u32, dir: &Path) -> Reference {
+    let name = &bench.name;
+    let mode = if bench.spectral { "-spectral" } else { "" };
     let half_spp = (spp / 2).max(1);
     let halves: Vec<Vec<f32>> = REFERENCE_SEEDS
         .iter()
         .zip(["a", "b"])
         .map(|(&seed, half)| {
             let path = dir.join(format!(
-                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{}-{half}.pfm",
+                "reference-{name}-{WIDTH}x{HEIGHT}-depth{MAX_DEPTH}-{spp}spp-{}{mode}-{half}.pfm",
                 REFERENCE_ALGORITHM.0
             ));
             if let Ok((WIDTH, HEIGHT, image)) = mlt::io::read_pfm(&path) {
                 return image;
             }
             println!(
-                "rendering reference half {half} of {name}: {}, {half_spp} spp, all threads",
-                REFERENCE_ALGORITHM.0
+                "rendering reference half {half} of {name}: {} ({}), {half_spp} spp, all threads",
+                REFERENCE_ALGORITHM.0,
+                bench.mode()
             );
             let settings = RenderSettings {
-                width: WIDTH,
-                height: HEIGHT,
-                max_depth: MAX_DEPTH,
                 algorithm: REFERENCE_ALGORITHM.1,
                 samples_per_pixel: half_spp,
                 threads: 0,
                 seed,
-                ..Default::default()
+                ..bench.settings()
             };
             let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
-            let stats = render(scene, camera, &settings, &mut image, None).expect("renders");
+            let stats =
+                render(&bench.scene, &bench.camera, &settings, &mut image, None).expect("renders");
             assert_eq!(stats.stop, StopReason::Completed);
             mlt::io::write_pfm(&path, WIDTH, HEIGHT, &image).expect("reference cache writes");
             println!("  {:.1} s, cached in {}", stats.seconds, path.display());
