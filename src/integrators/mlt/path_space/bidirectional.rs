@@ -230,7 +230,8 @@ impl Bidirectional {
         let h_y = split_density_sum(space, y, a, added);
         let h_x = split_density_sum(space_x, x, a, deleted);
         let b_new = a + added as isize + 1;
-        let ratio = (added + 1) as f32 * deletion_probability(a, b_new, n_new) * h_x
+        let kept = space_x.kept_density_ratio(space, x, [(a + 1) as usize, b as usize], true);
+        let ratio = (added + 1) as f32 * deletion_probability(a, b_new, n_new) * h_x * kept
             / ((deleted + 1) as f32 * deletion_probability(a, b, n) * h_y);
         Some(Proposal {
             ratio,

@@ -38,6 +38,31 @@
 //! strategy that would have to hit a delta light (s = 0) has no density: C_0 is `None` there,
 //! as BDPT gives it no weight. The mutations keep x_0's kind where they keep x_0, and where
 //! they sample it they do so with the densities C_s divides by (see each module).
+//!
+//! # Wavelengths
+//!
+//! In a spectral render a chain's state is a path and its wavelengths: the random number u
+//! they are drawn from (`SampledWavelengths::sample`), first the one its bootstrap sample
+//! drew. The target is the luminance of the path's contribution measured at them, which
+//! divides by their density, so it is a density over u (uniform for BDPT's samples), and a
+//! move that draws a new u uniformly, or steps u symmetrically, leaves only the ratio of
+//! the contributions. A path through a dispersive vertex exists at its hero wavelength
+//! alone: it is measured there (`channels_of`, as the path tracer and BDPT keep it), and a
+//! move changes its u only where it samples or retraces every dispersive vertex anew:
+//!
+//! - the bidirectional mutation draws a new u when no vertex it keeps disperses (then the
+//!   kept vertices exist at any wavelength), and samples and measures y at it;
+//! - the perturbations step u by a small amount (`step_wavelength_number`) under the same
+//!   rule, and trace y at it: a path through a prism moves along its spectrum as well as
+//!   across the film; otherwise they keep the path's wavelengths, as a dispersive path must
+//!   be perturbed at its own.
+//!
+//! The rule depends only on the kept vertices, which x and y share, so a move and its
+//! reverse follow it alike. What the kept vertices contribute is measured at each path's
+//! own wavelengths. The densities with which they were sampled, which cancel between C_s(y)
+//! and C_s(x) when the wavelengths stay, may not when they change (a metallic-roughness
+//! surface picks its lobes by their spectral tints): the ratio is multiplied by theirs
+//! (`kept_density_ratio`).
 
 mod bidirectional;
 mod chain;
@@ -118,6 +143,52 @@ impl PathSpace<'_> {
             channels.keep_hero_only();
         }
         channels
+    }
+
+    /// The densities with which BDPT's strategies sample the kept vertices of a move, at
+    /// `y_space`'s wavelengths over at `self`'s (1 where they are the same): the BSDF
+    /// densities at x_1 … x_{prefix − 2} towards the light side's next vertex, and at
+    /// x_{suffix + 1} … x_{n − 2} towards the lens side's next, where x_0 … x_{prefix − 1}
+    /// and x_suffix … x_{n − 1} are kept. C_s divides by them, so a move that changes the
+    /// wavelengths multiplies its ratio of C_s by this (module docs, "Wavelengths"). With
+    /// `lobes_sampled` false a specular lobe's probability is not among them, as in
+    /// `unweighted_contribution`.
+    fn kept_density_ratio(
+        &self,
+        y_space: &PathSpace,
+        path: &[PathVertex],
+        [prefix, suffix]: [usize; 2],
+        lobes_sampled: bool,
+    ) -> f32 {
+        if self.channels == y_space.channels {
+            return 1.0;
+        }
+        let n = path.len();
+        let density = |space: &PathSpace, from: usize, at: usize, to: usize, mode| {
+            let v = &path[at];
+            if v.light.is_some() {
+                return Some(1.0);
+            }
+            let (wo, _) = direction(v, &path[from])?;
+            let (wi, _) = direction(v, &path[to])?;
+            let s = space.surface_bsdf(v).scatter(wo, wi, mode)?;
+            Some(if s.specular && !lobes_sampled {
+                1.0
+            } else {
+                s.pdf
+            })
+        };
+        let ratio = |from: usize, at: usize, to: usize, mode| -> Option<f32> {
+            Some(density(y_space, from, at, to, mode)? / density(self, from, at, to, mode)?)
+        };
+        let light_side = (1..prefix.saturating_sub(1))
+            .map(|j| ratio(j - 1, j, j + 1, TransportMode::Importance));
+        let lens_side = (suffix + 1..n.saturating_sub(1))
+            .map(|j| ratio(j + 1, j, j - 1, TransportMode::Radiance));
+        light_side
+            .chain(lens_side)
+            .map(|r| r.filter(|r| r.is_finite()).unwrap_or(0.0))
+            .product()
     }
 
     /// The BSDF of surface vertex `v`.

@@ -555,7 +555,8 @@ pub(crate) fn lens(
     let in_sample_space = kernel.in_sample_space();
     let density_y = lens_side_factors(space_y, in_sample_space, y, s);
     let density_x = lens_side_factors(space_x, in_sample_space, x, s);
-    proposal([space_x, space_y], x, y, s, density_x, density_y)
+    let kept = space_x.kept_density_ratio(space_y, x, [s, n - 1], false);
+    proposal([space_x, space_y], x, y, s, density_x, density_y * kept)
 }
 
 /// The product of `moved_direction_factor` over the lens-side vertices (after the first s)
@@ -666,7 +667,8 @@ pub(crate) fn caustic(
             * at_start
     };
     let (density_x, density_y) = (factors(space_x, x), factors(space_y, y));
-    proposal([space_x, space_y], x, y, n - 1, density_x, density_y)
+    let kept = space_x.kept_density_ratio(space_y, x, [c + 1, n - 1], false);
+    proposal([space_x, space_y], x, y, n - 1, density_x, density_y * kept)
 }
 
 /// The proposal y of a perturbation of x that kept s light vertices, with the densities of
