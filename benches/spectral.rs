@@ -16,12 +16,14 @@ use common::{env_names, env_value, median};
 use mlt::{Algorithm, RenderSettings, Scene, render};
 use std::path::Path;
 
-const ALGORITHMS: [(&str, Algorithm); 5] = [
+const ALGORITHMS: [(&str, Algorithm); 7] = [
     ("path", Algorithm::Path),
     ("bdpt", Algorithm::Bdpt),
     ("pssmlt", Algorithm::Pssmlt),
     ("mmlt", Algorithm::Mmlt),
     ("pssmlt-bdpt", Algorithm::PssmltBdpt),
+    ("path-space-mlt", Algorithm::PathSpaceMlt),
+    ("erpt", Algorithm::Erpt),
 ];
 
 fn main() {
@@ -33,7 +35,7 @@ fn main() {
         &["cornell-box", "cornell-glass", "prism"],
     );
     println!(
-        "{:<14} {:<12} {:>9} {:>11} {:>7} {:>12} {:>12}",
+        "{:<14} {:<15} {:>9} {:>11} {:>7} {:>12} {:>12}",
         "scene", "algorithm", "RGB s", "spectral s", "ratio", "RGB Mrays", "spec. Mrays"
     );
     for name in &scenes {
@@ -67,7 +69,7 @@ fn main() {
             let (rgb_seconds, rgb_rays) = measure(false);
             let (spectral_seconds, spectral_rays) = measure(true);
             println!(
-                "{name:<14} {label:<12} {rgb_seconds:>9.3} {spectral_seconds:>11.3} {:>7.2} {:>12.2} {:>12.2}",
+                "{name:<14} {label:<15} {rgb_seconds:>9.3} {spectral_seconds:>11.3} {:>7.2} {:>12.2} {:>12.2}",
                 spectral_seconds / rgb_seconds,
                 rgb_rays / 1e6,
                 spectral_rays / 1e6
