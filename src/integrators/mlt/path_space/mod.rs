@@ -1221,17 +1221,30 @@ mod tests {
     fn spectral_contributions_match_bdpt_through_dispersive_glass() {
         let (scene, camera) = dispersive_glass_box();
         let compared = compare_with_bdpt_in("dispersive glass", &scene, &camera, 6, 20_000, true);
-        for (s, t, least) in [
-            (0, 8, 5),
-            (1, 4, 300),
-            (2, 4, 200),
-            (4, 1, 200),
-            (6, 1, 500),
-        ] {
+        assert_through_glass(
+            "dispersive glass",
+            &compared,
+            &[
+                (0, 8, 5),
+                (1, 4, 300),
+                (2, 4, 200),
+                (4, 1, 200),
+                (6, 1, 500),
+            ],
+        );
+    }
+
+    /// Asserts that each strategy (s, t) was compared through glass at least `least` times.
+    fn assert_through_glass(
+        name: &str,
+        compared: &std::collections::BTreeMap<(usize, usize), (u32, u32, u32)>,
+        least: &[(usize, usize, u32)],
+    ) {
+        for &(s, t, least) in least {
             let (_, through_glass, _) = compared.get(&(s, t)).copied().unwrap_or_default();
             assert!(
                 through_glass >= least,
-                "({s}, {t}) through glass {through_glass} times: {compared:?}"
+                "{name}: ({s}, {t}) through glass {through_glass} times"
             );
         }
     }
@@ -1252,20 +1265,18 @@ mod tests {
                 assert!(count > 50, "{name}: ({s}, {t}) compared {count} times");
             }
             if name == "cornell-glass" {
-                for (s, t, least) in [
-                    (0, 8, 5),
-                    (1, 5, 100),
-                    (2, 5, 100),
-                    (3, 4, 100),
-                    (4, 2, 50),
-                    (6, 1, 100),
-                ] {
-                    let (_, through_glass, _) = compared.get(&(s, t)).copied().unwrap_or_default();
-                    assert!(
-                        through_glass >= least,
-                        "{name}: ({s}, {t}) through glass {through_glass} times"
-                    );
-                }
+                assert_through_glass(
+                    name,
+                    &compared,
+                    &[
+                        (0, 8, 5),
+                        (1, 5, 100),
+                        (2, 5, 100),
+                        (3, 4, 100),
+                        (4, 2, 50),
+                        (6, 1, 100),
+                    ],
+                );
             }
         }
     }
