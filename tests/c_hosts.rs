@@ -1,7 +1,7 @@
-//! Compiles the C and C++ examples in c_examples/ against include/mlt.h and the static library
-//! cargo built, runs them on a small image and checks their PFM output against the same
-//! render through the Rust API (rendering is deterministic given the seed, so they must agree
-//! bit for bit).
+//! Compiles the C and C++ examples in c_examples/ against include/mlt.h (and the C++ ones
+//! against include/mlt.hpp, as C++17 and C++20) and the static library cargo built, runs
+//! them on a small image and checks their PFM output against the same render through the
+//! Rust API (rendering is deterministic given the seed, so they must agree bit for bit).
 //!
 //! Finding the library: `cargo test` builds the `mlt` lib target once with all its crate types
 //! (rlib, staticlib, cdylib), so `libmlt.a` sits next to this test's executable in
@@ -321,16 +321,122 @@ fn minimal_c_compiles_as_cpp_and_matches_the_rust_api() {
     run_and_check(&exe, "minimal_cpp");
 }
 
+/// The C++ standards `include/mlt.hpp` supports, each checked with the warnings as errors.
+const CPP_STANDARDS: [&str; 2] = ["c++17", "c++20"];
+
+/// `c_examples/cornell.cpp` uses `include/mlt.hpp` (RAII scene, exceptions, spans, a progress
+/// lambda); as C++17 and C++20 it renders the Rust API's image and answers ray queries.
 #[test]
 fn cornell_cpp_renders_and_answers_ray_queries() {
-    let exe = build("cornell.cpp", "cornell_cpp", true, &["-std=c++17"]);
-    let stdout = run_and_check(&exe, "cornell_cpp");
-    assert!(stdout.contains("ray 0 hits the back wall"), "{stdout}");
-    assert!(stdout.contains("ray 1: miss"), "{stdout}");
-    assert!(
-        stdout.contains("floor point 0 is lit, floor point 1 is in shadow"),
-        "{stdout}"
-    );
+    for std in CPP_STANDARDS {
+        let name = format!("cornell_{}", std.replace('+', "p"));
+        let exe = build("cornell.cpp", &name, true, &[&format!("-std={std}")]);
+        let stdout = run_and_check(&exe, &name);
+        assert!(stdout.contains("scene: 32 triangles, 2 lights"), "{stdout}");
+        assert!(stdout.contains("ray 0 hits the back wall"), "{stdout}");
+        assert!(stdout.contains("ray 1: miss"), "{stdout}");
+        assert!(
+            stdout.contains("floor point 0 is lit, floor point 1 is in shadow"),
+            "{stdout}"
+        );
+    }
+}
+
+/// `c_examples/cpp_checks.cpp` checks what `include/mlt.hpp` adds to the C API: defaults
+/// equal to the library's, errors as `mlt::Error` with the status and message, progress
+/// lambdas that cancel or throw (the render is cancelled and the exception reaches the
+/// caller), spans (and `std::span` in C++20), and the scene handle's ownership.
+#[test]
+fn cpp_header_reports_errors_and_cancels_from_callbacks() {
+    for std in CPP_STANDARDS {
+        let name = format!("cpp_checks_{}", std.replace('+', "p"));
+        let exe = build("cpp_checks.cpp", &name, true, &[&format!("-std={std}")]);
+        let output = Command::new(&exe).output().unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success(),
+            "{name} failed ({}):\n{stdout}\n{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let version = std.trim_start_matches("c++");
+        for line in [
+            "ok: mlt::RenderSettings{} is mlt_render_settings_default",
+            "ok: a bad setting throws mlt::Error: mlt_render: invalid argument: settings.width is 0",
+            "ok: a lambda returning false cancels the render",
+            "ok: a lambda's exception cancels the render and is rethrown after it",
+            "ok: an exception from the final progress call is rethrown",
+            "ok: mlt::Scene moves, releases and adopts its handle; ray queries answer",
+            &format!("all checks passed (C++{version})"),
+        ] {
+            assert!(stdout.contains(line), "{name}: no {line:?} in\n{stdout}");
+        }
+        let spans = if version == "20" {
+            "ok: C++20: render into a std::span, and mlt::Span converts to std::span"
+        } else {
+            "ok: C++17: mlt::Span without std::span"
+        };
+        assert!(stdout.contains(spans), "{name}: no {spans:?} in\n{stdout}");
+    }
+}
+
+/// `include/mlt.hpp` is written by hand, so a field added to one of the C structs it
+/// mirrors must be added to it too: every field of those structs in the generated mlt.h
+/// (but `struct_size`, which the initializers set) is read or written as `c.<field>` in
+/// mlt.hpp's conversions.
+#[test]
+fn cpp_header_mirrors_every_field_of_the_c_structs() {
+    let header = std::fs::read_to_string(crate_dir().join("include").join("mlt.h")).unwrap();
+    let cpp = std::fs::read_to_string(crate_dir().join("include").join("mlt.hpp")).unwrap();
+    let mut checked = 0;
+    for name in [
+        "MltTextureRef",
+        "MltMaterial",
+        "MltTexture",
+        "MltEnvironment",
+        "MltSun",
+        "MltPunctualLight",
+        "MltSceneDesc",
+        "MltCamera",
+        "MltRenderSettings",
+        "MltRenderStats",
+        "MltSceneInfo",
+    ] {
+        let start = header
+            .find(&format!("typedef struct {name} {{"))
+            .unwrap_or_else(|| panic!("mlt.h defines {name}"));
+        let end = start
+            + header[start..]
+                .find(&format!("}} {name};"))
+                .unwrap_or_else(|| panic!("the end of {name}"));
+        let fields: Vec<&str> = header[start..end]
+            .lines()
+            .skip(1)
+            .map(str::trim)
+            .filter(|line| line.ends_with(';') && !line.starts_with('*') && !line.starts_with('/'))
+            .map(|line| {
+                let declaration = line.trim_end_matches(';');
+                let declarator = declaration.split('[').next().unwrap();
+                declarator
+                    .rsplit(|c: char| c.is_whitespace() || c == '*')
+                    .next()
+                    .unwrap()
+            })
+            .filter(|&field| field != "struct_size")
+            .collect();
+        assert!(!fields.is_empty(), "no fields found in {name}");
+        for field in fields {
+            assert!(
+                [" ", ",", ")", ";"]
+                    .iter()
+                    .any(|end| cpp.contains(&format!("c.{field}{end}"))),
+                "include/mlt.hpp does not convert {name}.{field}: add it to the C++ struct and \
+                 its to_c / from_c"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "only {checked} fields found");
 }
 
 #[test]
