@@ -514,8 +514,19 @@ void sceneOwnership() {
     CHECK(!c && released == raw);
     mlt::Scene adopted = mlt::Scene::adopt(released);
     CHECK(adopted.info().triangle_count == 2);
-    static_assert(!std::is_copy_constructible_v<mlt::Scene>, "");
     static_assert(std::is_nothrow_move_constructible_v<mlt::Scene>, "");
+    {
+        // Copies share the scene: it outlives the Scene it was copied from.
+        mlt::Scene copy = adopted;
+        CHECK(copy.get() == adopted.get());
+        mlt::Scene other(ground.desc());
+        other = copy;
+        CHECK(other.get() == adopted.get());
+        mlt::Scene last = std::move(copy);
+        other = mlt::Scene();
+        CHECK(last.info().triangle_count == 2);
+    }
+    CHECK(adopted.info().triangle_count == 2);
 
     const mlt::SceneInfo info = adopted.info();
     CHECK(info.emitter_count == 0 && info.degenerate_triangle_count == 0);
@@ -534,7 +545,7 @@ void sceneOwnership() {
     std::array<std::uint8_t, 3> flags{};
     adopted.occluded(rays, flags);
     CHECK(flags[0] == 1 && flags[1] == 0 && flags[2] == 0);
-    ok("mlt::Scene moves, releases and adopts its handle; ray queries answer");
+    ok("mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer");
 }
 
 } // namespace

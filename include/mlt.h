@@ -377,6 +377,10 @@ typedef enum MltStatus {
 /**
  * An immutable scene: triangles, materials, lights and the acceleration structure. Thread
  * safe: any number of threads may render and query one scene at the same time.
+ * Reference-counted: `mlt_scene_retain` adds a reference, `mlt_scene_release` drops one,
+ * and each running render or query holds one of its own, so releasing a scene while
+ * other threads use it is safe. Calls given a pointer that is not a live scene fail with
+ * `MLT_STATUS_INVALID_ARGUMENT` (it is never dereferenced).
  */
 typedef struct MltScene MltScene;
 
@@ -1272,10 +1276,28 @@ MLT_API enum MltStatus mlt_scene_info_init(struct MltSceneInfo *out, size_t stru
 MLT_API enum MltStatus mlt_scene_create(const struct MltSceneDesc *desc, struct MltScene **out);
 
 /**
- * Releases a scene. NULL is a no-op. The scene must not be in use by another thread.
+ * Adds a reference to a live scene, to be dropped by one more `mlt_scene_release`: a host
+ * that shares a scene between owners (threads, documents) retains it for each.
  *
  * # Safety
- * `scene` must be NULL or a pointer returned by `mlt_scene_create` not yet released.
+ * None beyond passing a pointer: `scene` is looked up among the live scenes, never
+ * dereferenced, so NULL, released or foreign pointers are refused with
+ * `MLT_STATUS_INVALID_ARGUMENT`.
+ */
+MLT_API enum MltStatus mlt_scene_retain(struct MltScene *scene);
+
+/**
+ * Drops a reference to a scene (the one `mlt_scene_create` gave, or one added by
+ * `mlt_scene_retain`). NULL is a no-op. When the last reference is dropped, the handle is
+ * no longer valid; renders and queries still running on the scene in other threads
+ * finish normally, and the scene is freed when the last of them returns. A pointer that is
+ * not a live scene (released already, or not from `mlt_scene_create`) is ignored, and
+ * `mlt_last_error_message` says so. (A freed scene's address may be given to a scene
+ * created later, so a stale pointer may then name that one: a host bug, but never a
+ * use-after-free.)
+ *
+ * # Safety
+ * None beyond passing a pointer: it is looked up, never dereferenced.
  */
 MLT_API void mlt_scene_release(struct MltScene *scene);
 
@@ -1283,7 +1305,8 @@ MLT_API void mlt_scene_release(struct MltScene *scene);
  * Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
  *
  * # Safety
- * `scene` must be a live scene; `out` writable.
+ * `out` must be writable. (`scene` is looked up among the live scenes: any other pointer
+ * is refused.)
  */
 MLT_API enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct MltSceneInfo *out);
 
@@ -1296,6 +1319,10 @@ MLT_API enum MltStatus mlt_scene_get_info(const struct MltScene *scene, struct M
  * `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
  * normalized by the samples it actually received. A cancel or time limit takes effect once
  * every pixel has at least one sample (the first pass is never interrupted). On any other status `rgb_out` is untouched.
+ *
+ * The render holds its own reference to the scene: another thread may release the scene
+ * meanwhile, and it is freed when the render returns. A `scene` that is not live (released,
+ * or not from `mlt_scene_create`) is refused with `MLT_STATUS_INVALID_ARGUMENT`.
  *
  * # Safety
  * Pointers must be valid as described; `rgb_out` must not be accessed by the host until

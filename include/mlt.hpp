@@ -1036,8 +1036,10 @@ inline bool is_hit(const Hit &hit) noexcept { return hit.triangle_id != invalid_
 // Scene: the RAII handle
 // ---------------------------------------------------------------------------------------
 
-/// An immutable scene, owning its MltScene: released by the destructor, movable, not
-/// copyable. Thread safe: any number of threads may render and query one scene at once.
+/// An immutable scene, sharing ownership of its MltScene: a copy holds one more reference
+/// (mlt_scene_retain), and the last Scene destroyed releases it. Thread safe: any number
+/// of threads may render and query one scene at once, and a render keeps the scene alive
+/// even if every Scene is destroyed meanwhile.
 class Scene {
 public:
     /// An empty handle (what a moved-from Scene is). Using it throws.
@@ -1093,7 +1095,8 @@ public:
         detail::check(mlt_scene_create(&desc, &handle_), "mlt_scene_create");
     }
 
-    /// Takes ownership of a scene from mlt_scene_create (or NULL).
+    /// Takes over a reference to a scene (from mlt_scene_create or mlt_scene_retain, or
+    /// NULL).
     static Scene adopt(MltScene *scene) noexcept {
         Scene s;
         s.handle_ = scene;
@@ -1109,14 +1112,21 @@ public:
         }
         return *this;
     }
-    Scene(const Scene &) = delete;
-    Scene &operator=(const Scene &) = delete;
+    Scene(const Scene &other) : handle_(other.handle_) {
+        if (handle_) detail::check(mlt_scene_retain(handle_), "mlt_scene_retain");
+    }
+    Scene &operator=(const Scene &other) {
+        Scene copy(other);
+        std::swap(handle_, copy.handle_);
+        return *this;
+    }
 
     /// Whether this holds a scene.
     explicit operator bool() const noexcept { return handle_ != nullptr; }
     /// The C handle, still owned by this Scene.
     const MltScene *get() const noexcept { return handle_; }
-    /// Gives up ownership: the caller releases the result with mlt_scene_release.
+    /// Gives up this Scene's reference: the caller releases the result with
+    /// mlt_scene_release.
     MltScene *release() noexcept { return std::exchange(handle_, nullptr); }
 
     SceneInfo info() const {

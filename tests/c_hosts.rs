@@ -366,7 +366,7 @@ fn cpp_header_reports_errors_and_cancels_from_callbacks() {
             "ok: a lambda returning false cancels the render",
             "ok: a lambda's exception cancels the render and is rethrown after it",
             "ok: an exception from the final progress call is rethrown",
-            "ok: mlt::Scene moves, releases and adopts its handle; ray queries answer",
+            "ok: mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer",
             &format!("all checks passed (C++{version})"),
         ] {
             assert!(stdout.contains(line), "{name}: no {line:?} in\n{stdout}");

@@ -608,6 +608,185 @@ fn release_null_leaves_the_last_error_and_the_library_as_they_were() {
     drop(HostScene::floor_and_light().create());
 }
 
+/// Pointers that are not live scenes (released, never created, misaligned, NULL) are
+/// refused by every call that takes a scene, never dereferenced; retain adds a reference
+/// that one more release drops.
+#[test]
+fn released_and_foreign_scene_pointers_are_refused() {
+    let floor = HostScene::floor_and_light();
+    let mut out = sentinel_scene();
+    // SAFETY: a valid description and out-parameter.
+    assert_ok(unsafe { mlt_scene_create(&floor.desc(), &mut out) });
+    let released = out;
+    // SAFETY: pointers are looked up, not dereferenced.
+    unsafe {
+        assert_ok(mlt_scene_retain(released));
+        mlt_scene_release(released);
+    }
+    let retained = Handle(released);
+    assert_eq!(
+        retained.info().triangle_count,
+        4,
+        "retained scene still live"
+    );
+    drop(retained);
+
+    let mut word = 0u64;
+    let stack = (&raw mut word).cast::<MltScene>();
+    let odd = stack.cast::<u8>().wrapping_add(1).cast::<MltScene>();
+    let camera = floor_camera();
+    let settings = small_settings(4, 4, 1);
+    let rays = [ray([0.0, 1.0, 0.0], [0.0, -1.0, 0.0])];
+    for (what, scene) in [
+        ("released", released),
+        ("foreign", stack),
+        ("misaligned", odd),
+        ("sentinel", sentinel_scene()),
+    ] {
+        let mut image = vec![SENTINEL_F32; 48];
+        let mut hits = [SENTINEL_HIT];
+        let mut flags = [0xABu8];
+        let mut info = scene_info_default();
+        // SAFETY: every other pointer is valid; `scene` must be refused before use.
+        let statuses = unsafe {
+            [
+                mlt_scene_get_info(scene, &mut info),
+                mlt_render(
+                    scene,
+                    &camera,
+                    &settings,
+                    image.as_mut_ptr(),
+                    image.len(),
+                    None,
+                    null_mut(),
+                ),
+                mlt_intersect(scene, rays.as_ptr(), 1, hits.as_mut_ptr()),
+                mlt_occluded(scene, rays.as_ptr(), 1, flags.as_mut_ptr()),
+                mlt_scene_retain(scene),
+            ]
+        };
+        for status in statuses {
+            assert_invalid(status, &["scene", "not a live scene"]);
+        }
+        assert!(
+            image.iter().all(|&v| v == SENTINEL_F32),
+            "{what}: image written"
+        );
+        assert_eq!(hits[0].triangle_id, SENTINEL_HIT.triangle_id, "{what}");
+        assert_eq!((flags[0], info.triangle_count), (0xAB, 0), "{what}");
+        // SAFETY: looked up, not dereferenced; ignored with a message.
+        unsafe { mlt_scene_release(scene) };
+        assert!(
+            last_error().contains("not a live scene"),
+            "{what}: {}",
+            last_error()
+        );
+    }
+    assert_eq!(word, 0, "a foreign pointer's memory was written");
+    // SAFETY: NULL is refused by retain.
+    assert_invalid(unsafe { mlt_scene_retain(null_mut()) }, &["scene", "NULL"]);
+}
+
+/// A scene released while renders and queries on other threads are running stays alive
+/// until they return: each image equals the same render on a scene nobody releases.
+#[test]
+fn a_scene_released_during_renders_stays_alive_until_they_return() {
+    let floor = HostScene::floor_and_light();
+    let camera = floor_camera();
+    let settings = MltRenderSettings {
+        threads: 1,
+        // Long enough (a few tenths of a second) that the renders are still tracing rays
+        // when the progress callback's first call, after 50 ms, lets the release happen.
+        ..small_settings(16, 16, 2048)
+    };
+    let reference = floor.create().render(&camera, &settings, 16 * 16 * 3);
+    assert_ok(reference.0);
+
+    const RENDERS: usize = 3;
+    let doomed = floor.create();
+    let started = std::sync::Barrier::new(RENDERS + 1);
+    let images = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..RENDERS)
+            .map(|_| {
+                // The address crosses threads as a number: the threads must not borrow the
+                // handle that is dropped under them.
+                let (scene, started, camera, settings) =
+                    (doomed.0 as usize, &started, &camera, &settings);
+                scope.spawn(move || {
+                    let mut image = vec![0.0f32; 16 * 16 * 3];
+                    // The first progress call (while the render's workers trace) waits
+                    // until every render is under way; then the scene is released.
+                    let mut first = Some(started);
+                    let mut released_at = None;
+                    let mut on_progress = |fraction: f32| {
+                        if let Some(barrier) = first.take() {
+                            released_at = Some(fraction);
+                            barrier.wait();
+                        }
+                        true
+                    };
+                    let status = render_with_progress(
+                        scene as *const MltScene,
+                        camera,
+                        settings,
+                        &mut image,
+                        &mut on_progress,
+                    );
+                    (status, image, released_at)
+                })
+            })
+            .collect();
+        started.wait();
+        // Every render is running: drop the only host reference under them.
+        drop(doomed);
+        workers
+            .into_iter()
+            .map(|w| w.join().expect("render thread"))
+            .collect::<Vec<_>>()
+    });
+    for (status, image, released_at) in images {
+        assert_ok(status);
+        let released_at = released_at.expect("the callback was called");
+        assert!(
+            released_at < 0.75,
+            "the release came at {released_at} of a render, not well before its end"
+        );
+        assert!(
+            image == reference.1,
+            "a render lost its scene while running"
+        );
+    }
+}
+
+/// `mlt_render` with a Rust closure as the progress callback.
+fn render_with_progress(
+    scene: *const MltScene,
+    camera: &MltCamera,
+    settings: &MltRenderSettings,
+    image: &mut [f32],
+    on_progress: &mut dyn FnMut(f32) -> bool,
+) -> MltStatus {
+    unsafe extern "C" fn trampoline(fraction: f32, user_data: *mut std::ffi::c_void) -> bool {
+        // SAFETY: `user_data` is the `&mut dyn FnMut` below, alive for the render.
+        let callback = unsafe { &mut *user_data.cast::<&mut dyn FnMut(f32) -> bool>() };
+        callback(fraction)
+    }
+    let mut callback = on_progress;
+    // SAFETY: valid pointers; `image` holds the floats passed; the callback's user data
+    // outlives the call.
+    unsafe {
+        mlt_render(
+            scene,
+            camera,
+            settings,
+            image.as_mut_ptr(),
+            image.len(),
+            Some(trampoline),
+            (&raw mut callback).cast(),
+        )
+    }
+}
+
 #[test]
 fn backend_supported() {
     assert!(mlt_backend_supported(MLT_BACKEND_BVH));

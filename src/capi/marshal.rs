@@ -53,16 +53,6 @@ pub(super) fn check_pointer<T>(pointer: *const T, name: &str) -> Result<()> {
     Ok(())
 }
 
-/// A reference from a host pointer, after checking it is non-null and aligned.
-///
-/// # Safety
-/// If non-null, `pointer` must point to a valid `T` for the returned lifetime.
-pub(super) unsafe fn host_ref<'a, T>(pointer: *const T, name: &str) -> Result<&'a T> {
-    check_pointer(pointer, name)?;
-    // SAFETY: non-null and aligned (checked above); validity is the caller's contract.
-    Ok(unsafe { &*pointer })
-}
-
 /// A slice from a host pointer and element count; NULL is allowed only with a count of 0.
 ///
 /// # Safety

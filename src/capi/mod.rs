@@ -17,6 +17,7 @@
 
 mod convert;
 mod extensible;
+mod handles;
 mod marshal;
 mod types;
 
@@ -34,7 +35,6 @@ use extensible::*;
 use marshal::*;
 use std::borrow::Cow;
 use std::ffi::{c_char, c_void};
-use std::panic::{AssertUnwindSafe, catch_unwind};
 
 /// The library version as MAJOR * 10000 + MINOR * 100 + PATCH.
 #[unsafe(no_mangle)]
@@ -290,10 +290,10 @@ pub unsafe extern "C" fn mlt_scene_create(
             colors,
             textures: &textures,
         })?;
-        let handle = Box::into_raw(Box::new(MltScene {
+        let handle = handles::register(MltScene {
             scene,
             backend: desc.backend,
-        }));
+        });
         // SAFETY: `out` checked non-null and aligned above.
         unsafe { out.write(handle) };
         Ok(MLT_STATUS_OK)
@@ -370,25 +370,42 @@ unsafe fn read_textures<'a>(
         .collect()
 }
 
-/// Releases a scene. NULL is a no-op. The scene must not be in use by another thread.
+/// Adds a reference to a live scene, to be dropped by one more `mlt_scene_release`: a host
+/// that shares a scene between owners (threads, documents) retains it for each.
 ///
 /// # Safety
-/// `scene` must be NULL or a pointer returned by `mlt_scene_create` not yet released.
+/// None beyond passing a pointer: `scene` is looked up among the live scenes, never
+/// dereferenced, so NULL, released or foreign pointers are refused with
+/// `MLT_STATUS_INVALID_ARGUMENT`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_scene_retain(scene: *mut MltScene) -> MltStatus {
+    guard(|| handles::retain(scene).map(|()| MLT_STATUS_OK))
+}
+
+/// Drops a reference to a scene (the one `mlt_scene_create` gave, or one added by
+/// `mlt_scene_retain`). NULL is a no-op. When the last reference is dropped, the handle is
+/// no longer valid; renders and queries still running on the scene in other threads
+/// finish normally, and the scene is freed when the last of them returns. A pointer that is
+/// not a live scene (released already, or not from `mlt_scene_create`) is ignored, and
+/// `mlt_last_error_message` says so. (A freed scene's address may be given to a scene
+/// created later, so a stale pointer may then name that one: a host bug, but never a
+/// use-after-free.)
+///
+/// # Safety
+/// None beyond passing a pointer: it is looked up, never dereferenced.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mlt_scene_release(scene: *mut MltScene) {
     if scene.is_null() {
         return;
     }
-    let _ = catch_unwind(AssertUnwindSafe(|| {
-        // SAFETY: created by Box::into_raw in mlt_scene_create, released once (contract).
-        drop(unsafe { Box::from_raw(scene) });
-    }));
+    let _ = guard(|| handles::release(scene).map(|()| MLT_STATUS_OK));
 }
 
 /// Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
 ///
 /// # Safety
-/// `scene` must be a live scene; `out` writable.
+/// `out` must be writable. (`scene` is looked up among the live scenes: any other pointer
+/// is refused.)
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn mlt_scene_get_info(
     scene: *const MltScene,
@@ -396,7 +413,7 @@ pub unsafe extern "C" fn mlt_scene_get_info(
 ) -> MltStatus {
     guard(|| {
         // SAFETY: forwarded contract.
-        let handle = unsafe { host_ref(scene, "scene") }?;
+        let handle = handles::acquire(scene, "scene")?;
         let fields = unsafe { host_fields(out, "out") }?;
         let info = handle.scene.info();
         let value = MltSceneInfo {
@@ -422,6 +439,10 @@ pub unsafe extern "C" fn mlt_scene_get_info(
 /// `MLT_STATUS_TIME_LIMIT_REACHED` also leave a valid image in `rgb_out`, each pixel
 /// normalized by the samples it actually received. A cancel or time limit takes effect once
 /// every pixel has at least one sample (the first pass is never interrupted). On any other status `rgb_out` is untouched.
+///
+/// The render holds its own reference to the scene: another thread may release the scene
+/// meanwhile, and it is freed when the render returns. A `scene` that is not live (released,
+/// or not from `mlt_scene_create`) is refused with `MLT_STATUS_INVALID_ARGUMENT`.
 ///
 /// # Safety
 /// Pointers must be valid as described; `rgb_out` must not be accessed by the host until
@@ -469,7 +490,7 @@ pub unsafe extern "C" fn mlt_render_ex(
 ) -> MltStatus {
     guard(|| {
         // SAFETY: forwarded contract for every pointer below.
-        let handle = unsafe { host_ref(scene, "scene") }?;
+        let handle = handles::acquire(scene, "scene")?;
         let camera: Camera = (&unsafe { read_host(camera, "camera") }?).into();
         let settings = render_settings(&unsafe { read_host(settings, "settings") }?)?;
         let stats_fields = if stats_out.is_null() {
@@ -551,7 +572,7 @@ pub unsafe extern "C" fn mlt_intersect(
 ) -> MltStatus {
     guard(|| {
         // SAFETY: forwarded contract.
-        let handle = unsafe { host_ref(scene, "scene") }?;
+        let handle = handles::acquire(scene, "scene")?;
         let rays = unsafe { host_slice(rays, count, "rays") }?;
         if count == 0 {
             return Ok(MLT_STATUS_OK);
@@ -593,7 +614,7 @@ pub unsafe extern "C" fn mlt_occluded(
 ) -> MltStatus {
     guard(|| {
         // SAFETY: forwarded contract.
-        let handle = unsafe { host_ref(scene, "scene") }?;
+        let handle = handles::acquire(scene, "scene")?;
         let rays = unsafe { host_slice(rays, count, "rays") }?;
         if count == 0 {
             return Ok(MLT_STATUS_OK);

@@ -622,6 +622,10 @@ pub struct MltHit {
 
 /// An immutable scene: triangles, materials, lights and the acceleration structure. Thread
 /// safe: any number of threads may render and query one scene at the same time.
+/// Reference-counted: `mlt_scene_retain` adds a reference, `mlt_scene_release` drops one,
+/// and each running render or query holds one of its own, so releasing a scene while
+/// other threads use it is safe. Calls given a pointer that is not a live scene fail with
+/// `MLT_STATUS_INVALID_ARGUMENT` (it is never dereferenced).
 pub struct MltScene {
     pub(super) scene: Scene,
     pub(super) backend: i32,
