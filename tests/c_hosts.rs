@@ -552,3 +552,184 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
         }
     }
 }
+
+/// A host program of c_examples/ and how a memory check runs it.
+struct HostRun {
+    source: &'static str,
+    /// The language standard (C unless it starts with "c++").
+    std: &'static str,
+    args: &'static [&'static str],
+}
+
+impl HostRun {
+    fn build(&self, tag: &str, flags: &[&str]) -> PathBuf {
+        let as_cpp = self.std.starts_with("c++");
+        let name = format!("{}_{tag}", self.source.replace('.', "_"));
+        let std = format!("-std={}", self.std);
+        let mut all = vec![std.as_str()];
+        all.extend_from_slice(flags);
+        build(self.source, &name, as_cpp, &all)
+    }
+
+    fn args(&self) -> Vec<String> {
+        let dir = scratch_dir();
+        self.args
+            .iter()
+            .map(|a| match a.strip_prefix("OUT:") {
+                Some(file) => dir.join(file).to_string_lossy().into_owned(),
+                None => a.to_string(),
+            })
+            .collect()
+    }
+}
+
+/// The stress program (c_examples/stress.c): many random scenes with cancels and time
+/// limits, renders and queries from several host threads, a scene released under running
+/// renders, and every kind of bad input.
+const STRESS: HostRun = HostRun {
+    source: "stress.c",
+    std: "c11",
+    args: &["1", "24"],
+};
+
+#[test]
+fn stress_program_passes_its_checks() {
+    let exe = STRESS.build("plain", &["-O2"]);
+    for seed in ["2", "3"] {
+        let output = Command::new(&exe).args([seed, "24"]).output().unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success() && stdout.contains("all checks passed"),
+            "stress {seed} failed ({}):\n{stdout}\n{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}
+
+/// Every C and C++ host, built with AddressSanitizer and UndefinedBehaviorSanitizer (leak
+/// checking included), runs clean. The sanitizers instrument the hosts' code and watch
+/// every allocation and free, mlt's included (mlt's Rust code is not instrumented: valgrind
+/// below checks its memory accesses). minimal.c and cornell.cpp must still give the Rust
+/// API's image bit for bit.
+#[test]
+fn hosts_are_clean_under_address_and_undefined_behaviour_sanitizers() {
+    let flags = [
+        "-g",
+        "-O1",
+        "-fsanitize=address,undefined",
+        "-fno-sanitize-recover=all",
+        "-fno-omit-frame-pointer",
+    ];
+    for (source, std) in [("minimal.c", "c99"), ("cornell.cpp", "c++17")] {
+        let host = HostRun {
+            source,
+            std,
+            args: &[],
+        };
+        let exe = host.build("asan", &flags);
+        run_and_check(&exe, &format!("{source}_asan"));
+    }
+    let hosts = [
+        HostRun {
+            source: "sky.c",
+            std: "c99",
+            args: &["OUT:sky_asan.pfm", "16", "16", "4"],
+        },
+        HostRun {
+            source: "textured.c",
+            std: "c99",
+            args: &["OUT:textured_asan.pfm", "16", "16", "4"],
+        },
+        HostRun {
+            source: "cpp_checks.cpp",
+            std: "c++17",
+            args: &[],
+        },
+        HostRun {
+            source: "cpp_checks.cpp",
+            std: "c++20",
+            args: &[],
+        },
+        STRESS,
+    ];
+    for host in hosts {
+        let exe = host.build(&format!("asan_{}", host.std.replace('+', "p")), &flags);
+        let output = Command::new(&exe)
+            .args(host.args())
+            .env("ASAN_OPTIONS", "detect_leaks=1:halt_on_error=1")
+            .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            output.status.success()
+                && !stderr.contains("Sanitizer")
+                && !stderr.contains("runtime error"),
+            "{} under the sanitizers ({}):\n{}\n{stderr}",
+            host.source,
+            output.status,
+            String::from_utf8_lossy(&output.stdout),
+        );
+    }
+}
+
+/// The C and C++ hosts under valgrind's memcheck, which sees every memory access, mlt's
+/// Rust code included: no invalid read or write, no use of uninitialized memory, and no
+/// definite, indirect or possible leak (c_examples/valgrind.supp names the few "possible"
+/// blocks the C and Rust runtimes keep on purpose, none of mlt's). Sizes and budgets are
+/// small: valgrind runs programs about 50 times slower. (minimal.c and cornell.cpp use the
+/// default 2^18 bootstrap samples; the stress program covers what they call.)
+#[test]
+fn hosts_are_clean_under_valgrind_memcheck() {
+    let version = Command::new("valgrind").arg("--version").output();
+    assert!(
+        version.is_ok_and(|v| v.status.success()),
+        "valgrind is needed for this test: apt-get install valgrind"
+    );
+    let suppressions = crate_dir().join("c_examples").join("valgrind.supp");
+    let hosts = [
+        HostRun {
+            source: "sky.c",
+            std: "c99",
+            args: &["OUT:sky_memcheck.pfm", "16", "16", "2"],
+        },
+        HostRun {
+            source: "textured.c",
+            std: "c99",
+            args: &["OUT:textured_memcheck.pfm", "16", "16", "2"],
+        },
+        HostRun {
+            source: "cpp_checks.cpp",
+            std: "c++17",
+            args: &[],
+        },
+        HostRun {
+            args: &["4", "12"],
+            ..STRESS
+        },
+    ];
+    for host in hosts {
+        let exe = host.build("memcheck", &["-g", "-O1"]);
+        let output = Command::new("valgrind")
+            .args([
+                "--tool=memcheck",
+                "--leak-check=full",
+                "--show-leak-kinds=definite,indirect,possible",
+                "--errors-for-leak-kinds=definite,indirect,possible",
+                "--error-exitcode=99",
+            ])
+            .arg(format!("--suppressions={}", suppressions.display()))
+            .arg(&exe)
+            .args(host.args())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            output.status.success() && stderr.contains("ERROR SUMMARY: 0 errors"),
+            "{} under memcheck ({}):\n{stderr}",
+            host.source,
+            output.status,
+        );
+    }
+}

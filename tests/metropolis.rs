@@ -555,3 +555,35 @@ fn bidirectional_mutations_agree_with_the_path_tracer_under_spot_and_directional
         BIDIRECTIONAL_ONLY,
     );
 }
+
+/// At max_depth 1 the direct pass owns every depth: multiplexed MLT has no depth left for
+/// chains (it once divided by its zero depth groups), and the algorithms with a direct pass
+/// all give the direct pass's image, bit for bit.
+#[test]
+fn direct_pass_alone_when_it_owns_every_depth() {
+    let (scene, camera) = load_canonical("cornell-box");
+    let image = |algorithm| {
+        let settings = RenderSettings {
+            max_depth: 1,
+            ..metropolis_settings(
+                Variant {
+                    algorithm,
+                    direct_samples_per_mutation: 1,
+                    adapted_in_sample_space: false,
+                },
+                16,
+                4,
+                7,
+            )
+        };
+        render_image(&scene, &camera, &settings)
+    };
+    let multiplexed = image(Algorithm::Mmlt);
+    assert!(
+        multiplexed.iter().any(|&v| v > 0.0),
+        "the direct pass lit nothing"
+    );
+    for algorithm in [Algorithm::Pssmlt, Algorithm::PssmltBdpt] {
+        assert!(image(algorithm) == multiplexed, "{algorithm:?}");
+    }
+}

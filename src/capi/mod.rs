@@ -273,23 +273,28 @@ pub unsafe extern "C" fn mlt_scene_create(
         let tangents = unsafe { host_slice(desc.tangents, desc.tangents_len, "desc.tangents") }?;
         let colors = unsafe { host_slice(desc.colors, desc.colors_len, "desc.colors") }?;
         let textures = unsafe { read_textures(desc.textures, desc.textures_len) }?;
-        let scene = Scene::new(&SceneDesc {
-            positions,
-            indices,
-            material_ids,
-            materials: &materials,
-            lights: LightsDesc {
-                environment,
-                sun,
-                punctual: &punctual,
-            },
-            backend: backend(desc.backend)?,
-            normals,
-            texcoords,
-            tangents,
-            colors,
-            textures: &textures,
-        })?;
+        // The BVH build is parallel: on the pool renders use, rather than start rayon's
+        // global pool as a second set of threads for the process.
+        let build = || {
+            Scene::new(&SceneDesc {
+                positions,
+                indices,
+                material_ids,
+                materials: &materials,
+                lights: LightsDesc {
+                    environment,
+                    sun,
+                    punctual: &punctual,
+                },
+                backend: backend(desc.backend)?,
+                normals,
+                texcoords,
+                tangents,
+                colors,
+                textures: &textures,
+            })
+        };
+        let scene = render::shared_pool()?.install(build)?;
         let handle = handles::register(MltScene {
             scene,
             backend: desc.backend,

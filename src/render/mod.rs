@@ -211,8 +211,8 @@ fn render_into(
     let pool = if settings.threads == 0 {
         shared_pool()?
     } else {
-        own_pool = new_pool(settings.threads as usize)?;
-        &own_pool
+        own_pool = JoinedPool::new(settings.threads as usize)?;
+        own_pool.pool()
     };
     let threads = pool.current_num_threads() as u32;
 
@@ -433,22 +433,78 @@ fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
 
 /// A pool of `threads` worker threads (0: one per core).
 fn new_pool(threads: usize) -> Result<rayon::ThreadPool> {
+    pool_builder(threads).build().map_err(could_not_start)
+}
+
+fn pool_builder(threads: usize) -> rayon::ThreadPoolBuilder {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .thread_name(|i| format!("mlt-worker-{i}"))
-        .build()
-        .map_err(|e| {
-            Error::new(
-                MLT_STATUS_OUT_OF_MEMORY,
-                format!("could not start worker threads: {e}"),
-            )
+}
+
+fn could_not_start(error: impl std::fmt::Display) -> Error {
+    Error::new(
+        MLT_STATUS_OUT_OF_MEMORY,
+        format!("could not start worker threads: {error}"),
+    )
+}
+
+/// A render's own pool, whose threads are joined when it is dropped. A dropped rayon pool
+/// only tells its threads to exit; these are waited for, so no thread of a render outlives
+/// the call (a host may unload the library right after it).
+struct JoinedPool {
+    /// Always `Some` until dropped: taken out so it is dropped before the joins.
+    pool: Option<rayon::ThreadPool>,
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl JoinedPool {
+    fn new(threads: usize) -> Result<JoinedPool> {
+        let handles = Mutex::new(Vec::with_capacity(threads));
+        let pool = pool_builder(threads)
+            .spawn_handler(|thread| {
+                let mut builder = std::thread::Builder::new();
+                if let Some(name) = thread.name() {
+                    builder = builder.name(name.to_owned());
+                }
+                if let Some(size) = thread.stack_size() {
+                    builder = builder.stack_size(size);
+                }
+                let handle = builder.spawn(|| thread.run())?;
+                handles
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .push(handle);
+                Ok(())
+            })
+            .build()
+            .map_err(could_not_start)?;
+        let threads = handles.into_inner().unwrap_or_else(|e| e.into_inner());
+        Ok(JoinedPool {
+            pool: Some(pool),
+            threads,
         })
+    }
+
+    fn pool(&self) -> &rayon::ThreadPool {
+        self.pool.as_ref().expect("present until dropped")
+    }
+}
+
+impl Drop for JoinedPool {
+    fn drop(&mut self) {
+        drop(self.pool.take()); // tells its threads to exit once idle
+        for thread in self.threads.drain(..) {
+            let _ = thread.join();
+        }
+    }
 }
 
 /// The pool every render with `threads` 0 runs on: one thread per core for the whole
 /// process, started by the first such render, so that a host rendering from several
-/// threads at once shares the cores instead of starting a pool per render.
-fn shared_pool() -> Result<&'static rayon::ThreadPool> {
+/// threads at once shares the cores instead of starting a pool per render. The C ABI
+/// builds scenes on it too, so a host process has one pool, not this and rayon's global.
+pub(crate) fn shared_pool() -> Result<&'static rayon::ThreadPool> {
     static SHARED: std::sync::OnceLock<std::result::Result<rayon::ThreadPool, String>> =
         std::sync::OnceLock::new();
     SHARED

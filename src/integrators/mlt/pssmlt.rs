@@ -8,7 +8,9 @@ use super::driver::{
     Bootstrap, ChainPlan, Deposits, MarkovChain, MetropolisOutcome, WeightedChain, bootstrap,
     deposit, finish_without_light, normalize, resample_seeds, restart_as_bootstrap, run_rounds,
 };
-use super::normalization::{Moments, NormalizationPass, PassImage, PointWeight};
+use super::normalization::{
+    Moments, NormalizationEstimate, NormalizationPass, PassImage, PointWeight,
+};
 use super::primary_space::{MetropolisSettings, PathSample, PrimarySpaceTarget, new_sampler};
 use super::pss::PssSampler;
 use crate::control::Control;
@@ -206,6 +208,12 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
 where
     T::Scratch: Send,
 {
+    // A target without groups (multiplexed MLT whose depths are all the direct pass's, as
+    // with max_depth 1) has no paths for chains: the image is the other passes' alone.
+    if target.groups() == 0 {
+        let nothing = NormalizationEstimate::new(0);
+        return finish_without_light(camera, settings, &nothing, film, control, after_round);
+    }
     // 1. Bootstrap.
     let n = settings.bootstrap_samples as u64;
     let boot = bootstrap(target, camera, settings, control);
