@@ -571,13 +571,14 @@ impl HostRun {
         build(self.source, &name, as_cpp, &all)
     }
 
-    fn args(&self) -> Vec<String> {
-        let dir = scratch_dir();
+    /// The arguments, "OUT" replaced by an output file of its own for `tag`.
+    fn args(&self, tag: &str) -> Vec<String> {
+        let out = scratch_dir().join(format!("{}_{tag}.pfm", self.source));
         self.args
             .iter()
-            .map(|a| match a.strip_prefix("OUT:") {
-                Some(file) => dir.join(file).to_string_lossy().into_owned(),
-                None => a.to_string(),
+            .map(|&a| match a {
+                "OUT" => out.to_string_lossy().into_owned(),
+                _ => a.to_string(),
             })
             .collect()
     }
@@ -591,6 +592,31 @@ const STRESS: HostRun = HostRun {
     std: "c11",
     args: &["1", "24"],
 };
+
+/// What runs under both the sanitizers and memcheck, sized for memcheck (about 50 times
+/// slower). minimal.c and cornell.cpp use the default 2^18 bootstrap samples, too many for
+/// memcheck; the stress program covers what they call.
+const CHECKED_HOSTS: [HostRun; 4] = [
+    HostRun {
+        source: "sky.c",
+        std: "c99",
+        args: &["OUT", "16", "16", "2"],
+    },
+    HostRun {
+        source: "textured.c",
+        std: "c99",
+        args: &["OUT", "16", "16", "2"],
+    },
+    HostRun {
+        source: "cpp_checks.cpp",
+        std: "c++17",
+        args: &[],
+    },
+    HostRun {
+        args: &["4", "12"],
+        ..STRESS
+    },
+];
 
 #[test]
 fn stress_program_passes_its_checks() {
@@ -630,33 +656,15 @@ fn hosts_are_clean_under_address_and_undefined_behaviour_sanitizers() {
         let exe = host.build("asan", &flags);
         run_and_check(&exe, &format!("{source}_asan"));
     }
-    let hosts = [
-        HostRun {
-            source: "sky.c",
-            std: "c99",
-            args: &["OUT:sky_asan.pfm", "16", "16", "4"],
-        },
-        HostRun {
-            source: "textured.c",
-            std: "c99",
-            args: &["OUT:textured_asan.pfm", "16", "16", "4"],
-        },
-        HostRun {
-            source: "cpp_checks.cpp",
-            std: "c++17",
-            args: &[],
-        },
-        HostRun {
-            source: "cpp_checks.cpp",
-            std: "c++20",
-            args: &[],
-        },
-        STRESS,
-    ];
-    for host in hosts {
-        let exe = host.build(&format!("asan_{}", host.std.replace('+', "p")), &flags);
+    let cpp20 = HostRun {
+        std: "c++20",
+        ..CHECKED_HOSTS[2]
+    };
+    for host in CHECKED_HOSTS.into_iter().chain([cpp20, STRESS]) {
+        let tag = format!("asan_{}", host.std.replace('+', "p"));
+        let exe = host.build(&tag, &flags);
         let output = Command::new(&exe)
-            .args(host.args())
+            .args(host.args(&tag))
             .env("ASAN_OPTIONS", "detect_leaks=1:halt_on_error=1")
             .env("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1")
             .output()
@@ -677,9 +685,7 @@ fn hosts_are_clean_under_address_and_undefined_behaviour_sanitizers() {
 /// The C and C++ hosts under valgrind's memcheck, which sees every memory access, mlt's
 /// Rust code included: no invalid read or write, no use of uninitialized memory, and no
 /// definite, indirect or possible leak (c_examples/valgrind.supp names the few "possible"
-/// blocks the C and Rust runtimes keep on purpose, none of mlt's). Sizes and budgets are
-/// small: valgrind runs programs about 50 times slower. (minimal.c and cornell.cpp use the
-/// default 2^18 bootstrap samples; the stress program covers what they call.)
+/// blocks the C and Rust runtimes keep on purpose, none of mlt's).
 #[test]
 fn hosts_are_clean_under_valgrind_memcheck() {
     let version = Command::new("valgrind").arg("--version").output();
@@ -688,28 +694,7 @@ fn hosts_are_clean_under_valgrind_memcheck() {
         "valgrind is needed for this test: apt-get install valgrind"
     );
     let suppressions = crate_dir().join("c_examples").join("valgrind.supp");
-    let hosts = [
-        HostRun {
-            source: "sky.c",
-            std: "c99",
-            args: &["OUT:sky_memcheck.pfm", "16", "16", "2"],
-        },
-        HostRun {
-            source: "textured.c",
-            std: "c99",
-            args: &["OUT:textured_memcheck.pfm", "16", "16", "2"],
-        },
-        HostRun {
-            source: "cpp_checks.cpp",
-            std: "c++17",
-            args: &[],
-        },
-        HostRun {
-            args: &["4", "12"],
-            ..STRESS
-        },
-    ];
-    for host in hosts {
+    for host in CHECKED_HOSTS {
         let exe = host.build("memcheck", &["-g", "-O1"]);
         let output = Command::new("valgrind")
             .args([
@@ -721,7 +706,7 @@ fn hosts_are_clean_under_valgrind_memcheck() {
             ])
             .arg(format!("--suppressions={}", suppressions.display()))
             .arg(&exe)
-            .args(host.args())
+            .args(host.args("memcheck"))
             .output()
             .unwrap();
         let stderr = String::from_utf8_lossy(&output.stderr);
