@@ -3,6 +3,11 @@
 //! without the `embree` feature: the C ABI has no feature-dependent items.
 //!
 //! With the `embree` feature, links the system's Embree 3 (`libembree3`).
+//!
+//! On Linux the shared library gets the soname `libmlt.so.<major>`, so hosts record that name
+//! and a later compatible library (the C ABI only grows, checked by `struct_size`) replaces it
+//! in place. `cmake --install` (CMakeLists.txt) installs it as `libmlt.so.<version>` with the
+//! `libmlt.so.<major>` and `libmlt.so` links.
 
 use std::path::PathBuf;
 
@@ -13,6 +18,10 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     if std::env::var_os("CARGO_FEATURE_EMBREE").is_some() {
         println!("cargo:rustc-link-lib=embree3");
+    }
+    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("linux") {
+        let major = std::env::var("CARGO_PKG_VERSION_MAJOR").unwrap();
+        println!("cargo:rustc-cdylib-link-arg=-Wl,-soname,libmlt.so.{major}");
     }
 
     let config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml"))
