@@ -8,9 +8,15 @@
 //! `target/<profile>/deps/`, from the very compilation that is linked into this test. After a
 //! plain `cargo build` it is in `target/<profile>/`. If neither exists (an unusual runner), the
 //! test runs `cargo build --lib` and takes the path cargo reports.
+//!
+//! The module `install` (c_hosts/install.rs) installs the same library with CMake and builds
+//! hosts against the installed prefix through pkg-config and `find_package`.
 
 mod common;
+#[path = "c_hosts/install.rs"]
+mod install;
 
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -104,26 +110,41 @@ fn build_with_header(
     as_cpp: bool,
     extra: &[&str],
 ) -> PathBuf {
+    let mut flags: Vec<OsString> = vec!["-I".into(), include_dir.into()];
+    flags.extend(extra.iter().map(OsString::from));
+    let mut libs: Vec<OsString> = vec![static_lib().into()];
+    if cfg!(feature = "embree") {
+        // The static library's own native dependency in this build.
+        libs.push("-lembree3".into());
+    }
+    libs.extend(["-lpthread", "-ldl", "-lm"].map(OsString::from));
+    if cfg!(target_os = "macos") {
+        libs.extend(["-framework", "Security", "-framework", "CoreFoundation"].map(OsString::from));
+    }
+    compile(source, exe_name, as_cpp, &flags, &libs)
+}
+
+/// Compiles `c_examples/<source>` (C unless `as_cpp`) with the warnings as errors and
+/// `flags`, links it with `libs` and returns the executable.
+fn compile(
+    source: &str,
+    exe_name: &str,
+    as_cpp: bool,
+    flags: &[OsString],
+    libs: &[OsString],
+) -> PathBuf {
     let out = scratch_dir().join(exe_name);
     let _ = std::fs::remove_file(&out);
     let mut cmd = common::compiler(as_cpp);
     cmd.args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
-        .arg("-I")
-        .arg(include_dir)
-        .args(extra)
+        .args(flags)
         .arg(crate_dir().join("c_examples").join(source))
         // Whatever follows is a library, not source in the language given by `-x`.
         .arg("-x")
         .arg("none")
-        .arg(static_lib());
-    if cfg!(feature = "embree") {
-        // The static library's own native dependency in this build.
-        cmd.arg("-lembree3");
-    }
-    cmd.args(["-lpthread", "-ldl", "-lm"]).arg("-o").arg(&out);
-    if cfg!(target_os = "macos") {
-        cmd.args(["-framework", "Security", "-framework", "CoreFoundation"]);
-    }
+        .args(libs)
+        .arg("-o")
+        .arg(&out);
     let output = cmd
         .output()
         .unwrap_or_else(|e| panic!("could not run the compiler {cmd:?}: {e}"));
