@@ -386,6 +386,31 @@ mod tests {
         }
     }
 
+    /// Rays from origins so far out that origin / direction overflows on every axis make
+    /// every slab of the box test NaN, which enters the empty slots of partly filled nodes
+    /// too (found by the ray_queries fuzzer: the traversal then indexed past the leaf
+    /// blocks). The traversal skips them: such rays get an answer, the same from both
+    /// queries, at every width.
+    #[test]
+    fn rays_from_far_origins_skip_empty_slots() {
+        let tris: Vec<[Vec3A; 3]> = (0..40)
+            .map(|i| {
+                let c = Vec3A::new(i as f32, (i % 3) as f32, (i % 7) as f32);
+                [c, c + Vec3A::X, c + Vec3A::Y]
+            })
+            .collect();
+        for width in widths() {
+            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            for origin in [Vec3A::splat(3e38), Vec3A::new(-3e38, 3e38, -3e38)] {
+                for direction in [Vec3A::ONE, -Vec3A::ONE, Vec3A::new(1.0, -1.0, 1.0)] {
+                    let ray = Ray::new(origin, direction.normalize(), 0.0, f32::INFINITY);
+                    let hit = accel.intersect(&ray);
+                    assert_eq!(accel.occluded(&ray), hit.is_some(), "{width:?} {ray:?}");
+                }
+            }
+        }
+    }
+
     /// Rays along the axes (zero direction components) from origins on box planes, at every
     /// width; and rays with no direction at all, which hit nothing.
     #[test]
