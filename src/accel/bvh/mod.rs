@@ -411,6 +411,40 @@ mod tests {
         }
     }
 
+    /// A ray with a direction component so small that origin / direction overflows on its
+    /// axis still enters the boxes it crosses (found by the ray_queries fuzzer: the 8-wide
+    /// box test's fused form made their far bound -inf and missed the triangle), at every
+    /// width, here among partly filled nodes of 40 small triangles.
+    #[test]
+    fn rays_with_tiny_direction_components_find_their_hit() {
+        let mut tris: Vec<[Vec3A; 3]> = (0..40)
+            .map(|i| {
+                let c = Vec3A::new(i as f32, -5.0, (i % 7) as f32);
+                [c, c + Vec3A::X, c + Vec3A::Y]
+            })
+            .collect();
+        tris.push([
+            Vec3A::new(-1e9, 1e8, 1e9),
+            Vec3A::new(1e9, 1e8, 1e9),
+            Vec3A::new(0.0, 1e8, -1e9),
+        ]);
+        let origin = Vec3A::new(3.0, -1.0, 0.0);
+        for tiny in [f32::MIN_POSITIVE, -f32::MIN_POSITIVE, 1e-37] {
+            let direction = Vec3A::new(tiny, 3.0, 1.0).normalize();
+            let expected = (1e8 + 1.0) / direction.y;
+            for width in widths() {
+                let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+                let ray = Ray::new(origin, direction, 0.0, f32::INFINITY);
+                let hit = accel.intersect(&ray);
+                let what = format!("{width:?}, direction {direction}: {hit:?}");
+                let hit = hit.expect(&what);
+                assert_eq!(accel.build_order[hit.triangle as usize], 40, "{what}");
+                assert!((hit.t / expected - 1.0).abs() < 1e-3, "{what}");
+                assert!(accel.occluded(&ray), "{what}");
+            }
+        }
+    }
+
     /// Rays along the axes (zero direction components) from origins on box planes, at every
     /// width; and rays with no direction at all, which hit nothing.
     #[test]
