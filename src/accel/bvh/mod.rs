@@ -445,6 +445,34 @@ mod tests {
         }
     }
 
+    /// Small triangles far apart, whose boxes' areas overflow: the wide tree's planning
+    /// costs are infinite or NaN, and it must still split every node (found by the
+    /// ray_queries fuzzer: a node "split" into itself recursed until the stack overflowed,
+    /// aborting the process). The tree is built and finds each triangle, at every width.
+    #[test]
+    fn builds_over_boxes_whose_area_overflows() {
+        // Spread along y and z, so the root's box has an area beyond f32 (1e43).
+        let tris: Vec<[Vec3A; 3]> = (0..20)
+            .map(|i| {
+                let far = 1e20 * (i + 1) as f32;
+                let c = Vec3A::new(0.0, if i % 2 == 0 { far } else { -far }, far);
+                [c, c + Vec3A::Y * 1e15, c + Vec3A::Z * 1e15]
+            })
+            .collect();
+        for width in widths() {
+            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            for (i, [a, ..]) in tris.iter().enumerate() {
+                let origin = *a + Vec3A::new(-1.0, 1e14, 1e14);
+                let ray = Ray::new(origin, Vec3A::X, 0.0, 2.0);
+                let hit = accel.intersect(&ray).expect("the triangle in front");
+                assert_eq!(
+                    accel.build_order[hit.triangle as usize] as usize, i,
+                    "{width:?}"
+                );
+            }
+        }
+    }
+
     /// Rays along the axes (zero direction components) from origins on box planes, at every
     /// width; and rays with no direction at all, which hit nothing.
     #[test]
