@@ -299,6 +299,24 @@ fn prism_scene_has_a_dispersive_prism_and_one_lamp() {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// A colour statement with fewer than three values made tobj panic (found by the obj_mtl
+/// fuzzer): it is an error naming the library, the line and the statement.
+#[test]
+fn mtl_colour_statements_with_too_few_values_are_errors() {
+    for statement in ["Kd 0 0", "Ka", "Ks 1", "Ke 0.5 2"] {
+        let mtl = format!("newmtl m\nNs 10\n{statement}\n");
+        let obj = b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+        let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl.as_bytes())]);
+        let error = io::load_scene(&dir.join("t.obj")).unwrap_err().message;
+        let key = statement.split(' ').next().unwrap();
+        assert!(error.contains("t.mtl"), "{error}");
+        assert!(
+            error.contains(&format!("line 3: {key} needs three numbers")),
+            "{error}"
+        );
+    }
+}
+
 #[test]
 fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\

@@ -25,7 +25,8 @@ pub(super) fn load_obj(path: &Path) -> Result<SceneData, IoError> {
     let loaded = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |library| {
         let full = directory.join(library);
         let result = match std::fs::read(&full) {
-            Ok(text) => tobj::load_mtl_buf(&mut text.as_slice()).map_err(|e| e.to_string()),
+            Ok(text) => check_colour_statements(&text)
+                .and_then(|()| tobj::load_mtl_buf(&mut text.as_slice()).map_err(|e| e.to_string())),
             Err(e) => Err(e.to_string()),
         };
         match result {
@@ -488,6 +489,23 @@ fn add_corners(mesh: &tobj::Mesh, normals: bool, texcoords: bool, data: &mut Sce
             }
         }
     }
+}
+
+/// tobj 4 panics on a colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three
+/// values (found by the obj_mtl fuzzer): such a library is refused before tobj reads it.
+fn check_colour_statements(text: &[u8]) -> Result<(), String> {
+    for (number, line) in String::from_utf8_lossy(text).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next()
+            && words.count() < 3
+        {
+            return Err(format!(
+                "line {}: {key} needs three numbers (r g b)",
+                number + 1
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `Tf r g b` or `Tf v` (grey).
