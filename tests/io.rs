@@ -800,6 +800,19 @@ fn gltf_errors_name_the_file() {
         e.message.contains("is 7") && e.message.contains("4 vertices"),
         "{e}"
     );
+
+    // A POSITION naming an accessor that does not exist: gltf-json's validation indexed
+    // past the accessors (a panic, found by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}],
+        "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3"}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(
+        e.message.contains("POSITION of primitive 0 of mesh 0 is accessor 1"),
+        "{e}"
+    );
     std::fs::remove_file(&path).unwrap();
 }
 
