@@ -317,6 +317,28 @@ fn mtl_colour_statements_with_too_few_values_are_errors() {
     }
 }
 
+/// Face indices far out of range made tobj overflow (found by the obj_mtl fuzzer): they are
+/// errors naming the line; in-range absolute and relative indices still load.
+#[test]
+fn obj_face_indices_out_of_range_are_errors() {
+    let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n";
+    for face in [
+        "f 1//6148914691236517206 2//1 3//1",
+        "f 1/99/1 2/1/1 3/1/1",
+        "f 1 2 -4",
+        "f 0 1 2",
+        "f 1 2 -9223372036854775808",
+    ] {
+        let path = temp_path("faces.obj");
+        std::fs::write(&path, format!("{head}{face}\n")).unwrap();
+        let error = io::load_scene(&path).unwrap_err().message;
+        assert!(error.contains("(line 6): face index"), "{face}: {error}");
+    }
+    let path = temp_path("faces.obj");
+    std::fs::write(&path, format!("{head}f 1/1/1 -2/-1/-1 3//1\n")).unwrap();
+    assert_eq!(io::load_scene(&path).unwrap().triangle_count(), 1);
+}
+
 #[test]
 fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\
@@ -810,7 +832,8 @@ fn gltf_errors_name_the_file() {
     std::fs::write(&path, text).unwrap();
     let e = io::load_scene(&path).unwrap_err();
     assert!(
-        e.message.contains("POSITION of primitive 0 of mesh 0 is accessor 1"),
+        e.message
+            .contains("POSITION of primitive 0 of mesh 0 is accessor 1"),
         "{e}"
     );
     std::fs::remove_file(&path).unwrap();
