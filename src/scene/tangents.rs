@@ -29,13 +29,30 @@ pub(crate) fn mikktspace_tangents(
         tangents: vec![[0.0; 4]; indices.len() / 3 * 3],
     };
     // On failure (no triangles) every corner keeps its zero tangent and gets the fallback.
-    mikktspace::generate_tangents(&mut mesh);
+    if has_extent(positions, &indices[..indices.len() / 3 * 3]) {
+        mikktspace::generate_tangents(&mut mesh);
+    }
     let mut tangents = mesh.tangents;
     for (corner, tangent) in tangents.iter_mut().enumerate() {
         let normal = Vec3A::from_slice(&normals[indices[corner] as usize * 3..]);
         *tangent = unit_tangent_perpendicular_to(normal, *tangent);
     }
     tangents
+}
+
+/// Whether the triangles' corners span a box of finite, non-zero size. mikktspace 0.3 hashes
+/// the corners into a grid along the box's widest axis and indexes past its table when none
+/// falls in the last cell: when that extent is 0 (every corner at one point, every triangle
+/// degenerate) or overflows (found by the capi_scene fuzzer). Such meshes have no tangents
+/// to find: every corner gets the fallback.
+fn has_extent(positions: &[f32], corners: &[u32]) -> bool {
+    let (mut min, mut max) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for &corner in corners {
+        let p = Vec3A::from_slice(&positions[corner as usize * 3..]);
+        (min, max) = (min.min(p), max.max(p));
+    }
+    let extent = max - min;
+    extent.is_finite() && extent.max_element() > 0.0
 }
 
 /// `tangent` made unit length and perpendicular to `normal`; any such tangent when it is zero
@@ -203,5 +220,21 @@ mod tests {
     #[test]
     fn no_triangles_give_no_tangents() {
         assert!(mikktspace_tangents(&[], &[], &[], &[]).is_empty());
+    }
+
+    /// Corners all at one point, or spanning more than a float holds: mikktspace would index
+    /// past its grid (found by the capi_scene fuzzer); every corner gets a unit tangent
+    /// perpendicular to its normal.
+    #[test]
+    fn meshes_without_a_usable_extent_get_the_fallback() {
+        let normals = [0.0, 0.0, 1.0].repeat(3);
+        let texcoords = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        for positions in [[1.0; 9], [-3e38, 0.0, 0.0, 3e38, 0.0, 0.0, 0.0, 1.0, 0.0]] {
+            for t in mikktspace_tangents(&positions, &normals, &texcoords, &[0, 1, 2]) {
+                let xyz = Vec3A::from_slice(&t[..3]);
+                assert!((xyz.length() - 1.0).abs() < 1e-5, "{t:?}");
+                assert!(xyz.z.abs() < 1e-5, "{t:?}");
+            }
+        }
     }
 }
