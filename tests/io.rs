@@ -823,6 +823,18 @@ fn gltf_errors_name_the_file() {
         "{e}"
     );
 
+    // A GLB whose header gives a length shorter than the header: gltf subtracted with
+    // overflow (a panic with overflow checks, found by the gltf_glb fuzzer).
+    let glb = temp_path("short.glb");
+    std::fs::write(
+        &glb,
+        [&b"glTF"[..], &2u32.to_le_bytes(), &4u32.to_le_bytes()].concat(),
+    )
+    .unwrap();
+    let e = io::load_scene(&glb).unwrap_err();
+    assert!(e.message.contains("GLB header gives a length of 4"), "{e}");
+    std::fs::remove_file(&glb).unwrap();
+
     // A POSITION naming an accessor that does not exist: gltf-json's validation indexed
     // past the accessors (a panic, found by the gltf_glb fuzzer).
     let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],

@@ -23,6 +23,16 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         |what: String| IoError::new(format!("cannot load glTF file {}: {what}", path.display()));
     let bytes = std::fs::read(path)
         .map_err(|e| IoError::new(format!("cannot read scene file {}: {e}", path.display())))?;
+    // gltf 1.4 subtracts the header's size from a GLB's declared length unchecked (an
+    // overflow, found by the gltf_glb fuzzer): a length shorter than the header is refused.
+    if let Some(length) = bytes.strip_prefix(b"glTF").and_then(|rest| rest.get(4..8)) {
+        let length = u32::from_le_bytes(length.try_into().expect("4 bytes"));
+        if length < 12 {
+            return Err(fail(format!(
+                "its GLB header gives a length of {length} bytes, less than the header's 12"
+            )));
+        }
+    }
     let ::gltf::Gltf { document, blob } =
         ::gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| fail(e.to_string()))?;
     // gltf-json 1.4's validation indexes the accessors with each primitive's POSITION
