@@ -40,19 +40,24 @@ pub(crate) fn mikktspace_tangents(
     tangents
 }
 
-/// Whether the triangles' corners span a box of finite, non-zero size. mikktspace 0.3 hashes
-/// the corners into a grid along the box's widest axis and indexes past its table when none
-/// falls in the last cell: when that extent is 0 (every corner at one point, every triangle
-/// degenerate) or overflows (found by the capi_scene fuzzer). Such meshes have no tangents
-/// to find: every corner gets the fallback.
+/// Whether mikktspace 0.3 can take these triangles: some triangle has three distinct corner
+/// positions, and the corners span a box of finite size. With every triangle degenerate it
+/// subtracts 1 from their count of 0 (a panic, or without overflow checks reads past its
+/// arrays; found by the obj_mtl fuzzer); it hashes the corners into a grid along the box's
+/// widest axis and indexes past its table when that extent is 0 or overflows (found by the
+/// capi_scene fuzzer). Such meshes get the fallback tangent at every corner.
 fn has_extent(positions: &[f32], corners: &[u32]) -> bool {
+    let position = |corner: u32| Vec3A::from_slice(&positions[corner as usize * 3..]);
     let (mut min, mut max) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
     for &corner in corners {
-        let p = Vec3A::from_slice(&positions[corner as usize * 3..]);
+        let p = position(corner);
         (min, max) = (min.min(p), max.max(p));
     }
-    let extent = max - min;
-    extent.is_finite() && extent.max_element() > 0.0
+    let proper = corners.chunks_exact(3).any(|t| {
+        let [a, b, c] = [0, 1, 2].map(|k| position(t[k]));
+        a != b && a != c && b != c
+    });
+    proper && (max - min).is_finite()
 }
 
 /// `tangent` made unit length and perpendicular to `normal`; any such tangent when it is zero
@@ -222,14 +227,18 @@ mod tests {
         assert!(mikktspace_tangents(&[], &[], &[], &[]).is_empty());
     }
 
-    /// Corners all at one point, or spanning more than a float holds: mikktspace would index
-    /// past its grid (found by the capi_scene fuzzer); every corner gets a unit tangent
-    /// perpendicular to its normal.
+    /// Corners all at one point, only degenerate triangles, or corners spanning more than a
+    /// float holds: mikktspace would overflow or index past its grid (found by the fuzzers);
+    /// every corner gets a unit tangent perpendicular to its normal.
     #[test]
     fn meshes_without_a_usable_extent_get_the_fallback() {
         let normals = [0.0, 0.0, 1.0].repeat(3);
         let texcoords = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
-        for positions in [[1.0; 9], [-3e38, 0.0, 0.0, 3e38, 0.0, 0.0, 0.0, 1.0, 0.0]] {
+        for positions in [
+            [1.0; 9],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            [-3e38, 0.0, 0.0, 3e38, 0.0, 0.0, 0.0, 1.0, 0.0],
+        ] {
             for t in mikktspace_tangents(&positions, &normals, &texcoords, &[0, 1, 2]) {
                 let xyz = Vec3A::from_slice(&t[..3]);
                 assert!((xyz.length() - 1.0).abs() < 1e-5, "{t:?}");
