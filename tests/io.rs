@@ -835,6 +835,23 @@ fn gltf_errors_name_the_file() {
     assert!(e.message.contains("GLB header gives a length of 4"), "{e}");
     std::fs::remove_file(&glb).unwrap();
 
+    // Images without the source gltf unwraps (a panic, found by the gltf_glb fuzzer).
+    for image in [r#"{"bufferView": 0}"#, "{}"] {
+        let text = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "images": [{image}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 4}}],
+            "buffers": [{{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}}],
+            "textures": [{{"source": 0}}]}}"#
+        );
+        std::fs::write(&path, text).unwrap();
+        let e = io::load_scene(&path).unwrap_err();
+        assert!(
+            e.message
+                .contains("image 0 needs a uri, or a bufferView with a mimeType"),
+            "{e}"
+        );
+    }
+
     // A POSITION naming an accessor that does not exist: gltf-json's validation indexed
     // past the accessors (a panic, found by the gltf_glb fuzzer).
     let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],

@@ -52,6 +52,19 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
             }
         }
     }
+    // gltf 1.4 unwraps an image's mimeType when it has a bufferView, and its uri otherwise,
+    // though validation checks neither (a panic, found by the gltf_glb fuzzer).
+    for (i, image) in json.images.iter().enumerate() {
+        let complete = match &image.buffer_view {
+            Some(_) => image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !complete {
+            return Err(fail(format!(
+                "image {i} needs a uri, or a bufferView with a mimeType"
+            )));
+        }
+    }
     let document = ::gltf::Document::from_json(json).map_err(|e| fail(e.to_string()))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
