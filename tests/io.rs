@@ -835,6 +835,14 @@ fn gltf_errors_name_the_file() {
     assert!(e.message.contains("GLB header gives a length of 4"), "{e}");
     std::fs::remove_file(&glb).unwrap();
 
+    // A node that is its own ancestor: the walk recursed until the stack overflowed (found
+    // by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+        "nodes": [{"children": [1]}, {"children": [0]}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(e.message.contains("node 0 is its own ancestor"), "{e}");
+
     // Images without the source gltf unwraps (a panic, found by the gltf_glb fuzzer).
     for image in [r#"{"bufferView": 0}"#, "{}"] {
         let text = format!(

@@ -18,6 +18,9 @@ use std::path::Path;
 /// factor, so a Blender lamp of P watts is P watts here.
 pub(crate) const LUMENS_PER_WATT: f32 = 683.0;
 
+/// The deepest node hierarchy a glTF file may have.
+const MAX_NODE_DEPTH: usize = 1024;
+
 pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let fail =
         |what: String| IoError::new(format!("cannot load glTF file {}: {what}", path.display()));
@@ -107,7 +110,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         texture_map: HashMap::new(),
     };
     for node in scene.nodes() {
-        loader.visit(&node, Mat4::IDENTITY)?;
+        loader.visit(&node, Mat4::IDENTITY, &mut Vec::new())?;
     }
     Ok(loader.data)
 }
@@ -145,7 +148,25 @@ impl Loader<'_> {
         ))
     }
 
-    fn visit(&mut self, node: &::gltf::Node, parent: Mat4) -> Result<(), IoError> {
+    /// Adds `node` and its subtree; `path` holds the indices of its ancestors. gltf's
+    /// validation lets a node be its own ancestor (found by the gltf_glb fuzzer: the walk
+    /// recursed until the stack overflowed): a cycle is an error, and so is a hierarchy
+    /// deeper than `MAX_NODE_DEPTH`, which would exhaust the stack too.
+    fn visit(
+        &mut self,
+        node: &::gltf::Node,
+        parent: Mat4,
+        path: &mut Vec<usize>,
+    ) -> Result<(), IoError> {
+        if path.contains(&node.index()) {
+            return Err(self.fail(format!("node {} is its own ancestor", node.index())));
+        }
+        if path.len() >= MAX_NODE_DEPTH {
+            return Err(self.fail(format!(
+                "node {} lies deeper than {MAX_NODE_DEPTH} levels in the node hierarchy",
+                node.index()
+            )));
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {
             return Err(self.fail(format!("node {} has a non-finite transform", node.index())));
@@ -165,9 +186,11 @@ impl Loader<'_> {
         {
             self.data.camera = Some(self.camera(node, &perspective, world)?);
         }
+        path.push(node.index());
         for child in node.children() {
-            self.visit(&child, world)?;
+            self.visit(&child, world, path)?;
         }
+        path.pop();
         Ok(())
     }
 
