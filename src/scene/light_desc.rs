@@ -158,7 +158,10 @@ impl SunDesc {
         check_non_negative3("desc.sun.irradiance", self.irradiance)?;
         if radius > 0.0 {
             let radiance = self.disc_radiance();
-            if radiance.iter().any(|&l| !(l <= MLT_MAX_LIGHT_SUM)) {
+            if radiance
+                .iter()
+                .any(|&l| l.is_nan() || l > MLT_MAX_LIGHT_SUM)
+            {
                 return Err(Error::invalid(format!(
                     "desc.sun.irradiance {:?} over a disc of angular radius {radius} degrees is a radiance of {radiance:?}; at most {MLT_MAX_LIGHT_SUM:e} is supported (widen the disc or lower the irradiance)",
                     self.irradiance
