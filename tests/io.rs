@@ -299,6 +299,46 @@ fn prism_scene_has_a_dispersive_prism_and_one_lamp() {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// A colour statement with fewer than three values made tobj panic (found by the obj_mtl
+/// fuzzer): it is an error naming the library, the line and the statement.
+#[test]
+fn mtl_colour_statements_with_too_few_values_are_errors() {
+    for statement in ["Kd 0 0", "Ka", "Ks 1", "Ke 0.5 2"] {
+        let mtl = format!("newmtl m\nNs 10\n{statement}\n");
+        let obj = b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+        let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl.as_bytes())]);
+        let error = io::load_scene(&dir.join("t.obj")).unwrap_err().message;
+        let key = statement.split(' ').next().unwrap();
+        assert!(error.contains("t.mtl"), "{error}");
+        assert!(
+            error.contains(&format!("line 3: {key} needs three numbers")),
+            "{error}"
+        );
+    }
+}
+
+/// Face indices far out of range made tobj overflow (found by the obj_mtl fuzzer): they are
+/// errors naming the line; in-range absolute and relative indices still load.
+#[test]
+fn obj_face_indices_out_of_range_are_errors() {
+    let head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\n";
+    for face in [
+        "f 1//6148914691236517206 2//1 3//1",
+        "f 1/99/1 2/1/1 3/1/1",
+        "f 1 2 -4",
+        "f 0 1 2",
+        "f 1 2 -9223372036854775808",
+    ] {
+        let path = temp_path("faces.obj");
+        std::fs::write(&path, format!("{head}{face}\n")).unwrap();
+        let error = io::load_scene(&path).unwrap_err().message;
+        assert!(error.contains("(line 6): face index"), "{face}: {error}");
+    }
+    let path = temp_path("faces.obj");
+    std::fs::write(&path, format!("{head}f 1/1/1 -2/-1/-1 3//1\n")).unwrap();
+    assert_eq!(io::load_scene(&path).unwrap().triangle_count(), 1);
+}
+
 #[test]
 fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\
@@ -780,6 +820,57 @@ fn gltf_errors_name_the_file() {
     let e = io::load_scene(&path).unwrap_err();
     assert!(
         e.message.contains("is 7") && e.message.contains("4 vertices"),
+        "{e}"
+    );
+
+    // A GLB whose header gives a length shorter than the header: gltf subtracted with
+    // overflow (a panic with overflow checks, found by the gltf_glb fuzzer).
+    let glb = temp_path("short.glb");
+    std::fs::write(
+        &glb,
+        [&b"glTF"[..], &2u32.to_le_bytes(), &4u32.to_le_bytes()].concat(),
+    )
+    .unwrap();
+    let e = io::load_scene(&glb).unwrap_err();
+    assert!(e.message.contains("GLB header gives a length of 4"), "{e}");
+    std::fs::remove_file(&glb).unwrap();
+
+    // A node that is its own ancestor: the walk recursed until the stack overflowed (found
+    // by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+        "nodes": [{"children": [1]}, {"children": [0]}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(e.message.contains("node 0 is its own ancestor"), "{e}");
+
+    // Images without the source gltf unwraps (a panic, found by the gltf_glb fuzzer).
+    for image in [r#"{"bufferView": 0}"#, "{}"] {
+        let text = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "images": [{image}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 4}}],
+            "buffers": [{{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}}],
+            "textures": [{{"source": 0}}]}}"#
+        );
+        std::fs::write(&path, text).unwrap();
+        let e = io::load_scene(&path).unwrap_err();
+        assert!(
+            e.message
+                .contains("image 0 needs a uri, or a bufferView with a mimeType"),
+            "{e}"
+        );
+    }
+
+    // A POSITION naming an accessor that does not exist: gltf-json's validation indexed
+    // past the accessors (a panic, found by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 1}}]}],
+        "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3"}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(
+        e.message
+            .contains("POSITION of primitive 0 of mesh 0 is accessor 1"),
         "{e}"
     );
     std::fs::remove_file(&path).unwrap();

@@ -18,15 +18,57 @@ use std::path::Path;
 /// factor, so a Blender lamp of P watts is P watts here.
 pub(crate) const LUMENS_PER_WATT: f32 = 683.0;
 
+/// The deepest node hierarchy a glTF file may have.
+const MAX_NODE_DEPTH: usize = 1024;
+
 pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let fail =
         |what: String| IoError::new(format!("cannot load glTF file {}: {what}", path.display()));
-    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::open(path).map_err(|e| match e {
-        ::gltf::Error::Io(e) => {
-            IoError::new(format!("cannot read scene file {}: {e}", path.display()))
+    let bytes = std::fs::read(path)
+        .map_err(|e| IoError::new(format!("cannot read scene file {}: {e}", path.display())))?;
+    // gltf 1.4 subtracts the header's size from a GLB's declared length unchecked (an
+    // overflow, found by the gltf_glb fuzzer): a length shorter than the header is refused.
+    if let Some(length) = bytes.strip_prefix(b"glTF").and_then(|rest| rest.get(4..8)) {
+        let length = u32::from_le_bytes(length.try_into().expect("4 bytes"));
+        if length < 12 {
+            return Err(fail(format!(
+                "its GLB header gives a length of {length} bytes, less than the header's 12"
+            )));
         }
-        e => fail(e.to_string()),
-    })?;
+    }
+    let ::gltf::Gltf { document, blob } =
+        ::gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| fail(e.to_string()))?;
+    // gltf-json 1.4's validation indexes the accessors with each primitive's POSITION
+    // without checking it (a panic, found by the gltf_glb fuzzer): checked here first.
+    let json = document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = ::gltf::json::validation::Checked::Valid(::gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position)
+                && index.value() >= accessors
+            {
+                return Err(fail(format!(
+                    "the POSITION of primitive {p} of mesh {m} is accessor {}, but there are {accessors} accessors",
+                    index.value()
+                )));
+            }
+        }
+    }
+    // gltf 1.4 unwraps an image's mimeType when it has a bufferView, and its uri otherwise,
+    // though validation checks neither (a panic, found by the gltf_glb fuzzer).
+    for (i, image) in json.images.iter().enumerate() {
+        let complete = match &image.buffer_view {
+            Some(_) => image.mime_type.is_some(),
+            None => image.uri.is_some(),
+        };
+        if !complete {
+            return Err(fail(format!(
+                "image {i} needs a uri, or a bufferView with a mimeType"
+            )));
+        }
+    }
+    let document = ::gltf::Document::from_json(json).map_err(|e| fail(e.to_string()))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
         .map_err(|e| fail(format!("cannot load its buffers: {e}")))?;
@@ -68,7 +110,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         texture_map: HashMap::new(),
     };
     for node in scene.nodes() {
-        loader.visit(&node, Mat4::IDENTITY)?;
+        loader.visit(&node, Mat4::IDENTITY, &mut Vec::new())?;
     }
     Ok(loader.data)
 }
@@ -106,7 +148,25 @@ impl Loader<'_> {
         ))
     }
 
-    fn visit(&mut self, node: &::gltf::Node, parent: Mat4) -> Result<(), IoError> {
+    /// Adds `node` and its subtree; `path` holds the indices of its ancestors. gltf's
+    /// validation lets a node be its own ancestor (found by the gltf_glb fuzzer: the walk
+    /// recursed until the stack overflowed): a cycle is an error, and so is a hierarchy
+    /// deeper than `MAX_NODE_DEPTH`, which would exhaust the stack too.
+    fn visit(
+        &mut self,
+        node: &::gltf::Node,
+        parent: Mat4,
+        path: &mut Vec<usize>,
+    ) -> Result<(), IoError> {
+        if path.contains(&node.index()) {
+            return Err(self.fail(format!("node {} is its own ancestor", node.index())));
+        }
+        if path.len() >= MAX_NODE_DEPTH {
+            return Err(self.fail(format!(
+                "node {} lies deeper than {MAX_NODE_DEPTH} levels in the node hierarchy",
+                node.index()
+            )));
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {
             return Err(self.fail(format!("node {} has a non-finite transform", node.index())));
@@ -126,9 +186,11 @@ impl Loader<'_> {
         {
             self.data.camera = Some(self.camera(node, &perspective, world)?);
         }
+        path.push(node.index());
         for child in node.children() {
-            self.visit(&child, world)?;
+            self.visit(&child, world, path)?;
         }
+        path.pop();
         Ok(())
     }
 

@@ -19,13 +19,20 @@ pub(super) fn load_obj(path: &Path) -> Result<SceneData, IoError> {
         ignore_points: true,
         ignore_lines: true,
     };
+    if let Err((line, message)) = check_face_indices(&bytes) {
+        return Err(IoError::new(format!(
+            "cannot parse OBJ file {} (line {line}): {message}",
+            path.display()
+        )));
+    }
     // The first material library that failed, to name it in the error.
     let library_error: RefCell<Option<(PathBuf, String)>> = RefCell::new(None);
     let directory = path.parent().unwrap_or(Path::new(""));
     let loaded = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |library| {
         let full = directory.join(library);
         let result = match std::fs::read(&full) {
-            Ok(text) => tobj::load_mtl_buf(&mut text.as_slice()).map_err(|e| e.to_string()),
+            Ok(text) => check_colour_statements(&text)
+                .and_then(|()| tobj::load_mtl_buf(&mut text.as_slice()).map_err(|e| e.to_string())),
             Err(e) => Err(e.to_string()),
         };
         match result {
@@ -488,6 +495,81 @@ fn add_corners(mesh: &tobj::Mesh, normals: bool, texcoords: bool, data: &mut Sce
             }
         }
     }
+}
+
+/// tobj 4 overflows on a face index far out of range (a panic, or without overflow checks a
+/// wrong index; found by the obj_mtl fuzzer): every index of a face must name one of the
+/// file's vertices, texture coordinates or normals, 1 to their count or -1 to minus the
+/// count read so far. Kinds the file has none of are ignored by tobj, and here. Returns
+/// the (1-based) line and what is wrong.
+fn check_face_indices(bytes: &[u8]) -> Result<(), (usize, String)> {
+    const KINDS: [(&str, &str); 3] = [
+        ("v", "vertices"),
+        ("vt", "texture coordinates"),
+        ("vn", "normals"),
+    ];
+    let text = String::from_utf8_lossy(bytes);
+    let kind = |line: &str| {
+        let first = line.split_whitespace().next();
+        KINDS.iter().position(|(key, _)| first == Some(*key))
+    };
+    let mut totals = [0i64; 3];
+    for line in text.lines() {
+        if let Some(k) = kind(line) {
+            totals[k] += 1;
+        }
+    }
+    let mut so_far = [0i64; 3];
+    for (number, line) in text.lines().enumerate() {
+        if let Some(k) = kind(line) {
+            so_far[k] += 1;
+            continue;
+        }
+        let mut words = line.split_whitespace();
+        if words.next() != Some("f") {
+            continue;
+        }
+        for word in words {
+            for (k, part) in word.split('/').take(3).enumerate() {
+                // Malformed numbers are tobj's to report.
+                let Ok(index) = part.parse::<i64>() else {
+                    continue;
+                };
+                let named = if index > 0 {
+                    index <= totals[k]
+                } else {
+                    index.checked_neg().is_some_and(|i| i > 0 && i <= so_far[k])
+                };
+                if totals[k] > 0 && !named {
+                    return Err((
+                        number + 1,
+                        format!(
+                            "face index {index} is out of bounds: the file has {} {}",
+                            totals[k], KINDS[k].1
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// tobj 4 panics on a colour statement (`Ka`, `Kd`, `Ks`, `Ke`) with fewer than three
+/// values (found by the obj_mtl fuzzer): such a library is refused before tobj reads it.
+fn check_colour_statements(text: &[u8]) -> Result<(), String> {
+    for (number, line) in String::from_utf8_lossy(text).lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next()
+            && words.count() < 3
+        {
+            return Err(format!(
+                "line {}: {key} needs three numbers (r g b)",
+                number + 1
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `Tf r g b` or `Tf v` (grey).

@@ -222,8 +222,12 @@ fn render_into(
     let control = Control::new(deadline, settings.algorithm.is_metropolis());
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
-    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer.
-    let direct = (settings.algorithm.is_metropolis() && settings.direct_samples_per_mutation > 0)
+    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer. A
+    // max depth below them would leave the chains no paths (and MMLT no depth to pick): then
+    // there is no direct pass, and the chains render every depth.
+    let direct = (settings.algorithm.is_metropolis()
+        && settings.direct_samples_per_mutation > 0
+        && settings.max_depth >= DIRECT_PASS_DEPTHS)
         .then(|| PathTracer {
             scene,
             max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
@@ -511,4 +515,61 @@ pub(crate) fn shared_pool() -> Result<&'static rayon::ThreadPool> {
         .get_or_init(|| new_pool(0).map_err(|e| e.message))
         .as_ref()
         .map_err(|message| Error::new(MLT_STATUS_OUT_OF_MEMORY, message.clone()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, SceneDesc};
+
+    /// A Metropolis render with the direct pass on and a max depth below the depths it
+    /// takes (found by the capi_scene fuzzer: MMLT had no depth left to sample and divided
+    /// by zero) renders every depth with its chains: here an emitter of radiance 1 filling
+    /// the image.
+    #[test]
+    fn metropolis_with_a_max_depth_below_the_direct_pass() {
+        let scene = Scene::new(&SceneDesc {
+            positions: &[
+                -2.0, -2.0, 0.0, 2.0, -2.0, 0.0, 2.0, 2.0, 0.0, -2.0, 2.0, 0.0,
+            ],
+            indices: &[0, 1, 2, 0, 2, 3],
+            materials: &[Material::diffuse([0.5; 3]).with_emission([1.0; 3])],
+            ..Default::default()
+        })
+        .unwrap();
+        let camera = Camera {
+            eye: [0.0, 0.0, 3.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 30.0,
+            ..Default::default()
+        };
+        for algorithm in [
+            Algorithm::Pssmlt,
+            Algorithm::Mmlt,
+            Algorithm::PssmltBdpt,
+            Algorithm::PathSpaceMlt,
+        ] {
+            for max_depth in [0, 1] {
+                let settings = RenderSettings {
+                    width: 4,
+                    height: 4,
+                    algorithm,
+                    max_depth,
+                    mutations_per_pixel: 8,
+                    bootstrap_samples: 256,
+                    chains: 4,
+                    threads: 1,
+                    ..Default::default()
+                };
+                let mut image = [0.0f32; 48];
+                render(&scene, &camera, &settings, &mut image, None).unwrap();
+                let mean = image.iter().sum::<f32>() / image.len() as f32;
+                assert!(
+                    (mean - 1.0).abs() < 0.05,
+                    "{algorithm:?}, max depth {max_depth}: mean {mean}"
+                );
+            }
+        }
+    }
 }

@@ -96,9 +96,23 @@ impl<'a> EnvironmentDesc<'a> {
                 )));
             }
         }
+        // The map is sampled by its texels' luminance, summed in single precision: every
+        // scaled value, and their sum, must stay a float.
+        let total = self.pixels.iter().map(|&v| v as f64).sum::<f64>() * self.scale as f64;
+        if total > MLT_MAX_LIGHT_SUM {
+            return Err(Error::invalid(format!(
+                "desc.environment.pixels times its scale ({}) sum to {total:e}; at most {MLT_MAX_LIGHT_SUM:e} is supported (lower the scale)",
+                self.scale
+            )));
+        }
         Ok(())
     }
 }
+
+/// Largest luminance an environment's texels (times its scale) may sum to, and largest
+/// radiance a sun disc may have: light values that sums and products in single precision
+/// still hold.
+pub(crate) const MLT_MAX_LIGHT_SUM: f64 = 1e38;
 
 /// The sun: a distant disc of uniform radiance, or a delta direction when its angular
 /// radius is 0.
@@ -141,7 +155,28 @@ impl SunDesc {
                 "desc.sun.angular_radius_degrees is {radius}; it must be in [0, {SUN_MAX_ANGULAR_RADIUS_DEGREES}] (0: a delta direction)"
             )));
         }
-        check_non_negative3("desc.sun.irradiance", self.irradiance)
+        check_non_negative3("desc.sun.irradiance", self.irradiance)?;
+        if radius > 0.0 {
+            let radiance = self.disc_radiance();
+            if radiance
+                .iter()
+                .any(|&l| l.is_nan() || l > MLT_MAX_LIGHT_SUM)
+            {
+                return Err(Error::invalid(format!(
+                    "desc.sun.irradiance {:?} over a disc of angular radius {radius} degrees is a radiance of {radiance:?}; at most {MLT_MAX_LIGHT_SUM:e} is supported (widen the disc or lower the irradiance)",
+                    self.irradiance
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The radiance of the disc of a sun with a positive angular radius: the irradiance
+    /// over π sin² of the radius.
+    pub(crate) fn disc_radiance(&self) -> [f64; 3] {
+        let sin = (self.angular_radius_degrees as f64).to_radians().sin();
+        let solid_for_irradiance = std::f64::consts::PI * sin * sin;
+        self.irradiance.map(|e| e as f64 / solid_for_irradiance)
     }
 }
 

@@ -259,7 +259,10 @@ impl Scene {
         // A little larger than the box's sphere: rays from its disc start outside the geometry.
         let radius = ((bounds_max - bounds_min).length() * 0.5 * 1.01).max(1e-3);
         // Lights are picked in proportion to their emitted power.
-        let scene_lights = lights::SceneLights::new(lights, &desc.lights, (center, radius));
+        let scene_lights =
+            lights::SceneLights::new(lights, &desc.lights, (center, radius), |internal| {
+                internal_to_input[internal as usize]
+            })?;
         for light in &scene_lights.lights {
             if let lights::Light::Area(light) = light {
                 shading[light.triangle as usize].light_area_pdf = light.area_pdf;
@@ -675,5 +678,100 @@ mod tests {
                 assert_eq!(scene.occluded(&short), front, "{what}");
             }
         }
+    }
+
+    /// Finite light values whose power overflows a float (found by the capi_scene fuzzer:
+    /// the light selection's or the environment map's weights were infinite) are refused,
+    /// naming the light; the same lights in a scene of sensible size and strength are
+    /// accepted.
+    #[test]
+    fn lights_whose_power_overflows_are_refused() {
+        // Two triangles `size` wide, `apart` from each other along x.
+        let geometry = |size: f32, apart: f32| {
+            let mut positions = Vec::new();
+            for x in [-apart / 2.0, apart / 2.0] {
+                positions.extend_from_slice(&[x, 0.0, 0.0, x, size, 0.0, x, 0.0, size]);
+            }
+            positions
+        };
+        let scene = |positions: &[f32], emission: f32, lights: LightsDesc| {
+            Scene::new(&SceneDesc {
+                positions,
+                indices: &[0, 1, 2, 3, 4, 5],
+                materials: &[Material::diffuse([0.5; 3]).with_emission([emission; 3])],
+                lights,
+                ..Default::default()
+            })
+            .map(|_| ())
+            .map_err(|e| e.message)
+        };
+        let huge_point = [PunctualLight::point([0.0; 3], [1e38; 3])];
+        let max_point = [PunctualLight::point([0.0; 3], [f32::MAX; 3])];
+        let bright_point = [PunctualLight::point([0.0; 3], [1e30; 3])];
+        let point = |lights| LightsDesc {
+            punctual: lights,
+            ..Default::default()
+        };
+        let sun = LightsDesc {
+            sun: Some(SunDesc {
+                direction: [0.0, 1.0, 0.0],
+                angular_radius_degrees: 0.0,
+                irradiance: [1.0; 3],
+            }),
+            ..Default::default()
+        };
+        let bright_sky = [1e30f32; 6];
+        let sky = |scale| LightsDesc {
+            environment: Some(EnvironmentDesc {
+                pixels: &bright_sky,
+                width: 2,
+                height: 1,
+                rotation_degrees: 0.0,
+                scale,
+            }),
+            ..Default::default()
+        };
+        let tiny_sun = LightsDesc {
+            sun: Some(SunDesc {
+                direction: [0.0, 1.0, 0.0],
+                angular_radius_degrees: 1e-30,
+                irradiance: [1.0; 3],
+            }),
+            ..Default::default()
+        };
+        let cases = [
+            (
+                scene(&geometry(1e9, 1.0), 1e30, Default::default()),
+                "emissive triangle 0",
+            ),
+            (
+                scene(&geometry(1.0, 1.0), 0.0, point(&huge_point)),
+                "desc.punctual_lights[0]",
+            ),
+            (
+                scene(&geometry(1.0, 1.0), 0.0, point(&max_point)),
+                "desc.punctual_lights[0]",
+            ),
+            (
+                scene(&geometry(1.0, 1e20), 0.0, sun),
+                "the sun and environment",
+            ),
+        ];
+        for (result, needle) in cases {
+            let message = result.expect_err(needle);
+            assert!(message.contains(needle), "{message}");
+            assert!(message.contains("overflows a float"), "{message}");
+        }
+        // Light values beyond what single-precision sums hold are refused when validated.
+        let message = scene(&geometry(1.0, 1.0), 0.0, sky(1e10)).unwrap_err();
+        assert!(
+            message.contains("desc.environment.pixels times its scale"),
+            "{message}"
+        );
+        let message = scene(&geometry(1.0, 1.0), 0.0, tiny_sun).unwrap_err();
+        assert!(message.contains("desc.sun.irradiance"), "{message}");
+        scene(&geometry(1e3, 1.0), 1e10, point(&bright_point)).unwrap();
+        scene(&geometry(1.0, 1e3), 0.0, sun).unwrap();
+        scene(&geometry(1.0, 1.0), 0.0, sky(1.0)).unwrap();
     }
 }

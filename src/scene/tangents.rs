@@ -29,13 +29,35 @@ pub(crate) fn mikktspace_tangents(
         tangents: vec![[0.0; 4]; indices.len() / 3 * 3],
     };
     // On failure (no triangles) every corner keeps its zero tangent and gets the fallback.
-    mikktspace::generate_tangents(&mut mesh);
+    if has_extent(positions, &indices[..indices.len() / 3 * 3]) {
+        mikktspace::generate_tangents(&mut mesh);
+    }
     let mut tangents = mesh.tangents;
     for (corner, tangent) in tangents.iter_mut().enumerate() {
         let normal = Vec3A::from_slice(&normals[indices[corner] as usize * 3..]);
         *tangent = unit_tangent_perpendicular_to(normal, *tangent);
     }
     tangents
+}
+
+/// Whether mikktspace 0.3 can take these triangles: some triangle has three distinct corner
+/// positions, and the corners span a box of finite size. With every triangle degenerate it
+/// subtracts 1 from their count of 0 (a panic, or without overflow checks reads past its
+/// arrays; found by the obj_mtl fuzzer); it hashes the corners into a grid along the box's
+/// widest axis and indexes past its table when that extent is 0 or overflows (found by the
+/// capi_scene fuzzer). Such meshes get the fallback tangent at every corner.
+fn has_extent(positions: &[f32], corners: &[u32]) -> bool {
+    let position = |corner: u32| Vec3A::from_slice(&positions[corner as usize * 3..]);
+    let (mut min, mut max) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for &corner in corners {
+        let p = position(corner);
+        (min, max) = (min.min(p), max.max(p));
+    }
+    let proper = corners.chunks_exact(3).any(|t| {
+        let [a, b, c] = [0, 1, 2].map(|k| position(t[k]));
+        a != b && a != c && b != c
+    });
+    proper && (max - min).is_finite()
 }
 
 /// `tangent` made unit length and perpendicular to `normal`; any such tangent when it is zero
@@ -203,5 +225,25 @@ mod tests {
     #[test]
     fn no_triangles_give_no_tangents() {
         assert!(mikktspace_tangents(&[], &[], &[], &[]).is_empty());
+    }
+
+    /// Corners all at one point, only degenerate triangles, or corners spanning more than a
+    /// float holds: mikktspace would overflow or index past its grid (found by the fuzzers);
+    /// every corner gets a unit tangent perpendicular to its normal.
+    #[test]
+    fn meshes_without_a_usable_extent_get_the_fallback() {
+        let normals = [0.0, 0.0, 1.0].repeat(3);
+        let texcoords = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        for positions in [
+            [1.0; 9],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            [-3e38, 0.0, 0.0, 3e38, 0.0, 0.0, 0.0, 1.0, 0.0],
+        ] {
+            for t in mikktspace_tangents(&positions, &normals, &texcoords, &[0, 1, 2]) {
+                let xyz = Vec3A::from_slice(&t[..3]);
+                assert!((xyz.length() - 1.0).abs() < 1e-5, "{t:?}");
+                assert!(xyz.z.abs() < 1e-5, "{t:?}");
+            }
+        }
     }
 }

@@ -42,6 +42,15 @@ impl BoxRay8 {
     #[target_feature(enable = "avx2,fma")]
     pub(super) fn new(ray: &Ray) -> Self {
         let inv = Vec3A::ONE / ray.direction;
+        // Where origin · inv overflows (a direction component tiny against the origin's),
+        // a box's far slab bound · inv − origin · inv would be −inf even for a box the ray
+        // enters: the ray is taken as parallel to that axis (inv = ±inf), whose slabs are
+        // ±inf or NaN as above, never a wrong bound.
+        let inv = Vec3A::select(
+            (ray.origin * inv).is_finite_mask(),
+            inv,
+            Vec3A::INFINITY.copysign(inv),
+        );
         let origin_inv = ray.origin * inv;
         let (near, far) = near_and_far_bounds(inv);
         BoxRay8 {

@@ -57,13 +57,17 @@ impl Builder<'_> {
         let (left, right) = (node.first_index as usize, node.first_index as usize + 1);
         self.plan_slots(left, width);
         self.plan_slots(right, width);
-        // The best split of i slots between the children, for i = 2..=width.
+        // The best split of i slots between the children, for i = 2..=width. Each starts
+        // from one slot to the left, so it is a split even when costs are infinite or NaN
+        // (boxes whose area overflows): a "split" of 0 would collapse the node into itself.
         let mut split_plans = [SlotPlan {
             cost: f32::INFINITY,
-            split: 0,
+            split: 1,
         }; 8];
         for slots in 2..=width {
-            for to_left in 1..slots {
+            split_plans[slots - 1].cost =
+                self.plans[left][0].cost + self.plans[right][slots - 2].cost;
+            for to_left in 2..slots {
                 let cost = self.plans[left][to_left - 1].cost
                     + self.plans[right][slots - to_left - 1].cost;
                 if cost < split_plans[slots - 1].cost {
@@ -83,11 +87,12 @@ impl Builder<'_> {
         for slots in 2..=width {
             let split = split_plans[slots - 1];
             // Ties split: at the full width the split always wins (whole adds a node), so a
-            // wide node always has a split to follow, even over boxes of zero area.
-            plans[slots - 1] = if split.cost <= whole.cost {
-                split
-            } else {
+            // wide node always has a split to follow, even over boxes of zero area, or of
+            // an area that overflows (NaN costs split too).
+            plans[slots - 1] = if whole.cost < split.cost {
                 whole
+            } else {
+                split
             };
         }
     }

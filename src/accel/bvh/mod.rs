@@ -386,6 +386,93 @@ mod tests {
         }
     }
 
+    /// Rays from origins so far out that origin / direction overflows on every axis make
+    /// every slab of the box test NaN, which enters the empty slots of partly filled nodes
+    /// too (found by the ray_queries fuzzer: the traversal then indexed past the leaf
+    /// blocks). The traversal skips them: such rays get an answer, the same from both
+    /// queries, at every width.
+    #[test]
+    fn rays_from_far_origins_skip_empty_slots() {
+        let tris: Vec<[Vec3A; 3]> = (0..40)
+            .map(|i| {
+                let c = Vec3A::new(i as f32, (i % 3) as f32, (i % 7) as f32);
+                [c, c + Vec3A::X, c + Vec3A::Y]
+            })
+            .collect();
+        for width in widths() {
+            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            for origin in [Vec3A::splat(3e38), Vec3A::new(-3e38, 3e38, -3e38)] {
+                for direction in [Vec3A::ONE, -Vec3A::ONE, Vec3A::new(1.0, -1.0, 1.0)] {
+                    let ray = Ray::new(origin, direction.normalize(), 0.0, f32::INFINITY);
+                    let hit = accel.intersect(&ray);
+                    assert_eq!(accel.occluded(&ray), hit.is_some(), "{width:?} {ray:?}");
+                }
+            }
+        }
+    }
+
+    /// A ray with a direction component so small that origin / direction overflows on its
+    /// axis still enters the boxes it crosses (found by the ray_queries fuzzer: the 8-wide
+    /// box test's fused form made their far bound -inf and missed the triangle), at every
+    /// width, here among partly filled nodes of 40 small triangles.
+    #[test]
+    fn rays_with_tiny_direction_components_find_their_hit() {
+        let mut tris: Vec<[Vec3A; 3]> = (0..40)
+            .map(|i| {
+                let c = Vec3A::new(i as f32, -5.0, (i % 7) as f32);
+                [c, c + Vec3A::X, c + Vec3A::Y]
+            })
+            .collect();
+        tris.push([
+            Vec3A::new(-1e9, 1e8, 1e9),
+            Vec3A::new(1e9, 1e8, 1e9),
+            Vec3A::new(0.0, 1e8, -1e9),
+        ]);
+        let origin = Vec3A::new(3.0, -1.0, 0.0);
+        for tiny in [f32::MIN_POSITIVE, -f32::MIN_POSITIVE, 1e-37] {
+            let direction = Vec3A::new(tiny, 3.0, 1.0).normalize();
+            let expected = (1e8 + 1.0) / direction.y;
+            for width in widths() {
+                let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+                let ray = Ray::new(origin, direction, 0.0, f32::INFINITY);
+                let hit = accel.intersect(&ray);
+                let what = format!("{width:?}, direction {direction}: {hit:?}");
+                let hit = hit.expect(&what);
+                assert_eq!(accel.build_order[hit.triangle as usize], 40, "{what}");
+                assert!((hit.t / expected - 1.0).abs() < 1e-3, "{what}");
+                assert!(accel.occluded(&ray), "{what}");
+            }
+        }
+    }
+
+    /// Small triangles far apart, whose boxes' areas overflow: the wide tree's planning
+    /// costs are infinite or NaN, and it must still split every node (found by the
+    /// ray_queries fuzzer: a node "split" into itself recursed until the stack overflowed,
+    /// aborting the process). The tree is built and finds each triangle, at every width.
+    #[test]
+    fn builds_over_boxes_whose_area_overflows() {
+        // Spread along y and z, so the root's box has an area beyond f32 (1e43).
+        let tris: Vec<[Vec3A; 3]> = (0..20)
+            .map(|i| {
+                let far = 1e20 * (i + 1) as f32;
+                let c = Vec3A::new(0.0, if i % 2 == 0 { far } else { -far }, far);
+                [c, c + Vec3A::Y * 1e15, c + Vec3A::Z * 1e15]
+            })
+            .collect();
+        for width in widths() {
+            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            for (i, [a, ..]) in tris.iter().enumerate() {
+                let origin = *a + Vec3A::new(-1.0, 1e14, 1e14);
+                let ray = Ray::new(origin, Vec3A::X, 0.0, 2.0);
+                let hit = accel.intersect(&ray).expect("the triangle in front");
+                assert_eq!(
+                    accel.build_order[hit.triangle as usize] as usize, i,
+                    "{width:?}"
+                );
+            }
+        }
+    }
+
     /// Rays along the axes (zero direction components) from origins on box planes, at every
     /// width; and rays with no direction at all, which hit nothing.
     #[test]

@@ -3,6 +3,7 @@
 //! skipping of those beyond the closest hit so far (`pop_within`); and `Lanes`, the entry
 //! distances `descend` orders by, as each width's box test gives them.
 
+use super::layout::EMPTY;
 use std::mem::MaybeUninit;
 
 /// A node's entry distances as its box test leaves them, in a vector register. `descend`
@@ -57,6 +58,10 @@ impl TraversalStack<(u32, f32)> {
     /// The children of a node that `mask` says the ray enters (at least one): returns the
     /// nearest to go on with and pushes the others, farthest first, with their entry
     /// distances. `prefetch` is called on each of them when there are several.
+    ///
+    /// Empty slots are skipped, and `EMPTY` is returned if the ray entered only those: a
+    /// box test enters an empty slot's box (min +inf, max -inf) when every slab is NaN,
+    /// for an origin so far out that origin / direction overflows on every axis.
     #[inline(always)]
     pub(super) fn descend<const N: usize>(
         &mut self,
@@ -75,6 +80,9 @@ impl TraversalStack<(u32, f32)> {
             let slot = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             let entry = (children[slot], t_near[slot]);
+            if entry.0 == EMPTY {
+                continue;
+            }
             prefetch(entry.0);
             // Insertion sort, nearest last.
             let mut at = count;
@@ -84,6 +92,9 @@ impl TraversalStack<(u32, f32)> {
             }
             hits[at] = entry;
             count += 1;
+        }
+        if count == 0 {
+            return EMPTY;
         }
         for &entry in &hits[..count - 1] {
             self.push(entry);

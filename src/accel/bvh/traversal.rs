@@ -126,7 +126,9 @@ fn intersect<const W: usize, N: WideNode<W>, D: Lanes<W>>(
             if mask != 0 {
                 current =
                     stack.descend(mask, node.children(), t_near, |child| tree.prefetch(child));
-                continue;
+                if current != EMPTY {
+                    continue;
+                }
             }
         } else {
             tree.intersect_leaf(current, &block_ray, &mut tmax, &mut best, accept);
@@ -157,8 +159,12 @@ fn occluded<const W: usize, N: WideNode<W>, D: Lanes<W>>(
             while mask != 0 {
                 let slot = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                tree.prefetch(node.children()[slot]);
-                stack.push(node.children()[slot]);
+                // Empty slots are entered only by rays with all-NaN slabs (`descend`).
+                let child = node.children()[slot];
+                if child != EMPTY {
+                    tree.prefetch(child);
+                    stack.push(child);
+                }
             }
         } else if tree.leaf_blocked(current, &block_ray, ray.tmax, accept) {
             return true;

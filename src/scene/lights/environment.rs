@@ -181,10 +181,7 @@ impl SunDisc {
     pub fn new(desc: &SunDesc) -> SunDisc {
         let radius = (desc.angular_radius_degrees as f64).to_radians();
         let sin = radius.sin();
-        let solid_for_irradiance = std::f64::consts::PI * sin * sin;
-        let [r, g, b] = desc
-            .irradiance
-            .map(|e| (e as f64 / solid_for_irradiance) as f32);
+        let [r, g, b] = desc.disc_radiance().map(|l| l as f32);
         SunDisc {
             toward: Vec3A::from(desc.direction).normalize(),
             radiance: Spectrum::new(r, g, b),

@@ -15,6 +15,7 @@ mod environment;
 pub(crate) use environment::{EnvironmentMap, InfiniteLight, SunDisc, uniform_sphere};
 
 use super::light_desc::{LightsDesc, PunctualLightKind};
+use crate::error::{Error, Result};
 use crate::sampling::{OrthonormalBasis, uniform_disk, uniform_triangle};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
@@ -463,16 +464,21 @@ pub(crate) struct SceneLights {
 
 impl SceneLights {
     /// `area` in the host's triangle order (their `area_pdf` is filled here);
-    /// `bounding_sphere` is the scene's (the environment's power is estimated through it).
+    /// `bounding_sphere` is the scene's (the environment's power is estimated through it);
+    /// `input_triangle` maps an internal triangle index to the host's, for messages. Fails
+    /// when a light's power, or the lights' total, overflows a float: the selection
+    /// probabilities would be 0 or NaN.
     pub fn new(
         area: Vec<AreaLight>,
         desc: &LightsDesc,
         bounding_sphere: (Vec3A, f32),
-    ) -> SceneLights {
+        input_triangle: impl Fn(u32) -> u32,
+    ) -> Result<SceneLights> {
         let bounds_radius = bounding_sphere.1;
         let area_of = |light: &AreaLight| 0.5 * light.edge1.cross(light.edge2).length();
         let mut lights: Vec<Light> = Vec::with_capacity(area.len() + desc.punctual.len() + 2);
         let mut power: Vec<f32> = Vec::with_capacity(lights.capacity());
+        let area_count = area.len();
         for light in area {
             power.push(light.emission.luminance() * light.power_scale * area_of(&light));
             lights.push(Light::Area(light));
@@ -537,6 +543,38 @@ impl SceneLights {
                 lights.push(Light::Infinite);
             }
         }
+        let mut total = 0.0f64;
+        for (index, &p) in power.iter().enumerate() {
+            total += p as f64;
+            if !(p.is_finite() && total <= f32::MAX as f64) {
+                let light = match &lights[index] {
+                    Light::Area(light) => format!(
+                        "emissive triangle {} (emission {:?}, area {:e})",
+                        input_triangle(light.triangle),
+                        light.emission.to_array(),
+                        area_of(light)
+                    ),
+                    Light::Point(_) => format!(
+                        "desc.punctual_lights[{}] (intensity {:?})",
+                        index - area_count,
+                        desc.punctual[index - area_count].intensity
+                    ),
+                    Light::Directional { .. } if index - area_count < desc.punctual.len() => {
+                        format!(
+                            "desc.punctual_lights[{}] (irradiance {:?} over the scene's bounding sphere of radius {bounds_radius:e})",
+                            index - area_count,
+                            desc.punctual[index - area_count].intensity
+                        )
+                    }
+                    Light::Directional { .. } | Light::Infinite => format!(
+                        "the sun and environment (over the scene's bounding sphere of radius {bounds_radius:e})"
+                    ),
+                };
+                return Err(Error::invalid(format!(
+                    "the power of {light} overflows a float (the lights' total up to it is {total:e}); scale the scene's light or its size down"
+                )));
+            }
+        }
         // Lights that emit nothing are never picked (zero weight) but keep their index.
         let distribution = crate::sampling::Distribution1D::new(&power);
         let infinite_select_pdf = infinite_index.map_or(0.0, |i| distribution.discrete_pdf(i));
@@ -545,12 +583,12 @@ impl SceneLights {
                 light.area_pdf = distribution.discrete_pdf(index) / area_of(light);
             }
         }
-        SceneLights {
+        Ok(SceneLights {
             lights,
             distribution,
             infinite,
             infinite_select_pdf,
             bounding_sphere,
-        }
+        })
     }
 }
