@@ -475,8 +475,8 @@ pub struct MltRenderSettings {
     /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
     /// mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
     /// depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
-    /// the chains; the two alternate, so a render stopped early keeps the ratio. 0, or a
-    /// max_depth below 2 (no longer paths): no direct pass, the chains render every depth.
+    /// the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
+    /// pass, the chains render every depth.
     pub direct_samples_per_mutation: u32,
     /// `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
     /// `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among

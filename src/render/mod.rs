@@ -222,12 +222,9 @@ fn render_into(
     let control = Control::new(deadline, settings.algorithm.is_metropolis());
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
-    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer. A
-    // max depth below them would leave the chains no paths (and MMLT no depth to pick): then
-    // there is no direct pass, and the chains render every depth.
-    let direct = (settings.algorithm.is_metropolis()
-        && settings.direct_samples_per_mutation > 0
-        && settings.max_depth >= DIRECT_PASS_DEPTHS)
+    // A Metropolis render with a direct pass leaves the shortest paths to a path tracer
+    // (with a max depth below 2, all of them: the chains then have nothing to render).
+    let direct = (settings.algorithm.is_metropolis() && settings.direct_samples_per_mutation > 0)
         .then(|| PathTracer {
             scene,
             max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
@@ -523,9 +520,9 @@ mod tests {
     use crate::scene::{Material, SceneDesc};
 
     /// A Metropolis render with the direct pass on and a max depth below the depths it
-    /// takes (found by the capi_scene fuzzer: MMLT had no depth left to sample and divided
-    /// by zero) renders every depth with its chains: here an emitter of radiance 1 filling
-    /// the image.
+    /// leaves to the chains (found by the capi_scene fuzzer and the stress program: MMLT had
+    /// no depth left to sample and divided by zero) is the direct pass's: here an emitter of
+    /// radiance 1 filling the image.
     #[test]
     fn metropolis_with_a_max_depth_below_the_direct_pass() {
         let scene = Scene::new(&SceneDesc {

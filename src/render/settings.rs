@@ -99,8 +99,8 @@ pub struct RenderSettings {
     /// The direct pass path-traces the paths of depth 0 and 1 (emitters seen directly,
     /// direct lighting), which chains render poorly: they spend mutations in proportion to
     /// brightness, on what stratified camera samples get right. The chains render the longer
-    /// paths. The two alternate, so a render stopped early keeps the ratio. 0, or a
-    /// `max_depth` below 2 (no longer paths): no direct pass; the chains render every depth.
+    /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
+    /// pass; the chains render every depth.
     pub direct_samples_per_mutation: u32,
     /// Metropolis: the share of the rays spent on independent samples of the chains' target
     /// (path-tracer samples for PSSMLT, BDPT samples with all strategies for the others),
