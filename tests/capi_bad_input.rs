@@ -695,9 +695,10 @@ fn a_scene_released_during_renders_stays_alive_until_they_return() {
     let camera = floor_camera();
     let settings = MltRenderSettings {
         threads: 1,
-        // Long enough (a few tenths of a second) that the renders are still tracing rays
-        // when the progress callback's first call, after 50 ms, lets the release happen.
-        ..small_settings(16, 16, 2048)
+        // Long enough (about half a second unloaded) that the renders are still tracing
+        // rays when the progress callback's first call, after 50 ms, lets the release
+        // happen.
+        ..small_settings(16, 16, 16384)
     };
     let reference = floor.create().render(&camera, &settings, 16 * 16 * 3);
     assert_ok(reference.0);

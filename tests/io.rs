@@ -873,6 +873,48 @@ fn gltf_errors_name_the_file() {
             .contains("POSITION of primitive 0 of mesh 0 is accessor 1"),
         "{e}"
     );
+
+    // Attributes whose accessors have a type glTF does not allow them: gltf read them with
+    // the wrong element size (a debug assertion, found by the gltf_glb fuzzer).
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    for (attribute, accessor) in [
+        (
+            "NORMAL",
+            r#""componentType": 5126, "count": 4, "type": "VEC2""#,
+        ),
+        (
+            "TEXCOORD_0",
+            r#""componentType": 5126, "count": 4, "type": "VEC3""#,
+        ),
+        (
+            "COLOR_0",
+            r#""componentType": 5125, "count": 4, "type": "VEC4""#,
+        ),
+        (
+            "TANGENT",
+            r#""componentType": 5126, "count": 4, "type": "VEC3""#,
+        ),
+    ] {
+        let json = gltf_json(Some(&uri), buffer.len())
+            .replacen(
+                r#""attributes": { "POSITION": 0 }"#,
+                &format!(r#""attributes": {{ "POSITION": 0, "{attribute}": 2 }}"#),
+                1,
+            )
+            .replace(
+                r#""type": "SCALAR" }"#,
+                &format!(r#""type": "SCALAR" }}, {{ "bufferView": 0, {accessor} }}"#),
+            );
+        std::fs::write(&path, json).unwrap();
+        let e = io::load_scene(&path).unwrap_err();
+        assert!(
+            e.message.contains(&format!(
+                "the {attribute} attribute of primitive 0 of mesh 0"
+            )) && e.message.contains("which glTF does not allow"),
+            "{attribute}: {e}"
+        );
+    }
     std::fs::remove_file(&path).unwrap();
 }
 

@@ -362,6 +362,48 @@ impl Loader<'_> {
             )));
         }
 
+        // gltf's readers take an attribute accessor's element type on trust (a debug
+        // assertion only, found by the gltf_glb fuzzer): one of another type would be read
+        // with the wrong size. These are the types glTF allows.
+        let floats_or_normalized = &[DataType::F32, DataType::U8, DataType::U16][..];
+        for (semantic, name, dimensions, types) in [
+            (
+                ::gltf::Semantic::Normals,
+                "NORMAL",
+                &[Dimensions::Vec3][..],
+                &[DataType::F32][..],
+            ),
+            (
+                ::gltf::Semantic::Tangents,
+                "TANGENT",
+                &[Dimensions::Vec4],
+                &[DataType::F32],
+            ),
+            (
+                ::gltf::Semantic::TexCoords(0),
+                "TEXCOORD_0",
+                &[Dimensions::Vec2],
+                floats_or_normalized,
+            ),
+            (
+                ::gltf::Semantic::Colors(0),
+                "COLOR_0",
+                &[Dimensions::Vec3, Dimensions::Vec4],
+                floats_or_normalized,
+            ),
+        ] {
+            if let Some(accessor) = primitive.get(&semantic)
+                && (!dimensions.contains(&accessor.dimensions())
+                    || !types.contains(&accessor.data_type()))
+            {
+                return Err(self.fail(format!(
+                    "the {name} attribute of {what} is {:?} of {:?}, which glTF does not allow",
+                    accessor.dimensions(),
+                    accessor.data_type()
+                )));
+            }
+        }
+
         let material = self.material(&primitive.material())?;
         let attribute = |what_attribute: &str| {
             self.fail(format!(
