@@ -874,6 +874,17 @@ fn gltf_errors_name_the_file() {
         "{e}"
     );
 
+    // A relative uri whose escapes decode to bytes that are not UTF-8: gltf unwrapped the
+    // decoding (a panic, found by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": []}],
+        "buffers": [{"byteLength": 4, "uri": "a%FFb.bin"}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(
+        e.message.contains("does not percent-decode to UTF-8"),
+        "{e}"
+    );
+
     // Attributes whose accessors have a type glTF does not allow them: gltf read them with
     // the wrong element size (a debug assertion, found by the gltf_glb fuzzer).
     let buffer = quad_buffer();

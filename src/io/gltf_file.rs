@@ -68,6 +68,17 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
             )));
         }
     }
+    // gltf 1.4 unwraps the percent-decoding of a relative uri, which fails when the bytes
+    // are not UTF-8 (a panic, found by the gltf_glb fuzzer).
+    let uris = json.buffers.iter().filter_map(|b| b.uri.as_deref());
+    let uris = uris.chain(json.images.iter().filter_map(|i| i.uri.as_deref()));
+    for uri in uris {
+        if !uri.contains(':') && !percent_decodes_to_utf8(uri) {
+            return Err(fail(format!(
+                "the uri {uri:?} does not percent-decode to UTF-8"
+            )));
+        }
+    }
     let document = ::gltf::Document::from_json(json).map_err(|e| fail(e.to_string()))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
@@ -730,4 +741,28 @@ fn srgb_to_linear(value: f32) -> f32 {
     } else {
         ((value + 0.055) / 1.055).powf(2.4)
     }
+}
+
+/// Whether a uri's %XX escapes decode, with the rest of its bytes, to UTF-8.
+fn percent_decodes_to_utf8(uri: &str) -> bool {
+    let bytes = uri.as_bytes();
+    let mut decoded = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let escape = bytes
+            .get(i + 1..i + 3)
+            .filter(|h| bytes[i] == b'%' && h.iter().all(u8::is_ascii_hexdigit));
+        match escape {
+            Some(hex) => {
+                let hex = std::str::from_utf8(hex).expect("ASCII hex digits");
+                decoded.push(u8::from_str_radix(hex, 16).expect("two hex digits"));
+                i += 3;
+            }
+            None => {
+                decoded.push(bytes[i]);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(decoded).is_ok()
 }
