@@ -885,6 +885,21 @@ fn gltf_errors_name_the_file() {
         "{e}"
     );
 
+    // An image whose bufferView lies beyond its buffer: gltf sliced out of range (a panic,
+    // found by the gltf_glb fuzzer).
+    let text = r#"{"asset": {"version": "2.0"}, "scenes": [{"nodes": []}],
+        "images": [{"bufferView": 0, "mimeType": "image/png"}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 8, "byteLength": 4}],
+        "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}],
+        "textures": [{"source": 0}]}"#;
+    std::fs::write(&path, text).unwrap();
+    let e = io::load_scene(&path).unwrap_err();
+    assert!(
+        e.message
+            .contains("image 0 reads bytes 8..12 of buffer 0, which holds 4"),
+        "{e}"
+    );
+
     // Attributes whose accessors have a type glTF does not allow them: gltf read them with
     // the wrong element size (a debug assertion, found by the gltf_glb fuzzer).
     let buffer = quad_buffer();

@@ -83,6 +83,25 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
         .map_err(|e| fail(format!("cannot load its buffers: {e}")))?;
+    // gltf 1.4 slices an image's bufferView out of its buffer unchecked (a panic, found by
+    // the gltf_glb fuzzer): each view an image reads must lie within its buffer.
+    for image in document.images() {
+        if let ::gltf::image::Source::View { view, .. } = image.source() {
+            let buffer_length = buffers
+                .get(view.buffer().index())
+                .map_or(0, |data| data.len());
+            let end = view.offset().checked_add(view.length());
+            if end.is_none_or(|end| end > buffer_length) {
+                return Err(fail(format!(
+                    "image {} reads bytes {}..{} of buffer {}, which holds {buffer_length}",
+                    image.index(),
+                    view.offset(),
+                    end.map_or_else(|| "overflow".to_string(), |end| end.to_string()),
+                    view.buffer().index()
+                )));
+            }
+        }
+    }
 
     let scene = document
         .default_scene()
