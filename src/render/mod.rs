@@ -519,6 +519,50 @@ mod tests {
     use super::*;
     use crate::scene::{Material, SceneDesc};
 
+    /// Light so faint that paths' values are subnormal floats (colours near 1e-40, found by
+    /// the capi_scene fuzzer): the Metropolis deposits, a path's contribution over its value,
+    /// stay finite and the image keeps its brightness.
+    #[test]
+    fn metropolis_with_subnormal_light() {
+        let radiance = 1e-40f32;
+        let scene = Scene::new(&SceneDesc {
+            positions: &[
+                -2.0, -2.0, 0.0, 2.0, -2.0, 0.0, 2.0, 2.0, 0.0, -2.0, 2.0, 0.0,
+            ],
+            indices: &[0, 1, 2, 0, 2, 3],
+            materials: &[Material::diffuse([0.5; 3]).with_emission([radiance; 3])],
+            ..Default::default()
+        })
+        .unwrap();
+        let camera = Camera {
+            eye: [0.0, 0.0, 3.0],
+            target: [0.0; 3],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: 30.0,
+            ..Default::default()
+        };
+        for algorithm in [Algorithm::Pssmlt, Algorithm::Mmlt, Algorithm::PssmltBdpt] {
+            let settings = RenderSettings {
+                width: 4,
+                height: 4,
+                algorithm,
+                mutations_per_pixel: 8,
+                bootstrap_samples: 256,
+                chains: 4,
+                threads: 1,
+                direct_samples_per_mutation: 0,
+                ..Default::default()
+            };
+            let mut image = [0.0f32; 48];
+            render(&scene, &camera, &settings, &mut image, None).unwrap();
+            let mean = image.iter().map(|&v| v as f64).sum::<f64>() / image.len() as f64;
+            assert!(
+                (mean / radiance as f64 - 1.0).abs() < 0.05,
+                "{algorithm:?}: mean {mean:e}"
+            );
+        }
+    }
+
     /// A Metropolis render with the direct pass on and a max depth below the depths it
     /// leaves to the chains (found by the capi_scene fuzzer and the stress program: MMLT had
     /// no depth left to sample and divided by zero) is the direct pass's: here an emitter of

@@ -562,14 +562,16 @@ where
 }
 
 /// Records `weight` × the state's contributions, each divided by the state's target value
-/// plus `mis_offset`.
+/// plus `mis_offset`. Each contribution is divided first: with a subnormal target (a scene
+/// of colours near 1e-40, found by the capi_scene fuzzer) `weight / denominator` alone
+/// overflows to infinity, while a contribution over its own path's value stays near 1.
 #[inline]
 pub(crate) fn deposit(deposits: &mut Vec<Splat>, state: &PathSample, weight: f32, mis_offset: f32) {
-    let scale = weight / (state.target + mis_offset);
+    let denominator = state.target + mis_offset;
     for entry in &state.entries {
         deposits.push(Splat {
             pixel: entry.pixel,
-            value: entry.value * scale,
+            value: entry.value / denominator * weight,
         });
     }
 }
