@@ -493,8 +493,9 @@ fn settings(u: &mut Unstructured) -> Result<MltRenderSettings> {
         14 => 0,
         _ => (1 << 20) + 1,
     };
-    // 0 is the automatic deposit energy, whose pre-pass alone traces 2^14 BDPT samples
-    // (0.2 s here): rare, to keep executions short. A small one starts many chains (see
+    // 0 is the automatic deposit energy, whose pre-pass traces at least 1024 BDPT samples
+    // (about 15 ms here; it was 2^14 until this target showed the cost): rare, to keep
+    // executions short. A small one starts many chains (see
     // `render`).
     s.erpt_deposit_energy = if u.ratio(1, 64)? {
         0.0

@@ -44,7 +44,9 @@
 //! `deposit_energy` 0 picks e_d so that a camera sample starts one chain on average: a
 //! pre-pass of independent BDPT samples (its own random streams, so e_d is independent of
 //! the render's samples and the estimate stays unbiased given it) estimates the mean energy
-//! ē of a camera sample (its strategies summed), and e_d = ē / L.
+//! ē of a camera sample (its strategies summed), and e_d = ē / L. The pre-pass takes as many
+//! samples as the render (in whole chunks, at least 1024), at most 2^14: a small render
+//! does not pay for a pre-pass a thousand times its own size.
 
 use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
@@ -71,9 +73,24 @@ const PREPASS_STREAM: u64 = 0x5eed_e398_0000_0000;
 const SEED_SALT: u64 = 0xe397_5a17_0000_0001;
 /// Salt of the hash that assigns camera samples to the filter's partial images.
 const BUFFER_SALT: u64 = 0xe397_b0ff_0000_0002;
-/// Camera samples of the pre-pass that estimates the mean energy per sample.
-const PREPASS_SAMPLES: u64 = 1 << 14;
+/// Most and fewest camera samples of the pre-pass that estimates the mean energy per sample
+/// (`prepass_samples`), in chunks of `PREPASS_CHUNK`.
+const MAX_PREPASS_SAMPLES: u64 = 1 << 14;
+const MIN_PREPASS_SAMPLES: u64 = 1 << 10;
 const PREPASS_CHUNK: u64 = 256;
+
+/// The pre-pass's samples for a render of `samples_per_pixel` (0: until stopped) over
+/// `pixels`: as many as the render takes, within the bounds, in whole chunks.
+fn prepass_samples(pixels: u64, samples_per_pixel: u32) -> u64 {
+    let render = if samples_per_pixel == 0 {
+        MAX_PREPASS_SAMPLES
+    } else {
+        pixels.saturating_mul(samples_per_pixel as u64)
+    };
+    render
+        .clamp(MIN_PREPASS_SAMPLES, MAX_PREPASS_SAMPLES)
+        .next_multiple_of(PREPASS_CHUNK)
+}
 /// Target camera samples per pass over the image (after the first).
 const PASS_SAMPLES: u64 = 1 << 15;
 /// Rows per work unit.
@@ -345,8 +362,14 @@ impl Redistributor<'_> {
 
 /// The mean luminance of a BDPT camera sample's strategies, summed, over independent film
 /// positions: what the automatic deposit energy is made from.
-fn mean_sample_energy(bdpt: &Bdpt, camera: &CameraModel, seed: u64, control: &Control) -> f64 {
-    let chunks = PREPASS_SAMPLES / PREPASS_CHUNK;
+fn mean_sample_energy(
+    bdpt: &Bdpt,
+    camera: &CameraModel,
+    samples: u64,
+    seed: u64,
+    control: &Control,
+) -> f64 {
+    let chunks = samples / PREPASS_CHUNK;
     let sums: Vec<(f64, u64)> = (0..chunks)
         .into_par_iter()
         .map(|chunk| {
@@ -372,7 +395,7 @@ fn mean_sample_energy(bdpt: &Bdpt, camera: &CameraModel, seed: u64, control: &Co
         .collect();
     let rays: u64 = sums.iter().map(|&(_, r)| r).sum();
     control.rays.fetch_add(rays, Ordering::Relaxed);
-    sums.iter().map(|&(s, _)| s).sum::<f64>() / PREPASS_SAMPLES as f64
+    sums.iter().map(|&(s, _)| s).sum::<f64>() / (chunks * PREPASS_CHUNK) as f64
 }
 
 /// Runs ERPT over the film. `outcome.normalization` reports the deposit energy used.
@@ -389,7 +412,8 @@ pub(crate) fn run(
     let deposit_energy = if settings.deposit_energy > 0.0 {
         settings.deposit_energy
     } else {
-        let mean = mean_sample_energy(bdpt, camera, settings.seed, control);
+        let samples = prepass_samples(pixels as u64, settings.samples_per_pixel);
+        let mean = mean_sample_energy(bdpt, camera, samples, settings.seed, control);
         let e_d = (mean / chain_length as f64) as f32;
         if e_d > 0.0 && e_d.is_finite() {
             e_d
@@ -529,4 +553,20 @@ pub(crate) fn run(
         film.add_partial_splat_sums(sums.iter().map(value));
     }
     outcome
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_prepass_is_as_large_as_the_render_within_bounds() {
+        // A 4 × 4 thumbnail at 3 spp: the fewest, not 2^14.
+        assert_eq!(prepass_samples(16, 3), MIN_PREPASS_SAMPLES);
+        assert_eq!(prepass_samples(40 * 30, 2), 2560);
+        assert_eq!(prepass_samples(1920 * 1080, 16), MAX_PREPASS_SAMPLES);
+        // Until stopped, or more samples than a u64 holds: the most.
+        assert_eq!(prepass_samples(16, 0), MAX_PREPASS_SAMPLES);
+        assert_eq!(prepass_samples(u64::MAX, 5), MAX_PREPASS_SAMPLES);
+    }
 }
