@@ -74,10 +74,11 @@ const SEED_SALT: u64 = 0xe397_5a17_0000_0001;
 /// Salt of the hash that assigns camera samples to the filter's partial images.
 const BUFFER_SALT: u64 = 0xe397_b0ff_0000_0002;
 /// Most and fewest camera samples of the pre-pass that estimates the mean energy per sample
-/// (`prepass_samples`), in chunks of `PREPASS_CHUNK`.
+/// (`prepass_samples`), split into `PREPASS_CHUNKS` parallel work units: a fixed number, so
+/// the pre-pass allocates the same whatever its size.
 const MAX_PREPASS_SAMPLES: u64 = 1 << 14;
 const MIN_PREPASS_SAMPLES: u64 = 1 << 10;
-const PREPASS_CHUNK: u64 = 256;
+const PREPASS_CHUNKS: u64 = 64;
 
 /// The pre-pass's samples for a render of `samples_per_pixel` (0: until stopped) over
 /// `pixels`: as many as the render takes, within the bounds, in whole chunks.
@@ -89,7 +90,7 @@ fn prepass_samples(pixels: u64, samples_per_pixel: u32) -> u64 {
     };
     render
         .clamp(MIN_PREPASS_SAMPLES, MAX_PREPASS_SAMPLES)
-        .next_multiple_of(PREPASS_CHUNK)
+        .next_multiple_of(PREPASS_CHUNKS)
 }
 /// Target camera samples per pass over the image (after the first).
 const PASS_SAMPLES: u64 = 1 << 15;
@@ -369,14 +370,14 @@ fn mean_sample_energy(
     seed: u64,
     control: &Control,
 ) -> f64 {
-    let chunks = samples / PREPASS_CHUNK;
-    let sums: Vec<(f64, u64)> = (0..chunks)
+    let chunk_size = samples / PREPASS_CHUNKS;
+    let sums: Vec<(f64, u64)> = (0..PREPASS_CHUNKS)
         .into_par_iter()
         .map(|chunk| {
             let mut scratch = bdpt.scratch();
             let mut counters = SampleCounters::default();
             let mut sum = 0.0;
-            for i in chunk * PREPASS_CHUNK..(chunk + 1) * PREPASS_CHUNK {
+            for i in chunk * chunk_size..(chunk + 1) * chunk_size {
                 let mut rng = Rng::new(seed, PREPASS_STREAM + i);
                 let [u, v] = rng.uniform2();
                 let (x, y) = (u * camera.width as f32, v * camera.height as f32);
@@ -395,7 +396,7 @@ fn mean_sample_energy(
         .collect();
     let rays: u64 = sums.iter().map(|&(_, r)| r).sum();
     control.rays.fetch_add(rays, Ordering::Relaxed);
-    sums.iter().map(|&(s, _)| s).sum::<f64>() / (chunks * PREPASS_CHUNK) as f64
+    sums.iter().map(|&(s, _)| s).sum::<f64>() / (PREPASS_CHUNKS * chunk_size) as f64
 }
 
 /// Runs ERPT over the film. `outcome.normalization` reports the deposit energy used.
@@ -563,7 +564,7 @@ mod tests {
     fn the_prepass_is_as_large_as_the_render_within_bounds() {
         // A 4 × 4 thumbnail at 3 spp: the fewest, not 2^14.
         assert_eq!(prepass_samples(16, 3), MIN_PREPASS_SAMPLES);
-        assert_eq!(prepass_samples(40 * 30, 2), 2560);
+        assert_eq!(prepass_samples(40 * 30, 2), 2432);
         assert_eq!(prepass_samples(1920 * 1080, 16), MAX_PREPASS_SAMPLES);
         // Until stopped, or more samples than a u64 holds: the most.
         assert_eq!(prepass_samples(16, 0), MAX_PREPASS_SAMPLES);
