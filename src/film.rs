@@ -1,5 +1,10 @@
 //! The film: per-pixel sums of radiance samples and the number of samples taken, turned into
 //! an image normalized pixel by pixel (so a partial render is still a valid estimate).
+//!
+//! Every sum is exact: values are rounded once to a fixed-point grid (`FixedPoint`) and
+//! added as integers, so a sum does not depend on the order of its terms. Films of work
+//! done apart (threads, processes, machines) merge into the bits of one film that did it
+//! all (`Film::merge`).
 
 use crate::filter::{FilterSettings, FilterStats, filter_splats};
 use crate::spectrum::Spectrum;
@@ -28,21 +33,101 @@ impl Splat {
     }
 }
 
+/// An exact sum of RGB values in units of a `FixedPoint`.
+pub type FixedRgb = [i128; 3];
+
+/// Fixed-point numbers for exact sums: 64 bits below a scale `2^exponent`, 63 above it.
+/// A value is rounded to the grid once, then added as an integer (wrapping, so any order
+/// gives the same bits). With the scale set to the scene's brightest light, contributions
+/// 2^-64 of it and below are rounded away and a pixel may sum to 2^61 times it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FixedPoint {
+    to_fixed: f64,
+    to_float: f64,
+}
+
+impl FixedPoint {
+    /// The bits below the scale.
+    const FRACTION_BITS: i32 = 64;
+    /// Largest magnitude of one rounded value, in units of the grid: its sum with a few
+    /// more stays within an i128.
+    const LIMIT: f64 = (1u128 << 125) as f64;
+
+    /// Fixed point below `2^exponent` (clamped to ±900, where f64 still holds the scale).
+    pub fn new(exponent: i32) -> FixedPoint {
+        let shift = Self::FRACTION_BITS - exponent.clamp(-900, 900);
+        FixedPoint {
+            to_fixed: 2f64.powi(shift),
+            to_float: 2f64.powi(-shift),
+        }
+    }
+
+    /// Fixed point scaled to values of about `brightest` (0, or not finite: about 1).
+    pub fn for_values_up_to(brightest: f32) -> FixedPoint {
+        let exponent = if brightest > 0.0 && brightest.is_finite() {
+            (brightest as f64).log2().ceil() as i32
+        } else {
+            0
+        };
+        FixedPoint::new(exponent)
+    }
+
+    /// `value` on the grid, rounded to the nearest point (ties to even); NaN is 0 and
+    /// magnitudes beyond the range are clamped.
+    #[inline]
+    pub fn fixed(&self, value: f64) -> i128 {
+        (value * self.to_fixed)
+            .clamp(-Self::LIMIT, Self::LIMIT)
+            .round_ties_even() as i128
+    }
+
+    #[inline]
+    pub fn float(&self, sum: i128) -> f64 {
+        sum as f64 * self.to_float
+    }
+
+    /// Adds `value` (each channel) to `sum`.
+    #[inline]
+    pub fn add(&self, sum: &mut FixedRgb, value: [f64; 3]) {
+        for (s, v) in sum.iter_mut().zip(value) {
+            *s = s.wrapping_add(self.fixed(v));
+        }
+    }
+
+    fn rgb(&self, sum: &FixedRgb) -> [f64; 3] {
+        sum.map(|s| self.float(s))
+    }
+}
+
+/// Adds `other` to `sums` element by element.
+fn add_sums(sums: &mut [FixedRgb], other: &[FixedRgb]) {
+    for (sum, other) in sums.iter_mut().zip(other) {
+        for (s, o) in sum.iter_mut().zip(other) {
+            *s = s.wrapping_add(*o);
+        }
+    }
+}
+
 pub struct Film {
     pub width: u32,
     pub height: u32,
-    /// Sum of radiance samples per pixel, RGB, in f64 so long renders do not lose precision.
-    sums: Vec<[f64; 3]>,
+    /// The fixed point of the sums in the scene's units of light (`sums`, `splats`,
+    /// `partials`) …
+    scene_units: FixedPoint,
+    /// … and of the chain layers, whose deposits are divided by their paths' values.
+    chain_units: FixedPoint,
+    /// Sum of radiance samples per pixel, RGB.
+    sums: Vec<FixedRgb>,
     /// Samples taken per pixel.
     counts: Vec<u32>,
     /// Sum of splats (light tracing) per pixel; empty when the estimator does not splat.
-    splats: Vec<[f64; 3]>,
+    splats: Vec<FixedRgb>,
     /// Light paths traced in all, the normalization of the splats.
     light_paths: u64,
     /// Metropolis chains' deposits per group of chains, `chain_layers[group * pixels +
     /// pixel]`, kept apart because each group is scaled by its own normalization, known only
-    /// when the render ends (24 bytes per pixel and group) …
-    chain_layers: Vec<[f64; 3]>,
+    /// when the render ends (48 bytes per pixel and group) …
+    chain_layers: Vec<FixedRgb>,
     /// … by these factors (one per group), on top of the splat scale.
     chain_layer_scales: Vec<f64>,
     /// Overrides the splat normalization (Metropolis: pixels / mutations per chain).
@@ -51,27 +136,51 @@ pub struct Film {
     filter: Option<FilterSettings>,
     /// … and the splats again, split into its partial images:
     /// `partials[pixel * buffers + buffer]`.
-    partials: Vec<[f32; 3]>,
+    partials: Vec<FixedRgb>,
 }
 
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
 pub struct FilmBand<'a> {
     pub first_row: u32,
     pub width: u32,
-    pub sums: &'a mut [[f64; 3]],
-    pub counts: &'a mut [u32],
+    units: FixedPoint,
+    sums: &'a mut [FixedRgb],
+    counts: &'a mut [u32],
+}
+
+impl FilmBand<'_> {
+    /// The band's pixels.
+    pub fn len(&self) -> usize {
+        self.counts.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.counts.is_empty()
+    }
+
+    /// Adds the sum of `count` samples to the band's pixel `i`.
+    #[inline]
+    pub fn add(&mut self, i: usize, sum: Spectrum, count: u32) {
+        self.units
+            .add(&mut self.sums[i], sum.to_array().map(|v| v as f64));
+        self.counts[i] += count;
+    }
 }
 
 impl Film {
-    pub fn new(width: u32, height: u32, with_splats: bool) -> Self {
+    /// A film whose sums are exact below `scene_units` (`FixedPoint::for_values_up_to` the
+    /// scene's brightest light).
+    pub fn new(width: u32, height: u32, with_splats: bool, scene_units: FixedPoint) -> Self {
         let pixels = width as usize * height as usize;
         Film {
             width,
             height,
-            sums: vec![[0.0; 3]; pixels],
+            scene_units,
+            chain_units: FixedPoint::new(0),
+            sums: vec![[0; 3]; pixels],
             counts: vec![0; pixels],
             splats: if with_splats {
-                vec![[0.0; 3]; pixels]
+                vec![[0; 3]; pixels]
             } else {
                 Vec::new()
             },
@@ -87,14 +196,14 @@ impl Film {
     /// Turns the post-process filter on: splats are also kept in its partial images, and
     /// the written image is filtered (`crate::filter`).
     pub fn enable_filter(&mut self, settings: FilterSettings) {
-        self.partials = vec![[0.0; 3]; self.splats.len() * settings.buffers as usize];
+        self.partials = vec![[0; 3]; self.splats.len() * settings.buffers as usize];
         self.filter = Some(settings);
     }
 
     /// Keeps the deposits of `groups` groups of Metropolis chains in layers of their own
     /// (`add_chain_splats`), each scaled by `set_chain_layer_scales` when written.
     pub fn enable_chain_layers(&mut self, groups: usize) {
-        self.chain_layers = vec![[0.0; 3]; self.counts.len() * groups];
+        self.chain_layers = vec![[0; 3]; self.counts.len() * groups];
         self.chain_layer_scales = vec![0.0; groups];
     }
 
@@ -119,7 +228,7 @@ impl Film {
     ) {
         let pixels = self.counts.len();
         let layer = &mut self.chain_layers[group * pixels..(group + 1) * pixels];
-        add_weighted(layer, splats, weight);
+        add_weighted(self.chain_units, layer, splats, weight);
         self.add_to_partial(splats, weight * partial_scale, buffer);
     }
 
@@ -144,16 +253,14 @@ impl Film {
     pub fn add_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>, light_paths: u64) {
         self.light_paths += light_paths;
         for (total, sum) in self.splats.iter_mut().zip(sums) {
-            for (t, s) in total.iter_mut().zip(sum) {
-                *t += s;
-            }
+            self.scene_units.add(total, sum);
         }
     }
 
     /// Adds `weight` × the splats of a work unit, in the unit's order, and with the filter
     /// on also to partial image `buffer` (taken modulo their number).
     pub fn add_weighted_splats(&mut self, splats: &[Splat], weight: f64, buffer: usize) {
-        add_weighted(&mut self.splats, splats, weight);
+        add_weighted(self.scene_units, &mut self.splats, splats, weight);
         self.add_to_partial(splats, weight, buffer);
     }
 
@@ -163,9 +270,8 @@ impl Film {
             let buffer = buffer % buffers;
             for splat in splats {
                 let partial = &mut self.partials[splat.pixel as usize * buffers + buffer];
-                for (s, v) in partial.iter_mut().zip(splat.value.to_array()) {
-                    *s += (v as f64 * weight) as f32;
-                }
+                let value = splat.value.to_array().map(|v| v as f64 * weight);
+                self.scene_units.add(partial, value);
             }
         }
     }
@@ -175,15 +281,14 @@ impl Film {
     /// `add_splat_sums`.
     pub fn add_partial_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>) {
         for (partial, sum) in self.partials.iter_mut().zip(sums) {
-            for (p, s) in partial.iter_mut().zip(sum) {
-                *p += s as f32;
-            }
+            self.scene_units.add(partial, sum);
         }
     }
 
     /// Splits the film into bands of `rows` rows for parallel iteration, in row order.
     pub fn par_bands(&mut self, rows: u32) -> impl IndexedParallelIterator<Item = FilmBand<'_>> {
         let width = self.width;
+        let units = self.scene_units;
         let band_pixels = (rows * width) as usize;
         self.sums
             .par_chunks_mut(band_pixels)
@@ -192,9 +297,42 @@ impl Film {
             .map(move |(band, (sums, counts))| FilmBand {
                 first_row: band as u32 * rows,
                 width,
+                units,
                 sums,
                 counts,
             })
+    }
+
+    /// Adds the work of `other`, a film of the same size and settings: the result has the
+    /// bits of one film that did the work of both. The chain layers' factors and the splat
+    /// scale are not work: they stay as set on `self`.
+    pub fn merge(&mut self, other: &Film) -> Result<(), String> {
+        let shape = |f: &Film| {
+            (
+                f.width,
+                f.height,
+                f.scene_units,
+                f.splats.len(),
+                f.chain_layers.len(),
+                f.partials.len(),
+            )
+        };
+        if shape(self) != shape(other) {
+            return Err(format!(
+                "the films differ in size, units or layers: {:?} and {:?}",
+                shape(self),
+                shape(other)
+            ));
+        }
+        add_sums(&mut self.sums, &other.sums);
+        for (count, other) in self.counts.iter_mut().zip(&other.counts) {
+            *count += other;
+        }
+        add_sums(&mut self.splats, &other.splats);
+        self.light_paths += other.light_paths;
+        add_sums(&mut self.chain_layers, &other.chain_layers);
+        add_sums(&mut self.partials, &other.partials);
+        Ok(())
     }
 
     /// Writes the estimate per pixel as RGB floats, rows top to bottom: the mean of the
@@ -203,13 +341,8 @@ impl Film {
     /// the splats are filtered (the pixels' own samples are not: they are a Metropolis
     /// render's direct pass), and `unfiltered`, if given, receives the image without it.
     pub fn write_rgb(&self, out: &mut [f32], unfiltered: Option<&mut [f32]>) -> FilterStats {
-        let combined;
-        let splats = if self.chain_layers.is_empty() {
-            &self.splats
-        } else {
-            combined = self.splats_with_chain_layers();
-            &combined
-        };
+        let splats = self.splats_with_chain_layers();
+        let splats = &splats;
         let Some(filter) = &self.filter else {
             self.write_rgb_with(out, splats);
             if let Some(unfiltered) = unfiltered {
@@ -217,7 +350,12 @@ impl Film {
             }
             return FilterStats::default();
         };
-        let (filtered, stats) = filter_splats(self.width as usize, filter, &self.partials, splats);
+        let partials: Vec<[f32; 3]> = self
+            .partials
+            .iter()
+            .map(|p| self.scene_units.rgb(p).map(|v| v as f32))
+            .collect();
+        let (filtered, stats) = filter_splats(self.width as usize, filter, &partials, splats);
         self.write_rgb_with(out, &filtered);
         if let Some(unfiltered) = unfiltered {
             self.write_rgb_with(unfiltered, splats);
@@ -225,13 +363,19 @@ impl Film {
         stats
     }
 
-    /// The splats plus every chain layer times its factor.
+    /// The splats plus every chain layer times its factor (empty without either).
     fn splats_with_chain_layers(&self) -> Vec<[f64; 3]> {
         let pixels = self.counts.len();
-        let mut combined = if self.splats.is_empty() {
+        let mut combined: Vec<[f64; 3]> = if self.splats.is_empty() {
+            if self.chain_layers.is_empty() {
+                return Vec::new();
+            }
             vec![[0.0; 3]; pixels]
         } else {
-            self.splats.clone()
+            self.splats
+                .iter()
+                .map(|s| self.scene_units.rgb(s))
+                .collect()
         };
         for (layer, &scale) in self
             .chain_layers
@@ -239,6 +383,7 @@ impl Film {
             .zip(&self.chain_layer_scales)
         {
             for (total, value) in combined.iter_mut().zip(layer) {
+                let value = self.chain_units.rgb(value);
                 for c in 0..3 {
                     total[c] += value[c] * scale;
                 }
@@ -263,6 +408,7 @@ impl Film {
             .enumerate()
         {
             let scale = if count > 0 { 1.0 / count as f64 } else { 0.0 };
+            let sum = self.scene_units.rgb(sum);
             let splat = splats.get(i).copied().unwrap_or([0.0; 3]);
             for c in 0..3 {
                 pixel[c] = (sum[c] * scale + splat[c] * splat_scale) as f32;
@@ -271,12 +417,129 @@ impl Film {
     }
 }
 
-/// Adds `weight` × each splat to its pixel of `sums`, in order.
-fn add_weighted(sums: &mut [[f64; 3]], splats: &[Splat], weight: f64) {
+/// Adds `weight` × each splat to its pixel of `sums`.
+fn add_weighted(units: FixedPoint, sums: &mut [FixedRgb], splats: &[Splat], weight: f64) {
     for splat in splats {
-        let sum = &mut sums[splat.pixel as usize];
-        for (s, v) in sum.iter_mut().zip(splat.value.to_array()) {
-            *s += v as f64 * weight;
+        let value = splat.value.to_array().map(|v| v as f64 * weight);
+        units.add(&mut sums[splat.pixel as usize], value);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+
+    #[test]
+    fn fixed_point_rounds_once_and_sums_in_any_order() {
+        let units = FixedPoint::new(0);
+        assert_eq!(units.fixed(1.0), 1 << 64);
+        assert_eq!(units.fixed(-0.5), -(1 << 63));
+        // Below half a unit of the grid rounds to 0; NaN is 0; the range is clamped.
+        assert_eq!(units.fixed(2f64.powi(-66)), 0);
+        assert_eq!(units.fixed(f64::NAN), 0);
+        assert_eq!(units.fixed(f64::INFINITY), 1 << 125);
+        assert_eq!(units.float(units.fixed(0.1)), 0.1);
+        // f64 sums of these depend on their order; fixed-point sums do not.
+        let values = [1e10, 1.0, -1e10, 3e-7, 0.1, 2.5e5];
+        let in_order = values.iter().fold(0i128, |s, &v| s + units.fixed(v));
+        let reversed = values.iter().rev().fold(0i128, |s, &v| s + units.fixed(v));
+        assert_eq!(in_order, reversed);
+        assert_ne!(values.iter().sum::<f64>(), values.iter().rev().sum::<f64>());
+        // The scale follows the scene's brightest light.
+        let bright = FixedPoint::for_values_up_to(3.0e9);
+        assert_eq!(bright.fixed(2f64.powi(32)), 1 << 64);
+        assert_eq!(FixedPoint::for_values_up_to(0.0), units);
+        assert_eq!(FixedPoint::for_values_up_to(f32::NAN), units);
+    }
+
+    /// Random splats of every kind the film takes, as work units: (pixel samples, splats,
+    /// chain deposits and their partials).
+    fn work_units(film: &Film, count: usize) -> Vec<Vec<Splat>> {
+        let pixels = (film.width * film.height) as u64;
+        let mut rng = Rng::new(7, 11);
+        (0..count)
+            .map(|_| {
+                (0..40)
+                    .map(|_| {
+                        let scale = 10f32.powi((rng.uniform() * 12.0) as i32 - 6);
+                        Splat {
+                            pixel: (rng.uniform() * pixels as f32) as u32 % pixels as u32,
+                            value: Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * scale,
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn blank(units: FixedPoint) -> Film {
+        let mut film = Film::new(5, 4, true, units);
+        film.enable_chain_layers(2);
+        film.enable_filter(FilterSettings {
+            buffers: 3,
+            strength: 0.45,
+            radius: 2,
+        });
+        film.set_chain_layer_scales(&[0.7, 1.3]);
+        film
+    }
+
+    fn add_work(film: &mut Film, units: &[(usize, &Vec<Splat>)]) {
+        for &(u, splats) in units {
+            film.add_splats(splats, 3);
+            film.add_weighted_splats(splats, 0.25, u);
+            film.add_chain_splats(u % 2, splats, 1.0 / 3.0, 0.5, u);
+            let mut bands = film.par_bands(2).collect::<Vec<_>>();
+            let band_count = bands.len();
+            let band = &mut bands[u % band_count];
+            for i in 0..band.len() {
+                let v = splats[i % splats.len()].value;
+                band.add(i, Spectrum::new(v.x, v.y, v.z), 2);
+            }
         }
+    }
+
+    fn image(film: &Film) -> Vec<f32> {
+        let mut out = vec![0.0; (film.width * film.height * 3) as usize];
+        film.write_rgb(&mut out, None);
+        out
+    }
+
+    #[test]
+    fn films_of_work_done_apart_merge_into_the_bits_of_one() {
+        let units = FixedPoint::for_values_up_to(40.0);
+        let mut whole = blank(units);
+        let work = work_units(&whole, 24);
+        let indexed: Vec<(usize, &Vec<Splat>)> = work.iter().enumerate().collect();
+        add_work(&mut whole, &indexed);
+        let expected = image(&whole);
+        assert!(expected.iter().all(|v| v.is_finite()) && expected.iter().any(|&v| v > 0.0));
+
+        // Split into 1 to 5 parts by interleaving, each part in reverse order, merged from
+        // the last part to the first.
+        for parts in 1..=5 {
+            let mut films: Vec<Film> = (0..parts).map(|_| blank(units)).collect();
+            for (p, film) in films.iter_mut().enumerate() {
+                let mine: Vec<(usize, &Vec<Splat>)> = indexed
+                    .iter()
+                    .rev()
+                    .filter(|(u, _)| u % parts == p)
+                    .copied()
+                    .collect();
+                add_work(film, &mine);
+            }
+            let mut merged = blank(units);
+            for film in films.iter().rev() {
+                merged.merge(film).unwrap();
+            }
+            assert_eq!(image(&merged), expected, "{parts} parts");
+        }
+
+        // Films of another shape or scale are refused.
+        let mut other = Film::new(5, 4, true, units);
+        assert!(other.merge(&whole).is_err());
+        let mut other = blank(FixedPoint::new(0));
+        assert!(other.merge(&whole).unwrap_err().contains("differ"));
     }
 }

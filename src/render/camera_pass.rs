@@ -90,7 +90,7 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
             let (first, end) = (indices.start, indices.end);
             film.par_bands(BAND_ROWS)
                 .zip(states.par_iter_mut())
-                .for_each(|(band, state)| {
+                .for_each(|(mut band, state)| {
                     state.splats.clear();
                     state.light_paths = 0;
                     // After the first pass a stop skips the bands not yet begun: pixels
@@ -100,9 +100,7 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                     }
                     let mut counters = SampleCounters::default();
                     let mut invalid = 0u64;
-                    for (i, (sum, count)) in
-                        band.sums.iter_mut().zip(band.counts.iter_mut()).enumerate()
-                    {
+                    for i in 0..band.len() {
                         let x = i as u32 % width;
                         let y = band.first_row + i as u32 / width;
                         let mut pixel_sum = Spectrum::ZERO;
@@ -127,12 +125,9 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                                 invalid += 1;
                             }
                         }
-                        for c in 0..3 {
-                            sum[c] += pixel_sum[c] as f64;
-                        }
-                        *count += end - first;
+                        band.add(i, pixel_sum, end - first);
                     }
-                    let band_samples = band.counts.len() as u64 * (end - first) as u64;
+                    let band_samples = band.len() as u64 * (end - first) as u64;
                     state.light_paths = band_samples;
                     control
                         .samples_done

@@ -16,7 +16,7 @@ pub use stats::{RenderStats, StopReason};
 
 use crate::control::Control;
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
-use crate::film::Film;
+use crate::film::{Film, FixedPoint, FixedRgb};
 use crate::filter::FilterSettings;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::driver::MetropolisOutcome;
@@ -278,7 +278,7 @@ fn render_into(
         Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
         Algorithm::Erpt => Estimator::Erpt(&bdpt),
     };
-    let mut film = try_film(settings, estimator.chain_groups())?;
+    let mut film = try_film(settings, estimator.chain_groups(), scene)?;
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit
     // only) there is no plan.
@@ -392,7 +392,7 @@ impl Drop for SignalOnDrop<'_> {
 
 /// Allocates the film (with a layer for each of `chain_groups` groups of Metropolis chains),
 /// reporting failure as a status instead of aborting.
-fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
+fn try_film(settings: &RenderSettings, chain_groups: usize, scene: &Scene) -> Result<Film> {
     let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;
     // Probe the largest allocations first: `vec!` would abort the process on failure.
@@ -402,23 +402,24 @@ fn try_film(settings: &RenderSettings, chain_groups: usize) -> Result<Film> {
             format!("could not allocate the film for {width} x {height} pixels"),
         )
     };
-    let mut probe: Vec<[f64; 3]> = Vec::new();
+    let mut probe: Vec<FixedRgb> = Vec::new();
     probe
         .try_reserve_exact(pixels)
         .map_err(|_| out_of_memory())?;
     drop(probe);
     let buffers = settings.filter_buffers;
-    let mut partials: Vec<[f32; 3]> = Vec::new();
+    let mut partials: Vec<FixedRgb> = Vec::new();
     partials
         .try_reserve_exact(pixels * buffers as usize)
         .map_err(|_| out_of_memory())?;
     drop(partials);
-    let mut layers: Vec<[f64; 3]> = Vec::new();
+    let mut layers: Vec<FixedRgb> = Vec::new();
     layers
         .try_reserve_exact(pixels * chain_groups)
         .map_err(|_| out_of_memory())?;
     drop(layers);
-    let mut film = Film::new(width, height, settings.algorithm != Algorithm::Path);
+    let units = FixedPoint::for_values_up_to(scene.brightest_light());
+    let mut film = Film::new(width, height, settings.algorithm != Algorithm::Path, units);
     if chain_groups > 0 {
         film.enable_chain_layers(chain_groups);
     }

@@ -488,6 +488,11 @@ impl Scene {
         }
     }
 
+    /// The scale of the scene's units of light (`SceneLights::brightest`).
+    pub(crate) fn brightest_light(&self) -> f32 {
+        self.lights.brightest()
+    }
+
     pub fn info(&self) -> SceneInfo {
         self.info
     }

@@ -236,6 +236,27 @@ pub(crate) struct EmissionSample {
 }
 
 impl SceneLights {
+    /// The largest of the lights' emitted radiance, intensity and irradiance (per channel),
+    /// and of the lights at infinity their luminance integral: the scale of the scene's
+    /// units, which the film's fixed-point sums are set to (`crate::film::FixedPoint`).
+    pub fn brightest(&self) -> f32 {
+        let max = |s: Spectrum| s.to_array().into_iter().fold(0.0f32, f32::max);
+        let mut brightest = self
+            .infinite
+            .as_ref()
+            .map_or(0.0, |light| light.luminance_integral());
+        for light in &self.lights {
+            let value = match light {
+                Light::Area(area) => max(area.emission),
+                Light::Point(point) => max(point.intensity),
+                Light::Directional { irradiance, .. } => max(*irradiance),
+                Light::Infinite => 0.0,
+            };
+            brightest = brightest.max(value);
+        }
+        brightest
+    }
+
     /// Picks a light by power with `u_select` and a point or direction on it with
     /// `u_point`; `None` if the scene has no lights or the sample has zero density. The
     /// caller draws both numbers (always, whether or not there are lights, where its
