@@ -520,12 +520,8 @@ mod tests {
     use super::*;
     use crate::scene::{Material, SceneDesc};
 
-    /// Light so faint that paths' values are subnormal floats (colours near 1e-40, found by
-    /// the capi_scene fuzzer): the Metropolis deposits, a path's contribution over its value,
-    /// stay finite and the image keeps its brightness.
-    #[test]
-    fn metropolis_with_subnormal_light() {
-        let radiance = 1e-40f32;
+    /// A square emitter of `radiance` (diffuse 0.5) filling the image of the camera.
+    fn emitter_filling_the_image(radiance: f32) -> (Scene, Camera) {
         let scene = Scene::new(&SceneDesc {
             positions: &[
                 -2.0, -2.0, 0.0, 2.0, -2.0, 0.0, 2.0, 2.0, 0.0, -2.0, 2.0, 0.0,
@@ -542,6 +538,16 @@ mod tests {
             fov_y_deg: 30.0,
             ..Default::default()
         };
+        (scene, camera)
+    }
+
+    /// Light so faint that paths' values are subnormal floats (colours near 1e-40, found by
+    /// the capi_scene fuzzer): the Metropolis deposits, a path's contribution over its value,
+    /// stay finite and the image keeps its brightness.
+    #[test]
+    fn metropolis_with_subnormal_light() {
+        let radiance = 1e-40f32;
+        let (scene, camera) = emitter_filling_the_image(radiance);
         for algorithm in [Algorithm::Pssmlt, Algorithm::Mmlt, Algorithm::PssmltBdpt] {
             let settings = RenderSettings {
                 width: 4,
@@ -570,22 +576,7 @@ mod tests {
     /// radiance 1 filling the image.
     #[test]
     fn metropolis_with_a_max_depth_below_the_direct_pass() {
-        let scene = Scene::new(&SceneDesc {
-            positions: &[
-                -2.0, -2.0, 0.0, 2.0, -2.0, 0.0, 2.0, 2.0, 0.0, -2.0, 2.0, 0.0,
-            ],
-            indices: &[0, 1, 2, 0, 2, 3],
-            materials: &[Material::diffuse([0.5; 3]).with_emission([1.0; 3])],
-            ..Default::default()
-        })
-        .unwrap();
-        let camera = Camera {
-            eye: [0.0, 0.0, 3.0],
-            target: [0.0; 3],
-            up: [0.0, 1.0, 0.0],
-            fov_y_deg: 30.0,
-            ..Default::default()
-        };
+        let (scene, camera) = emitter_filling_the_image(1.0);
         for algorithm in [
             Algorithm::Pssmlt,
             Algorithm::Mmlt,
