@@ -267,6 +267,11 @@
 #define MLT_MAX_FILTER_RADIUS 32
 
 /**
+ * Most jobs a render can be split into.
+ */
+#define MLT_MAX_JOBS (1 << 16)
+
+/**
  * Largest accepted image width or height.
  */
 #define MLT_MAX_IMAGE_SIDE (1 << 16)
@@ -1135,6 +1140,8 @@ typedef struct MltHit {
   float u;
   float v;
 } MltHit;
+
+
 
 
 

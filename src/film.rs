@@ -7,6 +7,7 @@
 //! all (`Film::merge`).
 
 use crate::filter::{FilterSettings, FilterStats, filter_splats};
+use crate::render::jobs::wire::{Reader, Writer};
 use crate::spectrum::Spectrum;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -415,6 +416,125 @@ impl Film {
             }
         }
     }
+}
+
+/// Writes a film's sums, counts and settings (`crate::render::jobs`: a job's partial result).
+pub(crate) fn write_film(film: &Film, w: &mut Writer) {
+    fn sums(w: &mut Writer, sums: &[FixedRgb]) {
+        w.len(sums.len());
+        for v in sums.iter().flatten() {
+            w.varint_i128(*v);
+        }
+    }
+    fn units(w: &mut Writer, units: FixedPoint) {
+        w.f64(units.to_fixed);
+        w.f64(units.to_float);
+    }
+    w.u32(film.width);
+    w.u32(film.height);
+    units(w, film.scene_units);
+    units(w, film.chain_units);
+    sums(w, &film.sums);
+    for &count in &film.counts {
+        w.varint_i128(count as i128);
+    }
+    sums(w, &film.splats);
+    w.u64(film.light_paths);
+    sums(w, &film.chain_layers);
+    w.len(film.chain_layer_scales.len());
+    for &scale in &film.chain_layer_scales {
+        w.f64(scale);
+    }
+    w.bool(film.splat_scale.is_some());
+    w.f64(film.splat_scale.unwrap_or(0.0));
+    w.bool(film.filter.is_some());
+    let filter = film.filter.unwrap_or(FilterSettings {
+        buffers: 0,
+        strength: 0.0,
+        radius: 0,
+    });
+    w.u32(filter.buffers);
+    w.f32(filter.strength);
+    w.u32(filter.radius);
+    sums(w, &film.partials);
+}
+
+/// Reads what `write_film` wrote; sizes that do not fit the film are an error.
+pub(crate) fn read_film(r: &mut Reader) -> Result<Film, crate::Error> {
+    fn sums(r: &mut Reader, multiple_of: usize) -> Result<Vec<FixedRgb>, crate::Error> {
+        let n = r.len(3)?;
+        if multiple_of == 0 || n % multiple_of != 0 {
+            return Err(r.malformed("a layer of sums does not fit the film"));
+        }
+        (0..n)
+            .map(|_| Ok([r.varint_i128()?, r.varint_i128()?, r.varint_i128()?]))
+            .collect()
+    }
+    fn units(r: &mut Reader) -> Result<FixedPoint, crate::Error> {
+        Ok(FixedPoint {
+            to_fixed: r.f64()?,
+            to_float: r.f64()?,
+        })
+    }
+    let width = r.u32()?;
+    let height = r.u32()?;
+    let pixels = width as usize * height as usize;
+    if pixels == 0 {
+        return Err(r.malformed("the film has no pixels"));
+    }
+    let scene_units = units(r)?;
+    let chain_units = units(r)?;
+    let film_sums = sums(r, pixels)?;
+    if film_sums.len() != pixels {
+        return Err(r.malformed("the film's sums do not fit its size"));
+    }
+    let counts = (0..pixels)
+        .map(|_| u32::try_from(r.varint_i128()?).map_err(|_| r.malformed("a sample count")))
+        .collect::<Result<Vec<u32>, _>>()?;
+    let splats = sums(r, pixels)?;
+    if splats.len() > pixels {
+        return Err(r.malformed("the film has more splats than pixels"));
+    }
+    let light_paths = r.u64()?;
+    let chain_layers = sums(r, pixels)?;
+    let layers = r.len(8)?;
+    if layers * pixels != chain_layers.len() {
+        return Err(r.malformed("the chain layers and their factors differ in number"));
+    }
+    let chain_layer_scales = (0..layers).map(|_| r.f64()).collect::<Result<_, _>>()?;
+    let has_splat_scale = r.bool()?;
+    let splat_scale = r.f64()?;
+    let splat_scale = has_splat_scale.then_some(splat_scale);
+    let filtered = r.bool()?;
+    let filter = FilterSettings {
+        buffers: r.u32()?,
+        strength: r.f32()?,
+        radius: r.u32()?,
+    };
+    let partials = sums(r, pixels)?;
+    let expected_partials = if filtered {
+        splats.len() * filter.buffers as usize
+    } else {
+        0
+    };
+    if partials.len() != expected_partials {
+        return Err(r.malformed("the filter's partial images do not fit the film"));
+    }
+    Ok(Film {
+        width,
+        height,
+        scene_units,
+        chain_units,
+        sums: film_sums,
+        counts,
+        splats,
+        light_paths,
+        chain_layers,
+        chain_layer_scales,
+        splat_scale,
+        filter: filtered.then_some(filter),
+        partials,
+    })
 }
 
 /// Adds `weight` × each splat to its pixel of `sums`.

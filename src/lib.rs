@@ -51,6 +51,7 @@ pub use error::{Error, MltStatus, Result};
 pub use filter::FilterStats;
 pub use integrators::mlt::driver::{Mutation, MutationCounts, MutationWeights};
 pub use integrators::mlt::normalization::NormalizationStats;
+pub use render::jobs;
 pub use render::{
     Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
 };

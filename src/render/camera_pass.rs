@@ -3,6 +3,7 @@
 //! `integrators::camera_passes`, each band's samples added to its pixels and its splats
 //! to the film.
 
+use super::JobShare;
 use crate::control::Control;
 use crate::film::{Film, Splat};
 use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
@@ -37,6 +38,17 @@ pub(super) struct CameraSampleJob<'a, E: PixelEstimator> {
     samples: PixelSamples,
     schedule: PassSchedule,
     states: Vec<BandState<E::Scratch>>,
+    /// The bands this run samples (a job's share of a split render).
+    share: JobShare,
+}
+
+/// Pixels of the bands of the image of `camera` that `share` owns.
+pub(super) fn pixels_in_share(camera: &CameraModel, share: JobShare) -> u64 {
+    let bands = camera.height.div_ceil(BAND_ROWS);
+    (0..bands)
+        .filter(|&band| share.owns(band as u64))
+        .map(|band| (camera.height - band * BAND_ROWS).min(BAND_ROWS) as u64 * camera.width as u64)
+        .sum()
 }
 
 impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
@@ -74,7 +86,15 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
             },
             schedule,
             states,
+            share: JobShare::WHOLE,
         }
+    }
+
+    /// Samples only the bands `share` owns: every pass of a band is one work unit, the
+    /// same whatever the number of jobs.
+    pub(super) fn with_share(mut self, share: JobShare) -> Self {
+        self.share = share;
+        self
     }
 
     pub(super) fn run(&mut self, film: &mut Film, control: &Control) {
@@ -86,13 +106,18 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
     pub(super) fn run_until(&mut self, film: &mut Film, control: &Control, target: u32) {
         let width = film.width;
         let states = &mut self.states;
+        let share = self.share;
         while let Some(indices) = self.schedule.next_pass(target, control) {
             let (first, end) = (indices.start, indices.end);
             film.par_bands(BAND_ROWS)
                 .zip(states.par_iter_mut())
-                .for_each(|(mut band, state)| {
+                .enumerate()
+                .for_each(|(index, (mut band, state))| {
                     state.splats.clear();
                     state.light_paths = 0;
+                    if !share.owns(index as u64) {
+                        return;
+                    }
                     // After the first pass a stop skips the bands not yet begun: pixels
                     // keep their own sample counts.
                     if first > 0 && control.should_stop() {

@@ -4,6 +4,7 @@
 //! (path tracer, BDPT, a Metropolis render's direct pass) in `camera_pass`.
 
 mod camera_pass;
+pub mod jobs;
 mod settings;
 mod stats;
 
@@ -17,7 +18,7 @@ pub use stats::{RenderStats, StopReason};
 use crate::control::Control;
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::{Film, FixedPoint, FixedRgb};
-use crate::filter::FilterSettings;
+use crate::filter::{FilterSettings, FilterStats};
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::driver::MetropolisOutcome;
 use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
@@ -69,6 +70,7 @@ impl Estimator<'_> {
         camera: &CameraModel,
         settings: &RenderSettings,
         direct: Option<&PathTracer>,
+        share: JobShare,
         film: &mut Film,
         control: &Control,
     ) -> MetropolisOutcome {
@@ -102,11 +104,15 @@ impl Estimator<'_> {
         };
         match *self {
             Estimator::Path(estimator) => {
-                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
+                CameraSampleJob::new(estimator, camera, seed, spp, film)
+                    .with_share(share)
+                    .run(film, control);
                 MetropolisOutcome::default()
             }
             Estimator::Bdpt(estimator) => {
-                CameraSampleJob::new(estimator, camera, seed, spp, film).run(film, control);
+                CameraSampleJob::new(estimator, camera, seed, spp, film)
+                    .with_share(share)
+                    .run(film, control);
                 MetropolisOutcome::default()
             }
             Estimator::Pssmlt(target) => {
@@ -196,7 +202,6 @@ fn render_into(
     progress: Option<Progress>,
 ) -> Result<RenderStats> {
     settings.validate()?;
-    camera.validate()?;
     let needed = settings.output_len()?;
     let shortest = rgb_out
         .len()
@@ -206,6 +211,55 @@ fn render_into(
             "the output buffer holds {shortest} floats but a {} x {} RGB image needs {needed}",
             settings.width, settings.height
         )));
+    }
+    let (film, mut stats) = render_film(scene, camera, settings, JobShare::WHOLE, progress)?;
+    stats.filter = film.write_rgb(
+        &mut rgb_out[..needed],
+        unfiltered_out.map(|u| &mut u[..needed]),
+    );
+    Ok(stats)
+}
+
+/// Which of a render's work units a run does: those whose index is `index` modulo `count`
+/// (a job of a render split across machines, `jobs`). The units are fixed by the render's
+/// settings, never by the number of jobs, so any split adds up to the same work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct JobShare {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl JobShare {
+    /// The whole render, in one run.
+    pub const WHOLE: JobShare = JobShare { index: 0, count: 1 };
+
+    #[inline]
+    pub fn owns(&self, unit: u64) -> bool {
+        unit % self.count as u64 == self.index as u64
+    }
+}
+
+/// Renders `share` of the work onto a film, without writing the image: what `render` and a
+/// job of a split render (`jobs`) have in common. The stats' `filter` is left at zero.
+fn render_film(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    share: JobShare,
+    progress: Option<Progress>,
+) -> Result<(Film, RenderStats)> {
+    settings.validate()?;
+    camera.validate()?;
+    if share != JobShare::WHOLE
+        && (settings.algorithm.is_metropolis() || settings.algorithm == Algorithm::Erpt)
+    {
+        return Err(Error::new(
+            crate::error::MLT_STATUS_UNSUPPORTED,
+            format!(
+                "{:?} cannot be split into jobs yet: only the path tracer and BDPT can",
+                settings.algorithm
+            ),
+        ));
     }
     let own_pool;
     let pool = if settings.threads == 0 {
@@ -281,7 +335,12 @@ fn render_into(
     let mut film = try_film(settings, estimator.chain_groups(), scene)?;
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit
-    // only) there is no plan.
+    // only) there is no plan. A job's share may hold no work at all.
+    let counted = if settings.algorithm.is_metropolis() {
+        settings.mutations_per_pixel > 0
+    } else {
+        settings.samples_per_pixel > 0
+    };
     let planned = if settings.algorithm.is_metropolis() {
         let direct_samples = if direct.is_some() {
             settings.direct_samples_per_mutation as u64 * settings.mutations_per_pixel as u64
@@ -294,7 +353,7 @@ fn render_into(
             0
         }
     } else {
-        settings.samples_per_pixel as u64 * pixels
+        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(&model, share)
     };
 
     let mut progress = progress;
@@ -309,7 +368,7 @@ fn render_into(
         let worker = s.spawn(move || {
             // Signals even when the render panics, so the caller never waits forever.
             let _signal = SignalOnDrop(done);
-            pool.install(|| estimator.run(model, settings, direct, film, control))
+            pool.install(|| estimator.run(model, settings, direct, share, film, control))
         });
         while !done.wait(PROGRESS_INTERVAL) {
             if let Some(callback) = progress.as_mut() {
@@ -330,13 +389,9 @@ fn render_into(
             "a rendering thread panicked; this is a bug in mlt",
         ));
     };
-    let filter = film.write_rgb(
-        &mut rgb_out[..needed],
-        unfiltered_out.map(|u| &mut u[..needed]),
-    );
     let stop = if control.was_cancelled() {
         StopReason::Cancelled
-    } else if planned == 0 || control.work_done() < planned {
+    } else if !counted || control.work_done() < planned {
         StopReason::TimeLimitReached
     } else {
         StopReason::Completed
@@ -345,7 +400,7 @@ fn render_into(
         // The last word is always 1.0 for a finished render; a cancel now changes nothing.
         let _ = callback(1.0);
     }
-    Ok(RenderStats {
+    let stats = RenderStats {
         stop,
         samples: control.samples_done.load(Ordering::Relaxed),
         mutations: control.mutations_done.load(Ordering::Relaxed),
@@ -357,8 +412,9 @@ fn render_into(
         normalization: metropolis.normalization,
         mutation_counts: metropolis.mutation_counts,
         mutation_weights: metropolis.mutation_weights,
-        filter,
-    })
+        filter: FilterStats::default(),
+    };
+    Ok((film, stats))
 }
 
 /// Tells the calling thread the render finished. A mutex and condition variable rather than

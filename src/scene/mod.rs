@@ -128,6 +128,71 @@ pub struct Scene {
     /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
     pub(crate) ray_epsilon: f32,
     info: SceneInfo,
+    fingerprint: u64,
+}
+
+/// XXH3-64 of a scene description: its arrays as bytes, its small structs (materials,
+/// lights, texture settings) by their `Debug` form, which names every field and prints
+/// every float exactly.
+fn fingerprint(desc: &SceneDesc) -> u64 {
+    use xxhash_rust::xxh3::Xxh3;
+    fn words<T: Copy>(hasher: &mut Xxh3, values: &[T], bytes: impl Fn(T) -> [u8; 4]) {
+        hasher.update(&(values.len() as u64).to_le_bytes());
+        let mut buffer = [0u8; 1024];
+        for chunk in values.chunks(buffer.len() / 4) {
+            for (slot, &v) in buffer.chunks_exact_mut(4).zip(chunk) {
+                slot.copy_from_slice(&bytes(v));
+            }
+            hasher.update(&buffer[..chunk.len() * 4]);
+        }
+    }
+    let floats = |h: &mut Xxh3, v: &[f32]| words(h, v, f32::to_le_bytes);
+    let mut h = Xxh3::new();
+    floats(&mut h, desc.positions);
+    words(&mut h, desc.indices, u32::to_le_bytes);
+    words(&mut h, desc.material_ids, u32::to_le_bytes);
+    floats(&mut h, desc.normals);
+    floats(&mut h, desc.texcoords);
+    floats(&mut h, desc.tangents);
+    floats(&mut h, desc.colors);
+    let LightsDesc {
+        environment,
+        sun,
+        punctual,
+    } = desc.lights;
+    if let Some(environment) = environment {
+        floats(&mut h, environment.pixels);
+    }
+    let small = format!(
+        "{:?} {:?} {:?} {:?} {:?}",
+        desc.materials,
+        environment.map(|e| (e.width, e.height, e.rotation_degrees, e.scale)),
+        sun,
+        punctual,
+        desc.backend,
+    );
+    h.update(small.as_bytes());
+    for texture in desc.textures {
+        let settings = format!(
+            "{} {} {} {:?} {:?} {:?} {:?}",
+            texture.width,
+            texture.height,
+            texture.channels,
+            texture.encoding,
+            texture.wrap_u,
+            texture.wrap_v,
+            texture.filter
+        );
+        h.update(settings.as_bytes());
+        match &texture.data {
+            crate::texture::TexelData::U8(bytes) => {
+                h.update(&(bytes.len() as u64).to_le_bytes());
+                h.update(bytes);
+            }
+            crate::texture::TexelData::F32(values) => floats(&mut h, values),
+        }
+    }
+    h.digest()
 }
 
 impl Scene {
@@ -292,7 +357,15 @@ impl Scene {
             internal_to_input,
             ray_epsilon: magnitude * 2e-5,
             info,
+            fingerprint: fingerprint(desc),
         })
+    }
+
+    /// A hash of everything the scene was built from: the jobs of a render split across
+    /// machines (`crate::render::jobs`) check that they all render the scene their plan was
+    /// made for.
+    pub fn fingerprint(&self) -> u64 {
+        self.fingerprint
     }
 
     /// The area density with which `sample_light` picks a point on internal triangle

@@ -1,0 +1,534 @@
+//! A render split into jobs for many machines, merged into the bits of one render.
+//!
+//! 1. [`plan`] fixes what the render is (scene fingerprint, camera, settings) and returns a
+//!    [`RenderPlan`], which travels as bytes ([`RenderPlan::to_bytes`]).
+//! 2. [`render_job`] renders job k of N of a plan on any machine holding the same scene and
+//!    returns a [`PartialRender`]: its film's exact sums and its counters, also as bytes.
+//! 3. [`merge`] adds the partial results of all N jobs, in any order, and writes the image.
+//!
+//! Why the merge is exact: a render's work is cut into units fixed by its settings alone
+//! (for the camera-sample algorithms, each pass over each band of rows), job k does the units
+//! whose index is k modulo N, and the film sums in fixed point (`film::FixedPoint`), where
+//! addition is associative. So the merged film holds the bits of the film one machine would
+//! have, for any N and any order of the partial results.
+//!
+//! Every buffer carries a magic number, the format and library versions and a checksum; a
+//! partial result names its plan's id and its job. A buffer from another plan, scene or
+//! version, a corrupted or truncated one, a job missing or given twice, is an error.
+
+pub(crate) mod wire;
+
+use super::{JobShare, Progress, RenderSettings, RenderStats, StopReason, render_film};
+use crate::error::{Error, MLT_STATUS_INVALID_ARGUMENT, Result};
+use crate::film::{Film, read_film, write_film};
+use crate::filter::FilterStats;
+use crate::integrators::mlt::driver::{MutationCounts, MutationWeights};
+use crate::integrators::mlt::normalization::NormalizationStats;
+use crate::render::Algorithm;
+use crate::scene::{Camera, Scene};
+use wire::{Reader, Writer};
+
+const PLAN_MAGIC: &[u8; 8] = b"MLTPLAN\0";
+const PARTIAL_MAGIC: &[u8; 8] = b"MLTPART\0";
+
+/// Most jobs a render can be split into.
+pub const MLT_MAX_JOBS: u32 = 1 << 16;
+
+/// What a split render is: made once by [`plan`], handed to every job and to the merge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderPlan {
+    settings: RenderSettings,
+    camera: Camera,
+    /// `Scene::fingerprint` of the scene the plan was made for.
+    scene: u64,
+    /// A hash of the plan's bytes: partial results name the plan they belong to.
+    id: u64,
+}
+
+/// Plans a render of `scene` to be split into jobs. Validates everything `render` would;
+/// `settings.threads` is only the default of the jobs, which each choose their own.
+pub fn plan(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result<RenderPlan> {
+    settings.validate()?;
+    camera.validate()?;
+    camera.model(settings.width, settings.height).validate()?;
+    let mut plan = RenderPlan {
+        settings: *settings,
+        camera: *camera,
+        scene: scene.fingerprint(),
+        id: 0,
+    };
+    let mut w = Writer::default();
+    plan.write_contents(&mut w);
+    plan.id = xxhash_rust::xxh3::xxh3_64(&w.finish(PLAN_MAGIC));
+    Ok(plan)
+}
+
+impl RenderPlan {
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Identifies the plan: a hash of its contents, named by its partial results.
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        self.write_contents(&mut w);
+        w.u64(self.id);
+        w.finish(PLAN_MAGIC)
+    }
+
+    pub fn from_bytes(bytes: &[u8]) -> Result<RenderPlan> {
+        let mut r = Reader::open(bytes, PLAN_MAGIC, "render plan")?;
+        let settings = read_settings(&mut r)?;
+        let camera = read_camera(&mut r)?;
+        let scene = r.u64()?;
+        let id = r.u64()?;
+        r.end()?;
+        let plan = RenderPlan {
+            settings,
+            camera,
+            scene,
+            id,
+        };
+        let mut w = Writer::default();
+        plan.write_contents(&mut w);
+        if xxhash_rust::xxh3::xxh3_64(&w.finish(PLAN_MAGIC)) != id {
+            return Err(Error::new(
+                MLT_STATUS_INVALID_ARGUMENT,
+                "the render plan's id does not match its contents",
+            ));
+        }
+        settings.validate()?;
+        camera.validate()?;
+        Ok(plan)
+    }
+
+    fn write_contents(&self, w: &mut Writer) {
+        write_settings(w, &self.settings);
+        write_camera(w, &self.camera);
+        w.u64(self.scene);
+    }
+}
+
+/// What one job rendered: its film's exact sums and its counters.
+pub struct PartialRender {
+    plan: u64,
+    job: u32,
+    jobs: u32,
+    film: Film,
+    stats: RenderStats,
+}
+
+impl PartialRender {
+    /// This is job `job()` of `jobs()`.
+    pub fn job(&self) -> u32 {
+        self.job
+    }
+
+    pub fn jobs(&self) -> u32 {
+        self.jobs
+    }
+
+    /// The id of the plan it belongs to.
+    pub fn plan_id(&self) -> u64 {
+        self.plan
+    }
+
+    /// What the job did (its `filter` is zero: the filter runs at the merge).
+    pub fn stats(&self) -> &RenderStats {
+        &self.stats
+    }
+
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u64(self.plan);
+        w.u32(self.job);
+        w.u32(self.jobs);
+        write_stats(&mut w, &self.stats);
+        write_film(&self.film, &mut w);
+        w.finish(PARTIAL_MAGIC)
+    }
+
+    pub fn from_bytes(bytes: &[u8]) -> Result<PartialRender> {
+        let mut r = Reader::open(bytes, PARTIAL_MAGIC, "partial render")?;
+        let plan = r.u64()?;
+        let job = r.u32()?;
+        let jobs = r.u32()?;
+        let stats = read_stats(&mut r)?;
+        let film = read_film(&mut r)?;
+        r.end()?;
+        if jobs == 0 || jobs > MLT_MAX_JOBS || job >= jobs {
+            return Err(Error::new(
+                MLT_STATUS_INVALID_ARGUMENT,
+                format!("the partial render claims to be job {job} of {jobs}"),
+            ));
+        }
+        Ok(PartialRender {
+            plan,
+            job,
+            jobs,
+            film,
+            stats,
+        })
+    }
+}
+
+/// Renders job `job` of `jobs` (numbered from 0) of `plan` on `scene`, which must be built
+/// from the same description as the plan's (backend included: the two backends agree only
+/// to the last bits). `threads` (0: every core) and the progress callback are this job's
+/// own; the plan's time limit applies to each job.
+pub fn render_job(
+    scene: &Scene,
+    plan: &RenderPlan,
+    job: u32,
+    jobs: u32,
+    threads: u32,
+    progress: Option<Progress>,
+) -> Result<PartialRender> {
+    if jobs == 0 || jobs > MLT_MAX_JOBS {
+        return Err(Error::invalid(format!(
+            "jobs is {jobs}: a render splits into 1 to {MLT_MAX_JOBS} jobs"
+        )));
+    }
+    if job >= jobs {
+        return Err(Error::invalid(format!(
+            "job {job} does not exist: jobs are numbered 0 to {}",
+            jobs - 1
+        )));
+    }
+    if scene.fingerprint() != plan.scene {
+        return Err(Error::invalid(
+            "the scene is not the one the plan was made for: every job must build its scene from the same description (arrays, materials, lights, textures and backend)",
+        ));
+    }
+    let settings = RenderSettings {
+        threads,
+        ..plan.settings
+    };
+    let share = JobShare {
+        index: job,
+        count: jobs,
+    };
+    let (film, stats) = render_film(scene, &plan.camera, &settings, share, progress)?;
+    Ok(PartialRender {
+        plan: plan.id,
+        job,
+        jobs,
+        film,
+        stats,
+    })
+}
+
+/// Merges the partial results of every job of `plan`, given in any order, and writes the
+/// image into `rgb_out` (width × height × 3 floats) as `render` would. The stats add the
+/// jobs' counts; `seconds` is the sum of the jobs' times, `threads` the most any job used,
+/// `stop` the first of Cancelled, TimeLimitReached, Completed that some job reports.
+pub fn merge(
+    plan: &RenderPlan,
+    partials: impl IntoIterator<Item = PartialRender>,
+    rgb_out: &mut [f32],
+) -> Result<RenderStats> {
+    let needed = plan.settings.output_len()?;
+    if rgb_out.len() < needed {
+        return Err(Error::invalid(format!(
+            "the output buffer holds {} floats but a {} x {} RGB image needs {needed}",
+            rgb_out.len(),
+            plan.settings.width,
+            plan.settings.height
+        )));
+    }
+    let mut merged: Option<(Film, RenderStats)> = None;
+    let mut seen: Vec<bool> = Vec::new();
+    for partial in partials {
+        if partial.plan != plan.id {
+            return Err(Error::invalid(format!(
+                "job {} of {} belongs to another plan (id {:016x}, not {:016x})",
+                partial.job, partial.jobs, partial.plan, plan.id
+            )));
+        }
+        if seen.is_empty() {
+            seen = vec![false; partial.jobs as usize];
+        }
+        if partial.jobs as usize != seen.len() {
+            return Err(Error::invalid(format!(
+                "job {} was one of {} jobs, another one of {}: a render is split one way",
+                partial.job,
+                partial.jobs,
+                seen.len()
+            )));
+        }
+        if std::mem::replace(&mut seen[partial.job as usize], true) {
+            return Err(Error::invalid(format!(
+                "job {} of {} is given twice",
+                partial.job, partial.jobs
+            )));
+        }
+        match &mut merged {
+            None => merged = Some((partial.film, partial.stats)),
+            Some((film, stats)) => {
+                film.merge(&partial.film).map_err(|why| {
+                    Error::invalid(format!(
+                        "job {} does not fit the others: {why}",
+                        partial.job
+                    ))
+                })?;
+                add_stats(stats, &partial.stats);
+            }
+        }
+    }
+    let missing: Vec<usize> = (0..seen.len()).filter(|&j| !seen[j]).collect();
+    let Some((film, mut stats)) = merged else {
+        return Err(Error::invalid("no partial render to merge"));
+    };
+    if !missing.is_empty() {
+        return Err(Error::invalid(format!(
+            "jobs {missing:?} of {} are missing: the image needs every job",
+            seen.len()
+        )));
+    }
+    stats.filter = film.write_rgb(&mut rgb_out[..needed], None);
+    Ok(stats)
+}
+
+fn add_stats(total: &mut RenderStats, job: &RenderStats) {
+    let rank = |stop: StopReason| match stop {
+        StopReason::Cancelled => 2,
+        StopReason::TimeLimitReached => 1,
+        StopReason::Completed => 0,
+    };
+    if rank(job.stop) > rank(total.stop) {
+        total.stop = job.stop;
+    }
+    total.samples += job.samples;
+    total.mutations += job.mutations;
+    total.rays += job.rays;
+    total.invalid_samples += job.invalid_samples;
+    total.seconds += job.seconds;
+    total.threads = total.threads.max(job.threads);
+    total.accepted_mutations += job.accepted_mutations;
+    total.mutation_counts.add(&job.mutation_counts);
+}
+
+fn write_settings(w: &mut Writer, settings: &RenderSettings) {
+    // Destructured, so a new setting does not compile until it is written here.
+    let RenderSettings {
+        width,
+        height,
+        algorithm,
+        samples_per_pixel,
+        max_depth,
+        seed,
+        threads,
+        time_limit_seconds,
+        mutations_per_pixel,
+        bootstrap_samples,
+        chains,
+        large_step_probability,
+        small_step_sigma,
+        direct_samples_per_mutation,
+        normalization_work_fraction,
+        mutation_weights,
+        adapt_mutation_weights,
+        perturb_in_sample_space,
+        erpt_chain_length,
+        erpt_deposit_energy,
+        filter_buffers,
+        filter_strength,
+        filter_radius,
+        spectral,
+    } = *settings;
+    w.u32(width);
+    w.u32(height);
+    w.u32(algorithm as u32);
+    w.u32(samples_per_pixel);
+    w.u32(max_depth);
+    w.u64(seed);
+    w.u32(threads);
+    w.f64(time_limit_seconds);
+    w.u32(mutations_per_pixel);
+    w.u32(bootstrap_samples);
+    w.u32(chains);
+    w.f32(large_step_probability);
+    w.f32(small_step_sigma);
+    w.u32(direct_samples_per_mutation);
+    w.f32(normalization_work_fraction);
+    for weight in mutation_weights.0 {
+        w.f32(weight);
+    }
+    w.bool(adapt_mutation_weights);
+    w.bool(perturb_in_sample_space);
+    w.u32(erpt_chain_length);
+    w.f32(erpt_deposit_energy);
+    w.u32(filter_buffers);
+    w.f32(filter_strength);
+    w.u32(filter_radius);
+    w.bool(spectral);
+}
+
+fn read_settings(r: &mut Reader) -> Result<RenderSettings> {
+    const ALGORITHMS: [Algorithm; 7] = [
+        Algorithm::Path,
+        Algorithm::Bdpt,
+        Algorithm::Pssmlt,
+        Algorithm::Mmlt,
+        Algorithm::PssmltBdpt,
+        Algorithm::PathSpaceMlt,
+        Algorithm::Erpt,
+    ];
+    let width = r.u32()?;
+    let height = r.u32()?;
+    let code = r.u32()?;
+    let algorithm = *ALGORITHMS
+        .iter()
+        .find(|&&a| a as u32 == code)
+        .ok_or_else(|| r.malformed("an unknown algorithm"))?;
+    Ok(RenderSettings {
+        width,
+        height,
+        algorithm,
+        samples_per_pixel: r.u32()?,
+        max_depth: r.u32()?,
+        seed: r.u64()?,
+        threads: r.u32()?,
+        time_limit_seconds: r.f64()?,
+        mutations_per_pixel: r.u32()?,
+        bootstrap_samples: r.u32()?,
+        chains: r.u32()?,
+        large_step_probability: r.f32()?,
+        small_step_sigma: r.f32()?,
+        direct_samples_per_mutation: r.u32()?,
+        normalization_work_fraction: r.f32()?,
+        mutation_weights: MutationWeights([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
+        adapt_mutation_weights: r.bool()?,
+        perturb_in_sample_space: r.bool()?,
+        erpt_chain_length: r.u32()?,
+        erpt_deposit_energy: r.f32()?,
+        filter_buffers: r.u32()?,
+        filter_strength: r.f32()?,
+        filter_radius: r.u32()?,
+        spectral: r.bool()?,
+    })
+}
+
+fn write_camera(w: &mut Writer, camera: &Camera) {
+    let Camera {
+        eye,
+        target,
+        up,
+        fov_y_deg,
+        lens_radius,
+        focus_distance,
+    } = *camera;
+    for v in eye.into_iter().chain(target).chain(up) {
+        w.f32(v);
+    }
+    w.f32(fov_y_deg);
+    w.f32(lens_radius);
+    w.f32(focus_distance);
+}
+
+fn read_camera(r: &mut Reader) -> Result<Camera> {
+    let mut vector = || -> Result<[f32; 3]> { Ok([r.f32()?, r.f32()?, r.f32()?]) };
+    Ok(Camera {
+        eye: vector()?,
+        target: vector()?,
+        up: vector()?,
+        fov_y_deg: r.f32()?,
+        lens_radius: r.f32()?,
+        focus_distance: r.f32()?,
+    })
+}
+
+fn write_stats(w: &mut Writer, stats: &RenderStats) {
+    let RenderStats {
+        stop,
+        samples,
+        mutations,
+        rays,
+        invalid_samples,
+        seconds,
+        threads,
+        accepted_mutations,
+        normalization,
+        mutation_counts,
+        mutation_weights,
+        filter: _,
+    } = *stats;
+    w.u8(match stop {
+        StopReason::Completed => 0,
+        StopReason::Cancelled => 1,
+        StopReason::TimeLimitReached => 2,
+    });
+    w.u64(samples);
+    w.u64(mutations);
+    w.u64(rays);
+    w.u64(invalid_samples);
+    w.f64(seconds);
+    w.u32(threads);
+    w.u64(accepted_mutations);
+    let NormalizationStats {
+        value,
+        samples,
+        relative_error,
+        largest_share,
+    } = normalization;
+    w.f64(value);
+    w.u64(samples);
+    w.f64(relative_error);
+    w.f64(largest_share);
+    for count in mutation_counts
+        .proposed
+        .iter()
+        .chain(&mutation_counts.accepted)
+    {
+        w.u64(*count);
+    }
+    for weight in mutation_weights.0 {
+        w.f32(weight);
+    }
+}
+
+fn read_stats(r: &mut Reader) -> Result<RenderStats> {
+    let stop = match r.u8()? {
+        0 => StopReason::Completed,
+        1 => StopReason::Cancelled,
+        2 => StopReason::TimeLimitReached,
+        _ => return Err(r.malformed("an unknown stop reason")),
+    };
+    fn counts(r: &mut Reader) -> Result<[u64; 4]> {
+        Ok([r.u64()?, r.u64()?, r.u64()?, r.u64()?])
+    }
+    let (samples, mutations, rays, invalid_samples) = (r.u64()?, r.u64()?, r.u64()?, r.u64()?);
+    let (seconds, threads, accepted_mutations) = (r.f64()?, r.u32()?, r.u64()?);
+    let normalization = NormalizationStats {
+        value: r.f64()?,
+        samples: r.u64()?,
+        relative_error: r.f64()?,
+        largest_share: r.f64()?,
+    };
+    let mutation_counts = MutationCounts {
+        proposed: counts(r)?,
+        accepted: counts(r)?,
+    };
+    Ok(RenderStats {
+        stop,
+        samples,
+        mutations,
+        rays,
+        invalid_samples,
+        seconds,
+        threads,
+        accepted_mutations,
+        normalization,
+        mutation_counts,
+        mutation_weights: MutationWeights([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
+        filter: FilterStats::default(),
+    })
+}

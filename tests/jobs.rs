@@ -1,0 +1,170 @@
+//! A render split into jobs (`mlt::jobs`): the merged image has the bits of the render one
+//! machine makes, for any number of jobs, any thread count per job and any order of the
+//! partial results; buffers that are corrupted, truncated, from another plan or another
+//! scene are refused.
+
+mod common;
+
+use common::*;
+use mlt::jobs::{self, PartialRender, RenderPlan};
+use mlt::{Algorithm, MltStatus, RenderSettings, StopReason};
+
+fn settings(algorithm: Algorithm) -> RenderSettings {
+    RenderSettings {
+        // 11 bands of 4 rows, the last one short.
+        width: 24,
+        height: 42,
+        algorithm,
+        samples_per_pixel: 3,
+        seed: 5,
+        threads: 2,
+        ..Default::default()
+    }
+}
+
+/// Plans, renders `jobs` jobs (each through bytes, alternating 1 and 2 threads) and merges
+/// them in reverse order.
+fn split_render(
+    scene: &mlt::Scene,
+    camera: &mlt::Camera,
+    settings: &RenderSettings,
+    count: u32,
+) -> (Vec<f32>, mlt::RenderStats) {
+    let plan = jobs::plan(scene, camera, settings).unwrap();
+    let plan = RenderPlan::from_bytes(&plan.to_bytes()).unwrap();
+    let partials: Vec<Vec<u8>> = (0..count)
+        .map(|job| {
+            let threads = 1 + job % 2;
+            let partial = jobs::render_job(scene, &plan, job, count, threads, None).unwrap();
+            assert_eq!(partial.stats().stop, StopReason::Completed);
+            partial.to_bytes()
+        })
+        .collect();
+    let mut image = vec![0.0f32; settings.output_len().unwrap()];
+    let stats = jobs::merge(
+        &plan,
+        partials
+            .iter()
+            .rev()
+            .map(|bytes| PartialRender::from_bytes(bytes).unwrap()),
+        &mut image,
+    )
+    .unwrap();
+    (image, stats)
+}
+
+fn same_bits(a: &[f32], b: &[f32]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
+#[test]
+fn split_renders_merge_into_the_bits_of_one() {
+    let (scene, camera) = load_canonical("cornell-box");
+    for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
+        let settings = settings(algorithm);
+        let mut whole = vec![0.0f32; settings.output_len().unwrap()];
+        let stats = mlt::render(&scene, &camera, &settings, &mut whole, None).unwrap();
+        assert!(whole.iter().any(|&v| v > 0.0));
+        // One job, fewer jobs than bands, and more (some jobs then render nothing).
+        for count in [1, 2, 3, 5, 13] {
+            let (merged, merged_stats) = split_render(&scene, &camera, &settings, count);
+            assert!(
+                same_bits(&whole, &merged),
+                "{algorithm:?} in {count} jobs differs from one render"
+            );
+            assert_eq!(merged_stats.samples, stats.samples);
+            assert_eq!(merged_stats.rays, stats.rays);
+            assert_eq!(merged_stats.stop, StopReason::Completed);
+            assert_eq!(merged_stats.filter, stats.filter);
+        }
+    }
+}
+
+/// Asserts that `result` is an invalid-argument error whose message contains `needle`.
+fn invalid<T>(result: Result<T, mlt::Error>, needle: &str) {
+    match result {
+        Ok(_) => panic!("accepted; expected an error about {needle:?}"),
+        Err(e) => {
+            assert_eq!(
+                e.status,
+                MltStatus::MLT_STATUS_INVALID_ARGUMENT,
+                "{}",
+                e.message
+            );
+            assert!(
+                e.message.contains(needle),
+                "{:?} lacks {needle:?}",
+                e.message
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_buffers_jobs_and_scenes_are_refused() {
+    let (scene, camera) = load_canonical("cornell-box");
+    let settings = settings(Algorithm::Path);
+    let plan = jobs::plan(&scene, &camera, &settings).unwrap();
+    let plan_bytes = plan.to_bytes();
+    // A flipped bit anywhere, or a buffer cut short, is caught by the checksum or frame.
+    let mut flipped = plan_bytes.clone();
+    flipped[plan_bytes.len() / 2] ^= 4;
+    invalid(RenderPlan::from_bytes(&flipped), "corrupted");
+    invalid(
+        RenderPlan::from_bytes(&plan_bytes[..plan_bytes.len() - 1]),
+        "truncated",
+    );
+    invalid(
+        RenderPlan::from_bytes(b"not a plan"),
+        "not an mlt render plan",
+    );
+
+    let job = |k: u32, n: u32| jobs::render_job(&scene, &plan, k, n, 1, None).unwrap();
+    let partial = job(0, 2).to_bytes();
+    invalid(
+        PartialRender::from_bytes(&plan_bytes),
+        "not an mlt partial render",
+    );
+    let mut flipped = partial.clone();
+    flipped[40] ^= 1;
+    invalid(PartialRender::from_bytes(&flipped), "corrupted");
+
+    invalid(jobs::render_job(&scene, &plan, 2, 2, 1, None), "job 2");
+    invalid(jobs::render_job(&scene, &plan, 0, 0, 1, None), "jobs is 0");
+    // A scene built from other arrays (one vertex moved) is not the plan's.
+    let mut mesh = cornell_box();
+    mesh.positions[0] += 1e-3;
+    invalid(
+        jobs::render_job(&mesh.scene(), &plan, 0, 1, 1, None),
+        "not the one the plan was made for",
+    );
+
+    let mut image = vec![0.0f32; settings.output_len().unwrap()];
+    let mut merge = |partials: Vec<PartialRender>, plan: &RenderPlan| {
+        jobs::merge(plan, partials, &mut image).map(|_| ())
+    };
+    invalid(merge(vec![job(1, 2)], &plan), "missing");
+    invalid(merge(vec![job(0, 2), job(0, 2)], &plan), "given twice");
+    invalid(merge(vec![job(0, 2), job(1, 3)], &plan), "split one way");
+    invalid(merge(Vec::new(), &plan), "no partial render");
+    let other_seed = RenderSettings {
+        seed: 6,
+        ..settings
+    };
+    let other_plan = jobs::plan(&scene, &camera, &other_seed).unwrap();
+    invalid(merge(vec![job(0, 1)], &other_plan), "another plan");
+}
+
+/// Until their units are split too, the Metropolis algorithms and ERPT say so rather than
+/// render a wrong image.
+#[test]
+fn algorithms_not_yet_split_say_so() {
+    let (scene, camera) = load_canonical("cornell-box");
+    for algorithm in [Algorithm::Mmlt, Algorithm::Erpt] {
+        let plan = jobs::plan(&scene, &camera, &settings(algorithm)).unwrap();
+        let error = jobs::render_job(&scene, &plan, 0, 2, 1, None)
+            .err()
+            .expect("refused");
+        assert_eq!(error.status, MltStatus::MLT_STATUS_UNSUPPORTED);
+    }
+}
