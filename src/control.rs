@@ -85,3 +85,22 @@ impl Control {
         by_samples.max(by_time).clamp(0.0, 1.0) as f32
     }
 }
+
+/// Which of a render's work units a run does: those whose index is `index` modulo `count`
+/// (a job of a render split across machines, `jobs`). The units are fixed by the render's
+/// settings, never by the number of jobs, so any split adds up to the same work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct JobShare {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl JobShare {
+    /// The whole render, in one run.
+    pub const WHOLE: JobShare = JobShare { index: 0, count: 1 };
+
+    #[inline]
+    pub fn owns(&self, unit: u64) -> bool {
+        unit % self.count as u64 == self.index as u64
+    }
+}

@@ -233,6 +233,31 @@ impl Film {
         self.add_to_partial(splats, weight * partial_scale, buffer);
     }
 
+    /// Multiplies the chains' work on the film by `factor`: the splats (a Metropolis
+    /// render's large steps), the partial images and every chain layer but `except` (the
+    /// normalization pass's, which counts per sample). A job of a split render cut short
+    /// scales its chains up to the mutations planned (`driver::tally`).
+    pub fn scale_chain_work(&mut self, factor: f64, except: Option<usize>) {
+        let scale = |units: FixedPoint, sums: &mut [FixedRgb]| {
+            for sum in sums {
+                *sum = sum.map(|v| units.fixed(units.float(v) * factor));
+            }
+        };
+        scale(self.scene_units, &mut self.splats);
+        scale(self.scene_units, &mut self.partials);
+        let pixels = self.counts.len();
+        for (layer, sums) in self.chain_layers.chunks_exact_mut(pixels).enumerate() {
+            if Some(layer) != except {
+                scale(self.chain_units, sums);
+            }
+        }
+    }
+
+    /// The layers of Metropolis chains' deposits (`enable_chain_layers`).
+    pub fn chain_layer_count(&self) -> usize {
+        self.chain_layer_scales.len()
+    }
+
     /// The number of partial images splats are split into; 0 when the filter is off.
     pub fn filter_buffers(&self) -> usize {
         self.filter.map_or(0, |f| f.buffers as usize)

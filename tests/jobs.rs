@@ -16,6 +16,12 @@ fn settings(algorithm: Algorithm) -> RenderSettings {
         height: 42,
         algorithm,
         samples_per_pixel: 3,
+        // Metropolis: 13 chains, so that jobs hold unequal numbers of them, with the direct
+        // pass and the normalization pass on (MMLT's pass joins the image).
+        mutations_per_pixel: 4,
+        bootstrap_samples: 4096,
+        chains: 13,
+        normalization_work_fraction: 0.2,
         seed: 5,
         threads: 2,
         ..Default::default()
@@ -60,8 +66,25 @@ fn same_bits(a: &[f32], b: &[f32]) -> bool {
 #[test]
 fn split_renders_merge_into_the_bits_of_one() {
     let (scene, camera) = load_canonical("cornell-box");
-    for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
-        let settings = settings(algorithm);
+    let filtered = |algorithm| RenderSettings {
+        filter_buffers: 4,
+        ..settings(algorithm)
+    };
+    let no_direct_pass = |algorithm| RenderSettings {
+        direct_samples_per_mutation: 0,
+        ..settings(algorithm)
+    };
+    for settings in [
+        settings(Algorithm::Path),
+        settings(Algorithm::Bdpt),
+        settings(Algorithm::Pssmlt),
+        settings(Algorithm::Mmlt),
+        settings(Algorithm::PssmltBdpt),
+        filtered(Algorithm::Mmlt),
+        no_direct_pass(Algorithm::Pssmlt),
+        no_direct_pass(Algorithm::Mmlt),
+    ] {
+        let algorithm = settings.algorithm;
         let mut whole = vec![0.0f32; settings.output_len().unwrap()];
         let stats = mlt::render(&scene, &camera, &settings, &mut whole, None).unwrap();
         assert!(whole.iter().any(|&v| v > 0.0));
@@ -73,8 +96,13 @@ fn split_renders_merge_into_the_bits_of_one() {
                 "{algorithm:?} in {count} jobs differs from one render"
             );
             assert_eq!(merged_stats.samples, stats.samples);
-            assert_eq!(merged_stats.rays, stats.rays);
+            assert_eq!(merged_stats.mutations, stats.mutations);
+            if !algorithm.is_metropolis() {
+                // Every Metropolis job runs the bootstrap again.
+                assert_eq!(merged_stats.rays, stats.rays);
+            }
             assert_eq!(merged_stats.stop, StopReason::Completed);
+            assert_eq!(merged_stats.normalization, stats.normalization);
             assert_eq!(merged_stats.filter, stats.filter);
         }
     }
@@ -160,7 +188,7 @@ fn bad_buffers_jobs_and_scenes_are_refused() {
 #[test]
 fn algorithms_not_yet_split_say_so() {
     let (scene, camera) = load_canonical("cornell-box");
-    for algorithm in [Algorithm::Mmlt, Algorithm::Erpt] {
+    for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
         let plan = jobs::plan(&scene, &camera, &settings(algorithm)).unwrap();
         let error = jobs::render_job(&scene, &plan, 0, 2, 1, None)
             .err()

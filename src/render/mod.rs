@@ -15,12 +15,12 @@ pub use settings::{
 };
 pub use stats::{RenderStats, StopReason};
 
-use crate::control::Control;
+use crate::control::{Control, JobShare};
 use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, Result};
 use crate::film::{Film, FixedPoint, FixedRgb};
 use crate::filter::{FilterSettings, FilterStats};
 use crate::integrators::bdpt::Bdpt;
-use crate::integrators::mlt::driver::MetropolisOutcome;
+use crate::integrators::mlt::driver::{ChainTally, MetropolisOutcome, finish};
 use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
 use crate::integrators::mlt::primary_space::{MetropolisSettings, PrimarySpaceTarget};
 use crate::integrators::mlt::pssmlt;
@@ -84,13 +84,14 @@ impl Estimator<'_> {
             small_step_sigma: settings.small_step_sigma,
             normalization_work_fraction: settings.normalization_work_fraction,
             seed,
+            share,
         };
         // The direct pass keeps pace with the chains: after each round of mutations it
         // catches up to its share of samples.
         let ratio = settings.direct_samples_per_mutation;
         let mut direct_job = direct.map(|direct| {
             let total = ratio * settings.mutations_per_pixel;
-            let mut job = CameraSampleJob::new(direct, camera, seed, total, film);
+            let mut job = CameraSampleJob::new(direct, camera, seed, total, film).with_share(share);
             job.run_until(film, control, 1);
             job
         });
@@ -212,31 +213,12 @@ fn render_into(
             settings.width, settings.height
         )));
     }
-    let (film, mut stats) = render_film(scene, camera, settings, JobShare::WHOLE, progress)?;
+    let (film, mut stats, _) = render_film(scene, camera, settings, JobShare::WHOLE, progress)?;
     stats.filter = film.write_rgb(
         &mut rgb_out[..needed],
         unfiltered_out.map(|u| &mut u[..needed]),
     );
     Ok(stats)
-}
-
-/// Which of a render's work units a run does: those whose index is `index` modulo `count`
-/// (a job of a render split across machines, `jobs`). The units are fixed by the render's
-/// settings, never by the number of jobs, so any split adds up to the same work.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct JobShare {
-    pub index: u32,
-    pub count: u32,
-}
-
-impl JobShare {
-    /// The whole render, in one run.
-    pub const WHOLE: JobShare = JobShare { index: 0, count: 1 };
-
-    #[inline]
-    pub fn owns(&self, unit: u64) -> bool {
-        unit % self.count as u64 == self.index as u64
-    }
 }
 
 /// Renders `share` of the work onto a film, without writing the image: what `render` and a
@@ -247,16 +229,19 @@ fn render_film(
     settings: &RenderSettings,
     share: JobShare,
     progress: Option<Progress>,
-) -> Result<(Film, RenderStats)> {
+) -> Result<(Film, RenderStats, Option<ChainTally>)> {
     settings.validate()?;
     camera.validate()?;
     if share != JobShare::WHOLE
-        && (settings.algorithm.is_metropolis() || settings.algorithm == Algorithm::Erpt)
+        && matches!(
+            settings.algorithm,
+            Algorithm::PathSpaceMlt | Algorithm::Erpt
+        )
     {
         return Err(Error::new(
             crate::error::MLT_STATUS_UNSUPPORTED,
             format!(
-                "{:?} cannot be split into jobs yet: only the path tracer and BDPT can",
+                "{:?} cannot be split into jobs yet: the path tracer, BDPT and the primary-sample-space Metropolis algorithms can",
                 settings.algorithm
             ),
         ));
@@ -348,7 +333,7 @@ fn render_film(
             0
         };
         if settings.mutations_per_pixel > 0 {
-            (settings.mutations_per_pixel as u64 + direct_samples) * pixels
+            (settings.mutations_per_pixel as u64 + direct_samples) * pixels / share.count as u64
         } else {
             0
         }
@@ -383,15 +368,21 @@ fn render_film(
         }
         worker.join()
     });
-    let Ok(metropolis) = outcome else {
+    let Ok(mut metropolis) = outcome else {
         return Err(Error::new(
             MLT_STATUS_INTERNAL_ERROR,
             "a rendering thread panicked; this is a bug in mlt",
         ));
     };
+    // A Metropolis job's share of the plan is known only approximately beforehand (its
+    // chains' count comes from the bootstrap): its chains say whether they finished.
+    let metropolis_job = share != JobShare::WHOLE && settings.algorithm.is_metropolis();
     let stop = if control.was_cancelled() {
         StopReason::Cancelled
-    } else if !counted || control.work_done() < planned {
+    } else if !counted
+        || (metropolis_job && metropolis.cut_short)
+        || (!metropolis_job && control.work_done() < planned)
+    {
         StopReason::TimeLimitReached
     } else {
         StopReason::Completed
@@ -400,7 +391,7 @@ fn render_film(
         // The last word is always 1.0 for a finished render; a cancel now changes nothing.
         let _ = callback(1.0);
     }
-    let stats = RenderStats {
+    let mut stats = RenderStats {
         stop,
         samples: control.samples_done.load(Ordering::Relaxed),
         mutations: control.mutations_done.load(Ordering::Relaxed),
@@ -414,7 +405,13 @@ fn render_film(
         mutation_weights: metropolis.mutation_weights,
         filter: FilterStats::default(),
     };
-    Ok((film, stats))
+    let mut tally = metropolis.tally.take();
+    if share == JobShare::WHOLE
+        && let Some(tally) = tally.take()
+    {
+        stats.normalization = finish(&mut film, tally);
+    }
+    Ok((film, stats, tally))
 }
 
 /// Tells the calling thread the render finished. A mutex and condition variable rather than

@@ -107,8 +107,11 @@ impl MutationCounts {
 }
 
 /// What a Metropolis render measured.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct MetropolisOutcome {
+    /// What the normalization is made of, to be finished (`finish`) once every chain is in:
+    /// at the end of the render, or at the merge of a split render's jobs.
+    pub(crate) tally: Option<ChainTally>,
     pub mutations: u64,
     pub accepted: u64,
     /// The normalization b = ∫ f (summed over chain groups) the image is scaled by.
@@ -117,6 +120,8 @@ pub struct MetropolisOutcome {
     pub mutation_counts: MutationCounts,
     /// … and the weights they ran with (after the warm-up, if adapted).
     pub mutation_weights: MutationWeights,
+    /// Whether the chains stopped before their planned mutations (a time limit, a cancel).
+    pub cut_short: bool,
 }
 
 /// A Markov chain of a Metropolis render: its state, random numbers and scratch memory.
@@ -173,6 +178,8 @@ impl Deposits {
 /// current round.
 pub(crate) struct WeightedChain<C> {
     pub chain: C,
+    /// Its index among the chains of the whole render.
+    pub index: u64,
     /// The group whose normalization scales the chain's deposits (a layer of the film).
     group: usize,
     /// 1 / the chains of its group: its share of the group's deposits.
@@ -184,9 +191,10 @@ pub(crate) struct WeightedChain<C> {
 }
 
 impl<C> WeightedChain<C> {
-    pub fn new(chain: C, group: usize, chains_in_group: u64, bootstrap_b: f64) -> Self {
+    pub fn new(chain: C, index: u64, group: usize, chains_in_group: u64, bootstrap_b: f64) -> Self {
         WeightedChain {
             chain,
+            index,
             group,
             share: 1.0 / chains_in_group as f64,
             bootstrap_b,
@@ -422,10 +430,14 @@ pub(crate) fn finish_without_light(
     after_round: &mut dyn FnMut(&mut Film, f64),
 ) -> MetropolisOutcome {
     let pixels = camera.width as u64 * camera.height as u64;
-    control.mutations_done.fetch_add(
-        settings.mutations_per_pixel as u64 * pixels,
-        Ordering::Relaxed,
-    );
+    // A job of a split render counts its share.
+    let share = settings.share;
+    let mutations = settings.mutations_per_pixel as u64 * pixels;
+    let job_mutations = mutations / share.count as u64
+        + (mutations % share.count as u64 > share.index as u64) as u64;
+    control
+        .mutations_done
+        .fetch_add(job_mutations, Ordering::Relaxed);
     let mutations_per_pixel = if settings.mutations_per_pixel > 0 {
         settings.mutations_per_pixel as f64
     } else {
@@ -434,45 +446,150 @@ pub(crate) fn finish_without_light(
     after_round(film, mutations_per_pixel);
     MetropolisOutcome {
         normalization: bootstrap.stats(),
+        tally: Some(ChainTally::without_chains(bootstrap.clone())),
         ..Default::default()
     }
 }
 
-/// Scales each group's chain deposits on the film by its final normalization estimate
-/// (with the chains' large steps pooled in when `pass` says so) and reports it.
-pub(crate) fn normalize<N: PrimarySpaceTarget, C: MarkovChain>(
-    film: &mut Film,
-    pass: NormalizationPass<N>,
-    chains: &[WeightedChain<C>],
-) -> NormalizationStats
-where
-    N::Scratch: Send,
-{
-    let pools_large_steps = pass.pools_large_steps();
-    let pass_layer = pass.image_layer_scale();
-    let mut estimate = pass.estimate;
-    if pools_large_steps {
-        for chain in chains {
-            estimate.merge_single_group(&chain.chain.large_steps());
+/// Mutations per chain that time-limited jobs of a split render (which have no count to
+/// scale to) scale their chains' work to: any constant, the same for every job.
+const TIME_LIMITED_JOB_MUTATIONS: u64 = 1 << 20;
+
+/// What a render's chains leave for their normalization, kept apart until every chain is in
+/// (the jobs of a split render each hold some chains' share).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct ChainTally {
+    /// The bootstrap's estimate, which the chains' independent samples join.
+    pub bootstrap: NormalizationEstimate,
+    /// Per chain (its index in the whole render), the estimate of its independent samples:
+    /// its share of the normalization pass, and its large steps when they are pooled.
+    pub chains: Vec<(u64, NormalizationEstimate)>,
+    /// The film layer of the pass's points, if they join the image, and the samples the
+    /// pass drew in all.
+    pub pass_layer: Option<usize>,
+    pub pass_samples: u64,
+    /// The mutations per chain that the chains' deposits on the film count as.
+    pub mutations_per_chain: u64,
+}
+
+impl ChainTally {
+    /// A tally of no chains (no light reached the camera, or no depth was left to them).
+    pub fn without_chains(bootstrap: NormalizationEstimate) -> Self {
+        ChainTally {
+            bootstrap,
+            chains: Vec::new(),
+            pass_layer: None,
+            pass_samples: 0,
+            mutations_per_chain: 0,
         }
     }
+
+    /// Adds the chains of another job of the same render.
+    pub fn merge(&mut self, other: ChainTally) -> Result<(), String> {
+        if self.bootstrap != other.bootstrap
+            || self.pass_layer != other.pass_layer
+            || self.mutations_per_chain != other.mutations_per_chain
+        {
+            return Err("its chains' bootstrap or normalization differs".into());
+        }
+        self.chains.extend(other.chains);
+        self.pass_samples += other.pass_samples;
+        Ok(())
+    }
+}
+
+/// Scales each group's chain deposits on the film by its final normalization estimate: the
+/// bootstrap's, with every chain's independent samples added in chain order (so the sum's
+/// bits do not depend on how the chains were split), and reports it.
+pub(crate) fn finish(film: &mut Film, mut tally: ChainTally) -> NormalizationStats {
+    let mut estimate = tally.bootstrap;
+    tally.chains.sort_by_key(|&(chain, _)| chain);
+    for (_, chain) in &tally.chains {
+        estimate.merge(chain);
+    }
     let mut scales = estimate.b();
-    if let Some((layer, scale)) = pass_layer {
+    if let Some(layer) = tally.pass_layer {
+        // Relative to the splat scale (pixels / mutations per chain): the pass's points
+        // count per sample drawn.
+        let scale = if tally.pass_samples > 0 {
+            tally.mutations_per_chain as f64 / tally.pass_samples as f64
+        } else {
+            0.0
+        };
         scales.resize(layer + 1, 0.0);
         scales[layer] = scale;
     }
     film.set_chain_layer_scales(&scales);
+    if tally.mutations_per_chain > 0 {
+        let pixels = film.width as f64 * film.height as f64;
+        film.set_splat_scale(pixels / tally.mutations_per_chain as f64);
+    }
     estimate.stats()
 }
 
+/// Collects the chains' independent samples for `finish`. `mutations_per_chain` is what
+/// each chain made; a job of a split render that made fewer than planned (a time limit)
+/// scales its chains' deposits up to the plan's count, so that the jobs' work adds up
+/// however far each got.
+pub(crate) fn tally<N: PrimarySpaceTarget, C: MarkovChain>(
+    film: &mut Film,
+    pass: NormalizationPass<N>,
+    chains: &[WeightedChain<C>],
+    plan: &ChainPlan,
+    settings: &MetropolisSettings,
+    mutations_per_chain: u64,
+) -> ChainTally
+where
+    N::Scratch: Send,
+{
+    let pools_large_steps = pass.pools_large_steps();
+    let pass_layer = pass.image_layer();
+    let groups = pass.estimate.group_sums.len();
+    let mut pass_samples = 0;
+    let per_chain = chains
+        .iter()
+        .zip(pass.slots)
+        .map(|(chain, slot)| {
+            let mut estimate = NormalizationEstimate::new(groups);
+            if let Some(slot) = slot {
+                estimate.merge(&slot.estimate);
+                pass_samples += slot.drawn;
+            }
+            if pools_large_steps {
+                estimate.merge_single_group(&chain.chain.large_steps());
+            }
+            (chain.index, estimate)
+        })
+        .collect();
+    let reference = if settings.share.count == 1 || mutations_per_chain == 0 {
+        mutations_per_chain
+    } else if settings.mutations_per_pixel > 0 {
+        plan.mutations_per_chain
+    } else {
+        TIME_LIMITED_JOB_MUTATIONS
+    };
+    if reference != mutations_per_chain {
+        film.scale_chain_work(reference as f64 / mutations_per_chain as f64, pass_layer);
+    }
+    ChainTally {
+        bootstrap: pass.estimate,
+        chains: per_chain,
+        pass_layer,
+        pass_samples,
+        mutations_per_chain: reference,
+    }
+}
+
 /// Runs `chains` in rounds, every chain making the same number of mutations, adds their
-/// deposits to the film in chain order after each round (each chain's into its group's
-/// layer), lets the normalization pass catch up, and sets the film's splat scale so that
-/// each group's deposits count per mutation.
+/// deposits to the film after each round (each chain's into its group's layer), lets each
+/// chain's share of the normalization pass catch up with it, and returns what they did with
+/// the mutations each chain made in all.
 ///
 /// The first round, about one mutation per pixel, always runs, so a stopped render still
 /// has an image. `done_before`: mutations per chain made in an earlier phase of the render
-/// by as many chains of the same groups, whose deposits are already on the film.
+/// by as many chains of the same groups, whose deposits are already on the film. Rounds are
+/// sized by the plan's chains, not by this run's (a job's share of them), so that a split
+/// render's jobs keep the same pace and the direct pass takes the same samples in each.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn run_rounds<C: MarkovChain, N: PrimarySpaceTarget>(
     target: &C::Target,
@@ -484,23 +601,22 @@ pub(crate) fn run_rounds<C: MarkovChain, N: PrimarySpaceTarget>(
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
-) -> MetropolisOutcome
+) -> (MetropolisOutcome, u64)
 where
     N::Scratch: Send,
 {
-    let chain_count = chains.len() as u64;
     let deposits_per_mutation = chains
         .iter()
         .map(|c| c.chain.max_deposits())
         .max()
         .unwrap_or(1) as u64;
-    let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / chain_count.max(1)).max(1);
+    let per_round = (DEPOSITS_PER_ROUND / deposits_per_mutation / plan.chain_count.max(1)).max(1);
     for chain in chains.iter_mut() {
         chain.deposits = Deposits::with_capacity((per_round * deposits_per_mutation) as usize);
     }
+    normalization.reserve_for_round(per_round);
     let mut mutations_done = 0u64;
     let first_round = plan.first_round().min(per_round);
-    normalization.start_phase();
     while mutations_done < plan.mutations_per_chain
         && (mutations_done + done_before == 0 || !control.should_stop())
     {
@@ -510,42 +626,49 @@ where
             per_round
         };
         let steps = (plan.mutations_per_chain - mutations_done).min(round);
-        chains.par_iter_mut().for_each(|weighted| {
-            weighted.deposits.clear();
-            for _ in 0..steps {
-                weighted
-                    .chain
-                    .mutate(target, camera, &mut weighted.deposits);
-            }
-            control.mutations_done.fetch_add(steps, Ordering::Relaxed);
-        });
+        let made = done_before + mutations_done + steps;
+        let pass = &normalization.context;
+        chains
+            .par_iter_mut()
+            .zip(normalization.slots.par_iter_mut())
+            .for_each(|(weighted, slot)| {
+                weighted.deposits.clear();
+                for _ in 0..steps {
+                    weighted
+                        .chain
+                        .mutate(target, camera, &mut weighted.deposits);
+                }
+                control.mutations_done.fetch_add(steps, Ordering::Relaxed);
+                if let Some(slot) = slot {
+                    let chain = &weighted.chain;
+                    pass.catch_up(slot, chain.rays(), chain.large_step_rays(), made, control);
+                }
+            });
         mutations_done += steps;
         // Chains are independent, so chain i's deposits also make partial image i mod K
         // of the post-process filter.
-        for (i, chain) in chains.iter().enumerate() {
+        for chain in chains.iter() {
             let independent_weight = chain.share * chain.bootstrap_b;
+            let buffer = chain.index as usize;
             film.add_chain_splats(
                 chain.group,
                 &chain.deposits.chain,
                 chain.share,
                 chain.bootstrap_b,
-                i,
+                buffer,
             );
-            film.add_weighted_splats(&chain.deposits.independent, independent_weight, i);
+            film.add_weighted_splats(&chain.deposits.independent, independent_weight, buffer);
         }
-        let chain_rays = chains.iter().map(|c| c.chain.rays()).sum();
-        let large_step_rays = chains.iter().map(|c| c.chain.large_step_rays()).sum();
-        let mutations = (done_before + mutations_done) * chain_count;
-        normalization.catch_up(chain_rays, large_step_rays, mutations, control, film);
+        normalization.deposit_round(film);
         after_round(
             film,
-            ((done_before + mutations_done) * chain_count) as f64 / plan.pixels as f64,
+            made as f64 * plan.chain_count as f64 / plan.pixels as f64,
         );
     }
 
-    // Group g's deposits sum to (its chains × mutations per chain) units.
     let mut outcome = MetropolisOutcome {
-        mutations: mutations_done * chain_count,
+        mutations: mutations_done * chains.len() as u64,
+        cut_short: mutations_done < plan.mutations_per_chain,
         ..Default::default()
     };
     let mut rays = 0;
@@ -555,10 +678,7 @@ where
         outcome.mutation_counts.add(&chain.chain.mutation_counts());
     }
     control.rays.fetch_add(rays, Ordering::Relaxed);
-    if done_before + mutations_done > 0 {
-        film.set_splat_scale(plan.pixels as f64 / (done_before + mutations_done) as f64);
-    }
-    outcome
+    (outcome, done_before + mutations_done)
 }
 
 /// Records `weight` × the state's contributions, each divided by the state's target value

@@ -63,7 +63,6 @@ use crate::film::Film;
 use crate::film::Splat;
 use crate::sampling::Rng;
 use crate::scene::CameraModel;
-use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 
 /// Count, sum, sum of squares and largest value of a stream of samples.
@@ -134,12 +133,6 @@ impl NormalizationEstimate {
         self.total.add(total);
     }
 
-    /// Forgets every sample, keeping the memory.
-    pub fn clear(&mut self) {
-        self.group_sums.fill(0.0);
-        self.total = Moments::default();
-    }
-
     pub fn merge(&mut self, other: &NormalizationEstimate) {
         for (sum, o) in self.group_sums.iter_mut().zip(&other.group_sums) {
             *sum += o;
@@ -189,12 +182,6 @@ impl NormalizationEstimate {
     }
 }
 
-/// Work units a batch of the pass is split into: fixed, not the thread count, so that the
-/// order the units' sums are added in (and the image's last bits) never depends on it.
-const PASS_UNITS: usize = 16;
-/// Samples a unit draws at most per batch when the pass is in the image, so that its
-/// points fit memory reserved once.
-const PASS_UNIT_BATCH: u64 = 64;
 /// Stream offsets of the pass's samples (apart from the bootstrap's and the chains'), of
 /// their positions within the pixel and of each film pass's order.
 const PASS_STREAM: u64 = 0x5eed_b0b0_0000_0000;
@@ -235,17 +222,6 @@ fn gcd(mut a: u64, mut b: u64) -> u64 {
         (a, b) = (b, a % b);
     }
     a
-}
-
-struct PassUnit<S> {
-    sampler: PssSampler,
-    scratch: S,
-    values: Vec<f32>,
-    estimate: NormalizationEstimate,
-    /// With the pass in the image: its samples' weighted points, and each sample's index
-    /// with the end of its points.
-    deposits: Vec<Splat>,
-    sample_ends: Vec<(u64, usize)>,
 }
 
 /// How a point of a pass sample (`PrimarySpaceTarget::pass_sample`) of a group is weighted
@@ -296,246 +272,255 @@ pub(crate) struct PassImage {
 
 /// The normalization pass: independent samples of `target` drawn alongside the chains, a
 /// fixed share of the rays, added to the estimate the bootstrap started.
+///
+/// The pass's samples belong to the chains: chain c draws samples c, c + C, c + 2C, … (C
+/// chains in all) in its own parallel task, after each round of its mutations, as many as
+/// its own mutations or rays call for, and keeps their sum apart (`PassSlot`). So what is
+/// drawn, and the order every sum is added in, depends only on each chain's own work, never
+/// on the thread count or on how the chains are split into jobs (`render::jobs`); and the
+/// samples of whole rounds form a prefix of the sample sequence, which the film positions
+/// stratify (`pass_film_position`).
 pub(crate) struct NormalizationPass<'a, T: PrimarySpaceTarget> {
+    pub context: PassContext<'a, T>,
+    /// One per chain of this run, in the order of its chains (`None`: the pass draws
+    /// nothing).
+    pub slots: Vec<Option<PassSlot<T::Scratch>>>,
+    /// The bootstrap's estimate, which the chains' samples are added to at the end.
+    pub estimate: NormalizationEstimate,
+}
+
+/// What every chain's share of the pass reads.
+pub(crate) struct PassContext<'a, T: PrimarySpaceTarget> {
     target: &'a T,
     camera: &'a CameraModel,
     seed: u64,
     /// The share of all rays that independent samples are to trace.
     work_fraction: f64,
-    /// Samples drawn and the rays they traced.
-    taken: u64,
-    rays: u64,
-    /// Rays of the chains of earlier phases, and of the current phase so far; of those, the
-    /// rays of large steps that count as independent samples.
-    chain_rays_before: u64,
-    chain_rays: u64,
-    large_step_rays_before: u64,
-    large_step_rays: u64,
-    units: Vec<PassUnit<T::Scratch>>,
-    pub estimate: NormalizationEstimate,
+    /// The chains of the whole render: sample j of chain c is sample j·C + c.
+    chain_count: u64,
     /// With its samples in the image, the pass keeps pace by samples per mutation instead
-    /// of by rays; the chains' mutations so far.
+    /// of by rays.
     image: Option<PassImage>,
-    mutations: u64,
+}
+
+/// A chain's share of the pass: its sampler and scratch, and what its samples came to.
+pub(crate) struct PassSlot<S> {
+    /// The chain's index in the whole render.
+    chain: u64,
+    sampler: PssSampler,
+    scratch: S,
+    values: Vec<f32>,
+    /// Its samples' values (every group) …
+    pub estimate: NormalizationEstimate,
+    /// … how many, and the rays they traced.
+    pub drawn: u64,
+    rays: u64,
+    /// The rays of this chain slot's chains in earlier phases, and of those the rays of
+    /// large steps that count as independent samples.
+    chain_rays_before: u64,
+    large_step_rays_before: u64,
+    /// With the pass in the image: the points of the samples drawn this round, and each
+    /// sample's index with the end of its points.
+    pub deposits: Vec<Splat>,
+    pub sample_ends: Vec<(u64, usize)>,
 }
 
 impl<'a, T: PrimarySpaceTarget> NormalizationPass<'a, T>
 where
     T::Scratch: Send,
 {
-    /// A pass continuing `estimate` (the bootstrap's); with a work fraction of 0 it draws
-    /// nothing.
+    /// A pass continuing `estimate` (the bootstrap's), with a slot for each of `chains`
+    /// (indices into the `chain_count` chains of the whole render); with a work fraction of
+    /// 0 it draws nothing.
     pub fn new(
         target: &'a T,
         camera: &'a CameraModel,
         settings: &MetropolisSettings,
         estimate: NormalizationEstimate,
+        chains: &[u64],
+        chain_count: u64,
     ) -> Self {
         let groups = target.groups();
         let fraction = settings.normalization_work_fraction as f64;
-        let units = if fraction > 0.0 {
-            (0..PASS_UNITS)
-                .map(|_| PassUnit {
+        let slots = chains
+            .iter()
+            .map(|&chain| {
+                (fraction > 0.0).then(|| PassSlot {
+                    chain,
                     sampler: new_sampler(target, settings),
                     scratch: target.scratch(),
                     values: vec![0.0; groups],
                     estimate: NormalizationEstimate::new(groups),
+                    drawn: 0,
+                    rays: 0,
+                    chain_rays_before: 0,
+                    large_step_rays_before: 0,
                     deposits: Vec::new(),
                     sample_ends: Vec::new(),
                 })
-                .collect()
-        } else {
-            Vec::new()
-        };
+            })
+            .collect();
         NormalizationPass {
-            target,
-            camera,
-            seed: settings.seed,
-            work_fraction: fraction,
-            taken: 0,
-            rays: 0,
-            chain_rays_before: 0,
-            chain_rays: 0,
-            large_step_rays_before: 0,
-            large_step_rays: 0,
-            units,
+            context: PassContext {
+                target,
+                camera,
+                seed: settings.seed,
+                work_fraction: fraction,
+                chain_count,
+                image: None,
+            },
+            slots,
             estimate,
-            image: None,
-            mutations: 0,
         }
     }
 
     /// Puts the pass's samples in the image (`PassImage`); a pass drawing nothing is left
     /// as it is.
     pub fn with_image(mut self, image: Option<PassImage>) -> Self {
-        self.image = image.filter(|_| !self.units.is_empty());
-        if self.image.is_some() {
-            let groups = self.estimate.group_sums.len();
-            let points: u32 = (0..groups).map(|g| self.target.points_per_sample(g)).sum();
-            let per_sample = self.target.max_entries() * points as usize;
-            for unit in &mut self.units {
-                unit.deposits = Vec::with_capacity(PASS_UNIT_BATCH as usize * per_sample);
-                unit.sample_ends = Vec::with_capacity(PASS_UNIT_BATCH as usize);
-            }
-        }
+        self.context.image = image.filter(|_| self.context.work_fraction > 0.0);
         self
     }
 
-    /// The film layer of the pass's points and its factor relative to the splat scale
-    /// (pixels / mutations per chain): mutations per chain / samples drawn.
-    pub fn image_layer_scale(&self) -> Option<(usize, f64)> {
-        let image = self.image.as_ref()?;
-        let scale = if self.taken > 0 {
-            self.mutations as f64 / image.chains as f64 / self.taken as f64
-        } else {
-            0.0
+    /// Reserves, once, room for the points of the samples each chain draws in a round of
+    /// `mutations` mutations.
+    pub fn reserve_for_round(&mut self, mutations: u64) {
+        let Some(image) = &self.context.image else {
+            return;
         };
-        Some((image.layer, scale))
+        let target = self.context.target;
+        let groups = self.estimate.group_sums.len();
+        let points: u32 = (0..groups).map(|g| target.points_per_sample(g)).sum();
+        let samples = (image.samples_per_mutation * mutations as f64).ceil() as usize + 1;
+        for slot in self.slots.iter_mut().flatten() {
+            slot.deposits = Vec::with_capacity(samples * target.max_entries() * points as usize);
+            slot.sample_ends = Vec::with_capacity(samples);
+        }
+    }
+
+    /// The film layer of the pass's points, if they join the image.
+    pub fn image_layer(&self) -> Option<usize> {
+        self.context.image.as_ref().map(|image| image.layer)
     }
 
     /// Whether the chains' large steps also count: the target's large steps evaluate what
     /// the bootstrap does.
     pub fn pools_large_steps(&self) -> bool {
-        self.target.large_steps_are_bootstrap_samples()
+        self.context.pools_large_steps()
     }
 
     /// Starts a new phase of chains (path-space MLT's adapted chains), whose ray counts
-    /// start again from their seeds.
-    pub fn start_phase(&mut self) {
-        self.chain_rays_before += self.chain_rays;
-        self.large_step_rays_before += self.large_step_rays;
-        self.chain_rays = 0;
-        self.large_step_rays = 0;
+    /// start again from their seeds: `chain_rays[i]` (and `large_step_rays[i]`) are what
+    /// slot i's chain of the phase that ends traced.
+    pub fn start_phase(&mut self, chain_rays: &[u64], large_step_rays: &[u64]) {
+        for ((slot, &rays), &large) in self.slots.iter_mut().zip(chain_rays).zip(large_step_rays) {
+            if let Some(slot) = slot {
+                slot.chain_rays_before += rays;
+                slot.large_step_rays_before += large;
+            }
+        }
     }
 
-    /// Draws samples until the independent samples have traced their share of the rays,
-    /// the chains of the current phase having traced `chain_rays`, `large_step_rays` of
-    /// them for large steps; nothing once the render is stopping. With the pass in the
-    /// image, draws instead until it has its samples per mutation for the chains'
-    /// `mutations` so far (all phases), even when stopping: the weights count on them.
+    /// Adds the points the slots drew this round to the film, sample i's to the filter's
+    /// partial image i, and forgets them.
+    pub fn deposit_round(&mut self, film: &mut Film) {
+        let Some(image) = &self.context.image else {
+            return;
+        };
+        // The partial images get the planned factor: mutations per chain / samples.
+        let partial_scale = 1.0 / (image.samples_per_mutation * image.chains as f64);
+        for slot in self.slots.iter_mut().flatten() {
+            let mut start = 0;
+            for &(i, end) in &slot.sample_ends {
+                let points = &slot.deposits[start..end];
+                film.add_chain_splats(image.layer, points, 1.0, partial_scale, i as usize);
+                start = end;
+            }
+            slot.deposits.clear();
+            slot.sample_ends.clear();
+        }
+    }
+}
+
+impl<T: PrimarySpaceTarget> PassContext<'_, T> {
+    fn pools_large_steps(&self) -> bool {
+        self.target.large_steps_are_bootstrap_samples()
+    }
+
+    /// Lets a chain's slot catch up with its chain, which has traced `chain_rays`
+    /// (`large_step_rays` of them for large steps) and made `mutations` mutations in all:
+    /// samples until its samples' rays and the pooled large steps' make the work fraction of
+    /// the chain's and theirs (nothing once the render is stopping); with the pass in the
+    /// image, until it has drawn its samples per mutation, even when stopping: the weights
+    /// count on them.
     pub fn catch_up(
-        &mut self,
+        &self,
+        slot: &mut PassSlot<T::Scratch>,
         chain_rays: u64,
         large_step_rays: u64,
         mutations: u64,
         control: &Control,
-        film: &mut Film,
     ) {
-        self.chain_rays = chain_rays;
-        self.large_step_rays = if self.pools_large_steps() {
-            large_step_rays
-        } else {
-            0
-        };
-        self.mutations = mutations;
-        if self.units.is_empty() {
-            return;
-        }
-        let rays_before = self.rays;
+        let rays_before = slot.rays;
         if let Some(image) = &self.image {
             let goal = (image.samples_per_mutation * mutations as f64).ceil() as u64;
-            while self.taken < goal {
-                let batch = (goal - self.taken).min(PASS_UNIT_BATCH * PASS_UNITS as u64);
-                self.draw(batch, film);
+            while slot.drawn < goal {
+                self.draw(slot, Some(&image.weights));
             }
-            control
-                .rays
-                .fetch_add(self.rays - rays_before, Ordering::Relaxed);
-            return;
-        }
-        // The pass's rays P and the pooled large steps' L must make f of all rays C + P:
-        // P + L ≥ f (C + P), so P ≥ (f C − L) / (1 − f).
-        let f = self.work_fraction;
-        let chains = (self.chain_rays_before + self.chain_rays) as f64;
-        let large_steps = (self.large_step_rays_before + self.large_step_rays) as f64;
-        let goal = ((f * chains - large_steps) / (1.0 - f)).max(0.0) as u64;
-        // Each batch draws as many samples as the rays still owed would take at the rays per
-        // sample seen so far (a few rays per sample before the first batch), at least one per
-        // unit; ray counts are exact, so the batches are the same on every run.
-        while self.rays < goal && !control.should_stop() {
-            let rays_per_sample = if self.taken > 0 {
-                (self.rays as f64 / self.taken as f64).max(1.0)
+        } else {
+            // The pass's rays P and the pooled large steps' L must make f of all rays C + P:
+            // P + L ≥ f (C + P), so P ≥ (f C − L) / (1 − f).
+            let f = self.work_fraction;
+            let chain = (slot.chain_rays_before + chain_rays) as f64;
+            let large_steps = if self.pools_large_steps() {
+                (slot.large_step_rays_before + large_step_rays) as f64
             } else {
-                4.0
+                0.0
             };
-            let count = (((goal - self.rays) as f64 / rays_per_sample).ceil() as u64)
-                .max(PASS_UNITS as u64);
-            self.draw(count, film);
+            let goal = ((f * chain - large_steps) / (1.0 - f)).max(0.0) as u64;
+            while slot.rays < goal && !control.should_stop() {
+                self.draw(slot, None);
+            }
         }
         control
             .rays
-            .fetch_add(self.rays - rays_before, Ordering::Relaxed);
+            .fetch_add(slot.rays - rays_before, Ordering::Relaxed);
     }
 
-    /// Draws `count` more samples (and with the pass in the image, adds their points to its
-    /// layer of `film`, sample i's to the filter's partial image i).
-    fn draw(&mut self, count: u64, film: &mut Film) {
-        let first = self.taken;
+    /// Draws the slot's next sample (with `weights`, keeping its points for the image).
+    fn draw(&self, slot: &mut PassSlot<T::Scratch>, weights: Option<&[PointWeight]>) {
         let (target, camera, seed) = (self.target, self.camera, self.seed);
-        let weights = self.image.as_ref().map(|image| &image.weights[..]);
-        let rays: u64 = self
-            .units
-            .par_iter_mut()
-            .enumerate()
-            .map(|(u, unit)| {
-                let begin = first + count * u as u64 / PASS_UNITS as u64;
-                let end = first + count * (u as u64 + 1) / PASS_UNITS as u64;
-                let mut rays = 0;
-                unit.estimate.clear();
-                unit.deposits.clear();
-                unit.sample_ends.clear();
-                for i in begin..end {
-                    let position = pass_film_position(i, camera, seed);
-                    unit.sampler.restart_at(seed, PASS_STREAM + i, position);
-                    unit.values.fill(0.0);
-                    if let Some(weights) = weights {
-                        let deposits = &mut unit.deposits;
-                        target.pass_sample(
-                            camera,
-                            &mut unit.sampler,
-                            &mut unit.scratch,
-                            &mut unit.values,
-                            &mut rays,
-                            &mut |group, point| {
-                                let weight = weights[group].of(point.target);
-                                deposits.extend(point.entries.iter().map(|e| Splat {
-                                    pixel: e.pixel,
-                                    value: e.value * weight,
-                                }));
-                            },
-                        );
-                        unit.sample_ends.push((i, unit.deposits.len()));
-                    } else {
-                        target.bootstrap(
-                            camera,
-                            &mut unit.sampler,
-                            &mut unit.scratch,
-                            &mut unit.values,
-                            &mut rays,
-                        );
-                    }
-                    unit.estimate.add(&unit.values);
-                }
-                rays
-            })
-            .sum();
-        for unit in &self.units {
-            self.estimate.merge(&unit.estimate);
+        let i = slot.drawn * self.chain_count + slot.chain;
+        let position = pass_film_position(i, camera, seed);
+        slot.sampler.restart_at(seed, PASS_STREAM + i, position);
+        slot.values.fill(0.0);
+        if let Some(weights) = weights {
+            let deposits = &mut slot.deposits;
+            target.pass_sample(
+                camera,
+                &mut slot.sampler,
+                &mut slot.scratch,
+                &mut slot.values,
+                &mut slot.rays,
+                &mut |group, point| {
+                    let weight = weights[group].of(point.target);
+                    deposits.extend(point.entries.iter().map(|e| Splat {
+                        pixel: e.pixel,
+                        value: e.value * weight,
+                    }));
+                },
+            );
+            slot.sample_ends.push((i, slot.deposits.len()));
+        } else {
+            target.bootstrap(
+                camera,
+                &mut slot.sampler,
+                &mut slot.scratch,
+                &mut slot.values,
+                &mut slot.rays,
+            );
         }
-        if let Some(image) = &self.image {
-            // The partial images get the planned factor: mutations per chain / samples.
-            let partial_scale = 1.0 / (image.samples_per_mutation * image.chains as f64);
-            for unit in &self.units {
-                let mut start = 0;
-                for &(i, end) in &unit.sample_ends {
-                    let points = &unit.deposits[start..end];
-                    film.add_chain_splats(image.layer, points, 1.0, partial_scale, i as usize);
-                    start = end;
-                }
-            }
-        }
-        self.taken += count;
-        self.rays += rays;
+        slot.estimate.add(&slot.values);
+        slot.drawn += 1;
     }
 }
 
@@ -607,8 +592,9 @@ mod tests {
         assert_eq!(single.b(), vec![2.0]);
         assert_eq!(single.stats().largest_share, 4.0 / 6.0);
 
-        estimate.clear();
-        assert_eq!(estimate, NormalizationEstimate::new(2));
-        assert_eq!(estimate.stats(), NormalizationStats::default());
+        assert_eq!(
+            NormalizationEstimate::new(2).stats(),
+            NormalizationStats::default()
+        );
     }
 }

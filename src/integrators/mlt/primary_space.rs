@@ -19,6 +19,9 @@ pub struct MetropolisSettings {
     /// The share of the rays the normalization pass spends (`normalization` module).
     pub normalization_work_fraction: f32,
     pub seed: u64,
+    /// The chains this run makes: all, or a job's share of a split render (chain c is job
+    /// c mod N's).
+    pub(crate) share: crate::control::JobShare,
 }
 
 /// What one state of a chain contributes to the image: a few (pixel, value) entries and the

@@ -6,7 +6,7 @@
 use super::acceptance;
 use super::driver::{
     Bootstrap, ChainPlan, Deposits, MarkovChain, MetropolisOutcome, WeightedChain, bootstrap,
-    deposit, finish_without_light, normalize, resample_seeds, restart_as_bootstrap, run_rounds,
+    deposit, finish_without_light, resample_seeds, restart_as_bootstrap, run_rounds, tally,
 };
 use super::normalization::{
     Moments, NormalizationEstimate, NormalizationPass, PassImage, PointWeight,
@@ -223,23 +223,37 @@ where
         return finish_without_light(camera, settings, &boot.estimate, film, control, after_round);
     }
 
-    // 2. Chains, allotted to groups and seeded from resampled bootstrap samples.
+    // 2. Chains, allotted to groups and seeded from resampled bootstrap samples; a job of
+    // a split render makes its share of them.
     let plan = ChainPlan::new(&b, camera, settings);
-    let seeds = resample_seeds(&boot, &plan.chains_per_group, settings.seed);
-    let pass = NormalizationPass::new(target, camera, settings, boot.estimate.clone());
+    let seeds: Vec<(u64, (usize, u64))> =
+        resample_seeds(&boot, &plan.chains_per_group, settings.seed)
+            .into_iter()
+            .enumerate()
+            .map(|(c, seed)| (c as u64, seed))
+            .filter(|&(c, _)| settings.share.owns(c))
+            .collect();
+    let owned: Vec<u64> = seeds.iter().map(|&(c, _)| c).collect();
+    let pass = NormalizationPass::new(
+        target,
+        camera,
+        settings,
+        boot.estimate.clone(),
+        &owned,
+        plan.chain_count,
+    );
     let (offsets, pass_image) =
         plan_pass_image(target, camera, settings, &boot, &plan, &pass, control);
     let mut pass = pass.with_image(pass_image);
     drop(boot.kept);
     let mut chains: Vec<WeightedChain<Chain<T>>> = seeds
         .into_par_iter()
-        .enumerate()
         .map(|(c, (group, index))| {
             let mut sampler = new_sampler(target, settings);
             restart_as_bootstrap(&mut sampler, settings, camera, index, n);
             let mut scratch = target.scratch();
             let mut current = PathSample::with_capacity(target.max_entries());
-            let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + c as u64);
+            let mut choice = Rng::new(settings.seed, SEED_CHOICE_STREAM + c);
             let mut rays = 0;
             target.seed(
                 camera,
@@ -251,7 +265,7 @@ where
                 &mut rays,
             );
             // Chains seeded from the same sample must still move independently.
-            sampler.reseed(settings.seed, CHAIN_STREAM + c as u64);
+            sampler.reseed(settings.seed, CHAIN_STREAM + c);
             let chain = Chain {
                 group,
                 sampler,
@@ -265,13 +279,13 @@ where
                 large_steps: Moments::default(),
                 large_step_rays: 0,
             };
-            WeightedChain::new(chain, group, plan.chains_per_group[group], b[group])
+            WeightedChain::new(chain, c, group, plan.chains_per_group[group], b[group])
         })
         .collect();
 
-    // 3. Rounds of mutations, the normalization estimated alongside; 4. the image scaled by
-    // its final estimate.
-    let mut outcome = run_rounds(
+    // 3. Rounds of mutations, the normalization estimated alongside; 4. what the image is
+    // scaled by, finished once every chain is in.
+    let (mut outcome, made) = run_rounds(
         target,
         camera,
         &mut chains,
@@ -282,7 +296,7 @@ where
         control,
         after_round,
     );
-    outcome.normalization = normalize(film, pass, &chains);
+    outcome.tally = Some(tally(film, pass, &chains, &plan, settings, made));
     outcome
 }
 

@@ -22,8 +22,8 @@ use super::{JobShare, Progress, RenderSettings, RenderStats, StopReason, render_
 use crate::error::{Error, MLT_STATUS_INVALID_ARGUMENT, Result};
 use crate::film::{Film, read_film, write_film};
 use crate::filter::FilterStats;
-use crate::integrators::mlt::driver::{MutationCounts, MutationWeights};
-use crate::integrators::mlt::normalization::NormalizationStats;
+use crate::integrators::mlt::driver::{ChainTally, MutationCounts, MutationWeights, finish};
+use crate::integrators::mlt::normalization::{Moments, NormalizationEstimate, NormalizationStats};
 use crate::render::Algorithm;
 use crate::scene::{Camera, Scene};
 use wire::{Reader, Writer};
@@ -124,6 +124,8 @@ pub struct PartialRender {
     jobs: u32,
     film: Film,
     stats: RenderStats,
+    /// A Metropolis job's chains' share of the normalization.
+    tally: Option<ChainTally>,
 }
 
 impl PartialRender {
@@ -153,6 +155,7 @@ impl PartialRender {
         w.u32(self.jobs);
         write_stats(&mut w, &self.stats);
         write_film(&self.film, &mut w);
+        write_tally(&mut w, self.tally.as_ref());
         w.finish(PARTIAL_MAGIC)
     }
 
@@ -163,6 +166,7 @@ impl PartialRender {
         let jobs = r.u32()?;
         let stats = read_stats(&mut r)?;
         let film = read_film(&mut r)?;
+        let tally = read_tally(&mut r)?;
         r.end()?;
         if jobs == 0 || jobs > MLT_MAX_JOBS || job >= jobs {
             return Err(Error::new(
@@ -176,6 +180,7 @@ impl PartialRender {
             jobs,
             film,
             stats,
+            tally,
         })
     }
 }
@@ -216,13 +221,14 @@ pub fn render_job(
         index: job,
         count: jobs,
     };
-    let (film, stats) = render_film(scene, &plan.camera, &settings, share, progress)?;
+    let (film, stats, tally) = render_film(scene, &plan.camera, &settings, share, progress)?;
     Ok(PartialRender {
         plan: plan.id,
         job,
         jobs,
         film,
         stats,
+        tally,
     })
 }
 
@@ -244,7 +250,7 @@ pub fn merge(
             plan.settings.height
         )));
     }
-    let mut merged: Option<(Film, RenderStats)> = None;
+    let mut merged: Option<(Film, RenderStats, Option<ChainTally>)> = None;
     let mut seen: Vec<bool> = Vec::new();
     for partial in partials {
         if partial.plan != plan.id {
@@ -271,20 +277,26 @@ pub fn merge(
             )));
         }
         match &mut merged {
-            None => merged = Some((partial.film, partial.stats)),
-            Some((film, stats)) => {
-                film.merge(&partial.film).map_err(|why| {
+            None => merged = Some((partial.film, partial.stats, partial.tally)),
+            Some((film, stats, tally)) => {
+                let misfit = |why: String| {
                     Error::invalid(format!(
                         "job {} does not fit the others: {why}",
                         partial.job
                     ))
-                })?;
+                };
+                film.merge(&partial.film).map_err(misfit)?;
+                match (tally.as_mut(), partial.tally) {
+                    (None, None) => {}
+                    (Some(tally), Some(other)) => tally.merge(other).map_err(misfit)?,
+                    _ => return Err(misfit("one has Metropolis chains, the other not".into())),
+                }
                 add_stats(stats, &partial.stats);
             }
         }
     }
     let missing: Vec<usize> = (0..seen.len()).filter(|&j| !seen[j]).collect();
-    let Some((film, mut stats)) = merged else {
+    let Some((mut film, mut stats, tally)) = merged else {
         return Err(Error::invalid("no partial render to merge"));
     };
     if !missing.is_empty() {
@@ -292,6 +304,17 @@ pub fn merge(
             "jobs {missing:?} of {} are missing: the image needs every job",
             seen.len()
         )));
+    }
+    if let Some(tally) = tally {
+        if tally
+            .pass_layer
+            .is_some_and(|layer| layer >= film.chain_layer_count())
+        {
+            return Err(Error::invalid(
+                "the partial renders name a film layer they do not have",
+            ));
+        }
+        stats.normalization = finish(&mut film, tally);
     }
     stats.filter = film.write_rgb(&mut rgb_out[..needed], None);
     Ok(stats)
@@ -531,4 +554,79 @@ fn read_stats(r: &mut Reader) -> Result<RenderStats> {
         mutation_weights: MutationWeights([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
         filter: FilterStats::default(),
     })
+}
+
+fn write_estimate(w: &mut Writer, estimate: &NormalizationEstimate) {
+    w.len(estimate.group_sums.len());
+    for &sum in &estimate.group_sums {
+        w.f64(sum);
+    }
+    let Moments {
+        count,
+        sum,
+        squares,
+        largest,
+    } = estimate.total;
+    w.u64(count);
+    w.f64(sum);
+    w.f64(squares);
+    w.f64(largest);
+}
+
+fn read_estimate(r: &mut Reader) -> Result<NormalizationEstimate> {
+    let groups = r.len(8)?;
+    let group_sums = (0..groups).map(|_| r.f64()).collect::<Result<_>>()?;
+    Ok(NormalizationEstimate {
+        group_sums,
+        total: Moments {
+            count: r.u64()?,
+            sum: r.f64()?,
+            squares: r.f64()?,
+            largest: r.f64()?,
+        },
+    })
+}
+
+fn write_tally(w: &mut Writer, tally: Option<&ChainTally>) {
+    w.bool(tally.is_some());
+    let Some(tally) = tally else {
+        return;
+    };
+    write_estimate(w, &tally.bootstrap);
+    w.len(tally.chains.len());
+    for (chain, estimate) in &tally.chains {
+        w.u64(*chain);
+        write_estimate(w, estimate);
+    }
+    w.bool(tally.pass_layer.is_some());
+    w.u64(tally.pass_layer.unwrap_or(0) as u64);
+    w.u64(tally.pass_samples);
+    w.u64(tally.mutations_per_chain);
+}
+
+fn read_tally(r: &mut Reader) -> Result<Option<ChainTally>> {
+    if !r.bool()? {
+        return Ok(None);
+    }
+    let bootstrap = read_estimate(r)?;
+    let groups = bootstrap.group_sums.len();
+    let chains = (0..r.len(40)?)
+        .map(|_| {
+            let chain = r.u64()?;
+            let estimate = read_estimate(r)?;
+            if estimate.group_sums.len() != groups {
+                return Err(r.malformed("a chain's estimate has another number of groups"));
+            }
+            Ok((chain, estimate))
+        })
+        .collect::<Result<_>>()?;
+    let has_pass_layer = r.bool()?;
+    let pass_layer = r.u64()? as usize;
+    Ok(Some(ChainTally {
+        bootstrap,
+        chains,
+        pass_layer: has_pass_layer.then_some(pass_layer),
+        pass_samples: r.u64()?,
+        mutations_per_chain: r.u64()?,
+    }))
 }

@@ -219,7 +219,20 @@ pub(crate) fn run(
     // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution;
     // the normalization goes on being estimated with more BDPT samples alongside them.
     let plan = ChainPlan::new(&[b], camera, settings);
-    let mut pass = NormalizationPass::new(&target.bdpt, camera, settings, boot.estimate.clone());
+    // A split render's jobs would each adapt the weights to their own chains' warm-up.
+    debug_assert_eq!(
+        settings.share.count, 1,
+        "path-space MLT does not split into jobs yet"
+    );
+    let all: Vec<u64> = (0..plan.chain_count).collect();
+    let mut pass = NormalizationPass::new(
+        &target.bdpt,
+        camera,
+        settings,
+        boot.estimate.clone(),
+        &all,
+        plan.chain_count,
+    );
     let seed_chains = |boot: &driver::Bootstrap, seed: u64, first_stream: u64| {
         let seeds = driver::resample_seeds(boot, &plan.chains_per_group, seed);
         seeds
@@ -228,7 +241,7 @@ pub(crate) fn run(
             .map(|(c, (_, index))| {
                 let stream = first_stream + c as u64;
                 let chain = seed_chain(target, settings, index, n, stream);
-                WeightedChain::new(chain, 0, plan.chain_count, b)
+                WeightedChain::new(chain, c as u64, 0, plan.chain_count, b)
             })
             .collect::<Vec<WeightedChain<PathChain>>>()
     };
@@ -245,7 +258,7 @@ pub(crate) fn run(
     let mut chains = seed_chains(&boot, settings.seed, 0);
     // The second phase seeds its chains from the bootstrap too; otherwise free it now.
     let boot = adapting.then_some(boot);
-    let mut outcome = driver::run_rounds(
+    let (mut outcome, made) = driver::run_rounds(
         target,
         camera,
         &mut chains,
@@ -258,7 +271,7 @@ pub(crate) fn run(
     );
     outcome.mutation_weights = target.weights;
     let Some(boot) = boot.filter(|_| !control.should_stop()) else {
-        outcome.normalization = driver::normalize(film, pass, &chains);
+        outcome.tally = Some(driver::tally(film, pass, &chains, &plan, settings, made));
         return outcome;
     };
     let mut counts = MutationCounts::default();
@@ -279,9 +292,11 @@ pub(crate) fn run(
     };
     outcome.mutation_weights = adapted.weights;
     // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
+    let rays: Vec<u64> = chains.iter().map(|c| c.chain.rays()).collect();
+    pass.start_phase(&rays, &vec![0; rays.len()]);
     let mut chains = seed_chains(&boot, settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
     drop(boot);
-    let rest = driver::run_rounds(
+    let (rest, made) = driver::run_rounds(
         &adapted,
         camera,
         &mut chains,
@@ -295,7 +310,8 @@ pub(crate) fn run(
     outcome.mutations += rest.mutations;
     outcome.accepted += rest.accepted;
     outcome.mutation_counts.add(&rest.mutation_counts);
-    outcome.normalization = driver::normalize(film, pass, &chains);
+    outcome.cut_short = rest.cut_short;
+    outcome.tally = Some(driver::tally(film, pass, &chains, &plan, settings, made));
     outcome
 }
 
