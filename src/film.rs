@@ -73,6 +73,11 @@ impl FixedPoint {
         FixedPoint::new(exponent)
     }
 
+    /// log2 of the grid's spacing (the value of one unit).
+    pub fn grid_log2(&self) -> i32 {
+        self.to_float.log2() as i32
+    }
+
     /// `value` on the grid, rounded to the nearest point (ties to even); NaN is 0 and
     /// magnitudes beyond the range are clamped.
     #[inline]
@@ -194,6 +199,20 @@ impl Film {
         }
     }
 
+    /// A film of the same size, units and chain layers, with nothing on it and no filter.
+    pub fn empty_like(&self) -> Film {
+        let mut film = Film::new(
+            self.width,
+            self.height,
+            !self.splats.is_empty(),
+            self.scene_units,
+        );
+        if !self.chain_layer_scales.is_empty() {
+            film.enable_chain_layers(self.chain_layer_scales.len());
+        }
+        film
+    }
+
     /// Turns the post-process filter on: splats are also kept in its partial images, and
     /// the written image is filtered (`crate::filter`).
     pub fn enable_filter(&mut self, settings: FilterSettings) {
@@ -274,15 +293,6 @@ impl Film {
         self.add_weighted_splats(splats, 1.0, 0);
     }
 
-    /// Adds per-pixel splat sums (one RGB triple per pixel, in pixel order) that stand for
-    /// `light_paths` light paths.
-    pub fn add_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>, light_paths: u64) {
-        self.light_paths += light_paths;
-        for (total, sum) in self.splats.iter_mut().zip(sums) {
-            self.scene_units.add(total, sum);
-        }
-    }
-
     /// Adds `weight` × the splats of a work unit, in the unit's order, and with the filter
     /// on also to partial image `buffer` (taken modulo their number).
     pub fn add_weighted_splats(&mut self, splats: &[Splat], weight: f64, buffer: usize) {
@@ -302,13 +312,37 @@ impl Film {
         }
     }
 
-    /// Adds per-(pixel, partial image) splat sums, in `partials` order (pixel by pixel, each
-    /// pixel's `filter_buffers()` partials in turn); their total must also be added with
-    /// `add_splat_sums`.
-    pub fn add_partial_splat_sums(&mut self, sums: impl Iterator<Item = [f64; 3]>) {
-        for (partial, sum) in self.partials.iter_mut().zip(sums) {
-            self.scene_units.add(partial, sum);
+    /// Adds integer per-pixel splat sums in units of `2^grid_log2` (at least the film's own
+    /// grid, `scene_grid_log2`: then the conversion is exact, a shift, so sums made apart
+    /// add up to the bits of one), standing for `light_paths` light paths; with
+    /// `partials`, also the per-(pixel, partial image) sums in `partials` order.
+    pub fn add_integer_splat_sums(
+        &mut self,
+        sums: impl Iterator<Item = [i64; 3]>,
+        partials: Option<&mut dyn Iterator<Item = [i64; 3]>>,
+        grid_log2: i32,
+        light_paths: u64,
+    ) {
+        let shift = grid_log2 - self.scene_units.grid_log2();
+        assert!(
+            (0..64).contains(&shift),
+            "a grid of 2^{grid_log2} is finer than the film's or too coarse"
+        );
+        let convert = |v: [i64; 3]| v.map(|c| (c as i128) << shift);
+        self.light_paths += light_paths;
+        for (total, sum) in self.splats.iter_mut().zip(sums) {
+            add_sums(std::slice::from_mut(total), &[convert(sum)]);
         }
+        if let Some(partials) = partials {
+            for (total, sum) in self.partials.iter_mut().zip(partials) {
+                add_sums(std::slice::from_mut(total), &[convert(sum)]);
+            }
+        }
+    }
+
+    /// log2 of the spacing of the film's grid in the scene's units of light.
+    pub fn scene_grid_log2(&self) -> i32 {
+        self.scene_units.grid_log2()
     }
 
     /// Splits the film into bands of `rows` rows for parallel iteration, in row order.

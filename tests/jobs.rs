@@ -65,6 +65,7 @@ fn same_bits(a: &[f32], b: &[f32]) -> bool {
 
 #[test]
 fn split_renders_merge_into_the_bits_of_one() {
+    // Every algorithm, with the options that change how its work is organized.
     let (scene, camera) = load_canonical("cornell-box");
     let filtered = |algorithm| RenderSettings {
         filter_buffers: 4,
@@ -83,6 +84,13 @@ fn split_renders_merge_into_the_bits_of_one() {
         filtered(Algorithm::Mmlt),
         no_direct_pass(Algorithm::Pssmlt),
         no_direct_pass(Algorithm::Mmlt),
+        settings(Algorithm::Erpt),
+        filtered(Algorithm::Erpt),
+        settings(Algorithm::PathSpaceMlt),
+        RenderSettings {
+            adapt_mutation_weights: true,
+            ..settings(Algorithm::PathSpaceMlt)
+        },
     ] {
         let algorithm = settings.algorithm;
         let mut whole = vec![0.0f32; settings.output_len().unwrap()];
@@ -97,8 +105,12 @@ fn split_renders_merge_into_the_bits_of_one() {
             );
             assert_eq!(merged_stats.samples, stats.samples);
             assert_eq!(merged_stats.mutations, stats.mutations);
-            if !algorithm.is_metropolis() {
-                // Every Metropolis job runs the bootstrap again.
+            assert_eq!(merged_stats.accepted_mutations, stats.accepted_mutations);
+            assert_eq!(merged_stats.mutation_counts, stats.mutation_counts);
+            assert_eq!(merged_stats.mutation_weights, stats.mutation_weights);
+            if matches!(algorithm, Algorithm::Path | Algorithm::Bdpt) {
+                // Every Metropolis job runs the bootstrap again, every ERPT job the pre-pass
+                // of its deposit energy.
                 assert_eq!(merged_stats.rays, stats.rays);
             }
             assert_eq!(merged_stats.stop, StopReason::Completed);
@@ -181,18 +193,4 @@ fn bad_buffers_jobs_and_scenes_are_refused() {
     };
     let other_plan = jobs::plan(&scene, &camera, &other_seed).unwrap();
     invalid(merge(vec![job(0, 1)], &other_plan), "another plan");
-}
-
-/// Until their units are split too, the Metropolis algorithms and ERPT say so rather than
-/// render a wrong image.
-#[test]
-fn algorithms_not_yet_split_say_so() {
-    let (scene, camera) = load_canonical("cornell-box");
-    for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
-        let plan = jobs::plan(&scene, &camera, &settings(algorithm)).unwrap();
-        let error = jobs::render_job(&scene, &plan, 0, 2, 1, None)
-            .err()
-            .expect("refused");
-        assert_eq!(error.status, MltStatus::MLT_STATUS_UNSUPPORTED);
-    }
 }

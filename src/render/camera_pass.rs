@@ -42,14 +42,18 @@ pub(super) struct CameraSampleJob<'a, E: PixelEstimator> {
     share: JobShare,
 }
 
-/// Pixels of the bands of the image of `camera` that `share` owns.
-pub(super) fn pixels_in_share(camera: &CameraModel, share: JobShare) -> u64 {
-    let bands = camera.height.div_ceil(BAND_ROWS);
+/// Pixels of the bands of `rows` rows (`BAND_ROWS`, or ERPT's) of the image of `camera`
+/// that `share` owns.
+pub(super) fn pixels_in_share(camera: &CameraModel, share: JobShare, rows: u32) -> u64 {
+    let bands = camera.height.div_ceil(rows);
     (0..bands)
         .filter(|&band| share.owns(band as u64))
-        .map(|band| (camera.height - band * BAND_ROWS).min(BAND_ROWS) as u64 * camera.width as u64)
+        .map(|band| (camera.height - band * rows).min(rows) as u64 * camera.width as u64)
         .sum()
 }
+
+/// Rows per band of the camera-sample passes.
+pub(super) const ROWS: u32 = BAND_ROWS;
 
 impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
     pub(super) fn new(

@@ -149,6 +149,7 @@ impl Estimator<'_> {
                     seed,
                     weights: settings.mutation_weights,
                     perturb_in_sample_space: settings.perturb_in_sample_space,
+                    share,
                 };
                 path_space::run_erpt(bdpt, camera, &erpt, film, control)
             }
@@ -232,20 +233,6 @@ fn render_film(
 ) -> Result<(Film, RenderStats, Option<ChainTally>)> {
     settings.validate()?;
     camera.validate()?;
-    if share != JobShare::WHOLE
-        && matches!(
-            settings.algorithm,
-            Algorithm::PathSpaceMlt | Algorithm::Erpt
-        )
-    {
-        return Err(Error::new(
-            crate::error::MLT_STATUS_UNSUPPORTED,
-            format!(
-                "{:?} cannot be split into jobs yet: the path tracer, BDPT and the primary-sample-space Metropolis algorithms can",
-                settings.algorithm
-            ),
-        ));
-    }
     let own_pool;
     let pool = if settings.threads == 0 {
         shared_pool()?
@@ -338,7 +325,12 @@ fn render_film(
             0
         }
     } else {
-        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(&model, share)
+        let rows = if settings.algorithm == Algorithm::Erpt {
+            path_space::ERPT_BAND_ROWS
+        } else {
+            camera_pass::ROWS
+        };
+        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(&model, share, rows)
     };
 
     let mut progress = progress;

@@ -219,29 +219,25 @@ pub(crate) fn run(
     // 2. Chains seeded from bootstrap paths resampled in proportion to their contribution;
     // the normalization goes on being estimated with more BDPT samples alongside them.
     let plan = ChainPlan::new(&[b], camera, settings);
-    // A split render's jobs would each adapt the weights to their own chains' warm-up.
-    debug_assert_eq!(
-        settings.share.count, 1,
-        "path-space MLT does not split into jobs yet"
-    );
-    let all: Vec<u64> = (0..plan.chain_count).collect();
+    // A job of a split render makes its share of the chains.
+    let share = settings.share;
+    let (owned, others): (Vec<u64>, Vec<u64>) = (0..plan.chain_count).partition(|&c| share.owns(c));
     let mut pass = NormalizationPass::new(
         &target.bdpt,
         camera,
         settings,
         boot.estimate.clone(),
-        &all,
+        &owned,
         plan.chain_count,
     );
-    let seed_chains = |boot: &driver::Bootstrap, seed: u64, first_stream: u64| {
+    let seed_chains = |boot: &driver::Bootstrap, seed: u64, first_stream: u64, which: &[u64]| {
         let seeds = driver::resample_seeds(boot, &plan.chains_per_group, seed);
-        seeds
-            .into_par_iter()
-            .enumerate()
-            .map(|(c, (_, index))| {
-                let stream = first_stream + c as u64;
-                let chain = seed_chain(target, settings, index, n, stream);
-                WeightedChain::new(chain, c as u64, 0, plan.chain_count, b)
+        which
+            .par_iter()
+            .map(|&c| {
+                let (_, index) = seeds[c as usize];
+                let chain = seed_chain(target, settings, index, n, first_stream + c);
+                WeightedChain::new(chain, c, 0, plan.chain_count, b)
             })
             .collect::<Vec<WeightedChain<PathChain>>>()
     };
@@ -255,7 +251,7 @@ pub(crate) fn run(
     } else {
         plan.mutations_per_chain
     };
-    let mut chains = seed_chains(&boot, settings.seed, 0);
+    let mut chains = seed_chains(&boot, settings.seed, 0, &owned);
     // The second phase seeds its chains from the bootstrap too; otherwise free it now.
     let boot = adapting.then_some(boot);
     let (mut outcome, made) = driver::run_rounds(
@@ -274,7 +270,41 @@ pub(crate) fn run(
         outcome.tally = Some(driver::tally(film, pass, &chains, &plan, settings, made));
         return outcome;
     };
-    let mut counts = MutationCounts::default();
+    // The weights adapt to the warm-up of every chain of the render, so a job also runs
+    // the warm-up of the chains it does not own (one round, about a mutation per pixel),
+    // apart: on a film of its own, uncounted, and without the normalization pass.
+    let mut others_counts = MutationCounts::default();
+    if !others.is_empty() {
+        let no_pass = MetropolisSettings {
+            normalization_work_fraction: 0.0,
+            ..*settings
+        };
+        let mut others_chains = seed_chains(&boot, settings.seed, 0, &others);
+        let mut others_pass = NormalizationPass::new(
+            &target.bdpt,
+            camera,
+            &no_pass,
+            boot.estimate.clone(),
+            &others,
+            plan.chain_count,
+        );
+        let mut scratch_film = film.empty_like();
+        driver::run_rounds(
+            target,
+            camera,
+            &mut others_chains,
+            &plan.phase(first_phase),
+            0,
+            &mut others_pass,
+            &mut scratch_film,
+            &Control::new(None, true),
+            &mut |_, _| {},
+        );
+        for chain in &others_chains {
+            others_counts.add(&chain.chain.counts);
+        }
+    }
+    let mut counts = others_counts;
     for chain in &chains {
         counts.add(&chain.chain.counts);
     }
@@ -294,7 +324,12 @@ pub(crate) fn run(
     // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
     let rays: Vec<u64> = chains.iter().map(|c| c.chain.rays()).collect();
     pass.start_phase(&rays, &vec![0; rays.len()]);
-    let mut chains = seed_chains(&boot, settings.seed ^ ADAPTED_PHASE_SEED, plan.chain_count);
+    let mut chains = seed_chains(
+        &boot,
+        settings.seed ^ ADAPTED_PHASE_SEED,
+        plan.chain_count,
+        &owned,
+    );
     drop(boot);
     let (rest, made) = driver::run_rounds(
         &adapted,

@@ -95,9 +95,11 @@ fn prepass_samples(pixels: u64, samples_per_pixel: u32) -> u64 {
 /// Target camera samples per pass over the image (after the first).
 const PASS_SAMPLES: u64 = 1 << 15;
 /// Rows per work unit.
-const BAND_ROWS: u32 = 2;
-/// Fixed-point units per e_d of the accumulators.
-const FIXED_POINT: f64 = (1u64 << 24) as f64;
+pub(crate) const BAND_ROWS: u32 = 2;
+/// Fixed-point units per e_d of the accumulators, at least: the unit is the power of two at
+/// or below e_d / 2^24 (never finer than the film's grid), so that the sums convert to the
+/// film's fixed point exactly and jobs of a split render add up to the bits of one render.
+const FIXED_POINT_BITS: i32 = 24;
 
 /// The settings of an ERPT render.
 pub(crate) struct ErptSettings {
@@ -110,6 +112,8 @@ pub(crate) struct ErptSettings {
     pub weights: MutationWeights,
     /// Perturb directions in the BSDF's sample space (`perturbation` module docs).
     pub perturb_in_sample_space: bool,
+    /// The bands of rows this run samples (a job's share of a split render).
+    pub share: crate::control::JobShare,
 }
 
 /// Per-work-unit memory, made once per render.
@@ -426,6 +430,8 @@ pub(crate) fn run(
     // (by a hash of pixel and sample, so every partial sees every region); the film's
     // splats are the partials' sums.
     let buffers = film.filter_buffers().max(1);
+    let grid_log2 = ((deposit_energy as f64).log2().floor() as i32 - FIXED_POINT_BITS)
+        .max(film.scene_grid_log2());
     let sums: Vec<[AtomicI64; 3]> = (0..pixels * buffers).map(|_| Default::default()).collect();
     let redistributor = Redistributor {
         bdpt,
@@ -442,7 +448,7 @@ pub(crate) fn run(
         deposit_energy,
         sums: &sums,
         buffers,
-        scale: FIXED_POINT / deposit_energy as f64,
+        scale: 2f64.powi(-grid_log2),
     };
     let bands = height.div_ceil(BAND_ROWS);
     let max_vertices = bdpt.max_depth as usize + 2;
@@ -480,6 +486,12 @@ pub(crate) fn run(
     let mut samples_taken = 0u64;
     while let Some(indices) = schedule.next_pass(u32::MAX, control) {
         units.par_iter_mut().enumerate().for_each(|(band, unit)| {
+            unit.taken = 0;
+            unit.mutations = 0;
+            unit.accepted = 0;
+            if !settings.share.owns(band as u64) {
+                return;
+            }
             let mut counters = SampleCounters::default();
             let (mut taken, mut mutations, mut accepted, mut invalid) = (0, 0, 0, 0);
             let first_row = band as u32 * BAND_ROWS;
@@ -533,26 +545,20 @@ pub(crate) fn run(
     }
     outcome.mutation_weights = settings.weights;
     // The film divides splats by (samples taken / pixels): one camera sample per pixel.
-    let unit = deposit_energy as f64 / FIXED_POINT;
-    let value = |s: &[AtomicI64; 3]| -> [f64; 3] {
-        std::array::from_fn(|c| s[c].load(Ordering::Relaxed) as f64 * unit)
-    };
-    film.add_splat_sums(
-        sums.chunks_exact(buffers).map(|pixel| {
-            // Integer sums first, so the total does not depend on the number of partials.
-            std::array::from_fn(|c| {
-                pixel
-                    .iter()
-                    .map(|s| s[c].load(Ordering::Relaxed))
-                    .fold(0i64, i64::saturating_add) as f64
-                    * unit
-            })
-        }),
-        samples_taken,
-    );
-    if buffers > 1 {
-        film.add_partial_splat_sums(sums.iter().map(value));
-    }
+    let load =
+        |s: &[AtomicI64; 3]| -> [i64; 3] { std::array::from_fn(|c| s[c].load(Ordering::Relaxed)) };
+    let totals = sums.chunks_exact(buffers).map(|pixel| {
+        // Integer sums first, so the total does not depend on the number of partials.
+        std::array::from_fn(|c| {
+            pixel
+                .iter()
+                .map(|s| s[c].load(Ordering::Relaxed))
+                .fold(0i64, i64::saturating_add)
+        })
+    });
+    let mut partials = sums.iter().map(load);
+    let partials = (buffers > 1).then_some(&mut partials as &mut dyn Iterator<Item = [i64; 3]>);
+    film.add_integer_splat_sums(totals, partials, grid_log2, samples_taken);
     outcome
 }
 

@@ -72,7 +72,7 @@ mod perturbation;
 mod test_geometry;
 
 pub(crate) use chain::{PathSpaceTarget, run};
-pub(crate) use erpt::{ErptSettings, run as run_erpt};
+pub(crate) use erpt::{BAND_ROWS as ERPT_BAND_ROWS, ErptSettings, run as run_erpt};
 pub(crate) use perturbation::PerturbationSizes;
 
 use crate::bsdf::{Bsdf, TransportMode};
