@@ -109,8 +109,8 @@ fn split_renders_merge_into_the_bits_of_one() {
             assert_eq!(merged_stats.mutation_counts, stats.mutation_counts);
             assert_eq!(merged_stats.mutation_weights, stats.mutation_weights);
             if matches!(algorithm, Algorithm::Path | Algorithm::Bdpt) {
-                // Every Metropolis job runs the bootstrap again, every ERPT job the pre-pass
-                // of its deposit energy.
+                // Every ERPT job runs the pre-pass of its deposit energy, every Metropolis
+                // job the calibration of its normalization pass.
                 assert_eq!(merged_stats.rays, stats.rays);
             }
             assert_eq!(merged_stats.stop, StopReason::Completed);

@@ -20,7 +20,7 @@ use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, R
 use crate::film::{Film, FixedPoint, FixedRgb};
 use crate::filter::{FilterSettings, FilterStats};
 use crate::integrators::bdpt::Bdpt;
-use crate::integrators::mlt::driver::{ChainTally, MetropolisOutcome, finish};
+use crate::integrators::mlt::driver::{ChainStart, ChainTally, MetropolisOutcome, finish};
 use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
 use crate::integrators::mlt::primary_space::{MetropolisSettings, PrimarySpaceTarget};
 use crate::integrators::mlt::pssmlt;
@@ -63,29 +63,81 @@ impl Estimator<'_> {
 /// Path depth below which a Metropolis render with a direct pass leaves paths to that pass.
 const DIRECT_PASS_DEPTHS: u32 = 2;
 
+/// The settings of a render's Metropolis chains, or of `share` of them.
+fn metropolis_settings(settings: &RenderSettings, share: JobShare) -> MetropolisSettings {
+    MetropolisSettings {
+        mutations_per_pixel: settings.mutations_per_pixel,
+        bootstrap_samples: settings.resolved_bootstrap_samples(),
+        chains: settings.chains,
+        large_step_probability: settings.large_step_probability,
+        small_step_sigma: settings.small_step_sigma,
+        normalization_work_fraction: settings.normalization_work_fraction,
+        seed: settings.seed,
+        share,
+    }
+}
+
 impl Estimator<'_> {
-    /// Runs the render; `direct` is the path tracer of a Metropolis render's direct pass.
+    /// A Metropolis render's bootstrap and chain seeds (`None` for the other algorithms).
+    fn chain_start(
+        &self,
+        camera: &CameraModel,
+        settings: &RenderSettings,
+        control: &Control,
+    ) -> Option<ChainStart> {
+        let chains = metropolis_settings(settings, JobShare::WHOLE);
+        fn start<T: PrimarySpaceTarget>(
+            target: &T,
+            camera: &CameraModel,
+            chains: &MetropolisSettings,
+            control: &Control,
+        ) -> Option<ChainStart>
+        where
+            T::Scratch: Send,
+        {
+            // A target without groups has no chains (`pssmlt::run`).
+            (target.groups() > 0).then(|| ChainStart::new(target, camera, chains, false, control))
+        }
+        match *self {
+            Estimator::Pssmlt(target) => start(target, camera, &chains, control),
+            Estimator::Mmlt(target) => start(target, camera, &chains, control),
+            Estimator::PssmltBdpt(target) => start(target, camera, &chains, control),
+            Estimator::PathSpaceMlt(bdpt) => {
+                let all_strategies = BdptAllStrategies(Bdpt {
+                    scene: bdpt.scene,
+                    max_depth: bdpt.max_depth,
+                    min_depth: bdpt.min_depth,
+                    spectral: bdpt.spectral,
+                });
+                let adapt = settings.adapt_mutation_weights;
+                Some(ChainStart::new(
+                    &all_strategies,
+                    camera,
+                    &chains,
+                    adapt,
+                    control,
+                ))
+            }
+            Estimator::Path(_) | Estimator::Bdpt(_) | Estimator::Erpt(_) => None,
+        }
+    }
+
+    /// Runs the render; `direct` is the path tracer of a Metropolis render's direct pass,
+    /// `start` the chains' bootstrap and seeds if a split render's plan made them.
+    #[allow(clippy::too_many_arguments)]
     fn run(
         &self,
         camera: &CameraModel,
         settings: &RenderSettings,
         direct: Option<&PathTracer>,
         share: JobShare,
+        start: Option<&ChainStart>,
         film: &mut Film,
         control: &Control,
     ) -> MetropolisOutcome {
         let seed = settings.seed;
         let spp = settings.samples_per_pixel;
-        let chains = MetropolisSettings {
-            mutations_per_pixel: settings.mutations_per_pixel,
-            bootstrap_samples: settings.resolved_bootstrap_samples(),
-            chains: settings.chains,
-            large_step_probability: settings.large_step_probability,
-            small_step_sigma: settings.small_step_sigma,
-            normalization_work_fraction: settings.normalization_work_fraction,
-            seed,
-            share,
-        };
+        let chains = metropolis_settings(settings, share);
         // The direct pass keeps pace with the chains: after each round of mutations it
         // catches up to its share of samples.
         let ratio = settings.direct_samples_per_mutation;
@@ -116,15 +168,33 @@ impl Estimator<'_> {
                     .run(film, control);
                 MetropolisOutcome::default()
             }
-            Estimator::Pssmlt(target) => {
-                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
-            }
-            Estimator::Mmlt(target) => {
-                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
-            }
-            Estimator::PssmltBdpt(target) => {
-                pssmlt::run(target, camera, &chains, film, control, &mut keep_pace)
-            }
+            Estimator::Pssmlt(target) => pssmlt::run(
+                target,
+                camera,
+                &chains,
+                start,
+                film,
+                control,
+                &mut keep_pace,
+            ),
+            Estimator::Mmlt(target) => pssmlt::run(
+                target,
+                camera,
+                &chains,
+                start,
+                film,
+                control,
+                &mut keep_pace,
+            ),
+            Estimator::PssmltBdpt(target) => pssmlt::run(
+                target,
+                camera,
+                &chains,
+                start,
+                film,
+                control,
+                &mut keep_pace,
+            ),
             Estimator::PathSpaceMlt(bdpt) => {
                 let target = PathSpaceTarget {
                     bdpt: BdptAllStrategies(Bdpt {
@@ -139,7 +209,15 @@ impl Estimator<'_> {
                     perturb_in_sample_space: settings.perturb_in_sample_space,
                 };
                 let adapt = settings.adapt_mutation_weights;
-                path_space::run(&target, &chains, adapt, film, control, &mut keep_pace)
+                path_space::run(
+                    &target,
+                    &chains,
+                    start,
+                    adapt,
+                    film,
+                    control,
+                    &mut keep_pace,
+                )
             }
             Estimator::Erpt(bdpt) => {
                 let erpt = path_space::ErptSettings {
@@ -214,7 +292,8 @@ fn render_into(
             settings.width, settings.height
         )));
     }
-    let (film, mut stats, _) = render_film(scene, camera, settings, JobShare::WHOLE, progress)?;
+    let (film, mut stats, _) =
+        render_film(scene, camera, settings, JobShare::WHOLE, None, progress)?;
     stats.filter = film.write_rgb(
         &mut rgb_out[..needed],
         unfiltered_out.map(|u| &mut u[..needed]),
@@ -229,6 +308,7 @@ fn render_film(
     camera: &Camera,
     settings: &RenderSettings,
     share: JobShare,
+    start_from: Option<&ChainStart>,
     progress: Option<Progress>,
 ) -> Result<(Film, RenderStats, Option<ChainTally>)> {
     settings.validate()?;
@@ -248,6 +328,47 @@ fn render_film(
     let control = Control::new(deadline, settings.algorithm.is_metropolis());
     let model = camera.model(settings.width, settings.height);
     model.validate()?;
+    with_estimator(scene, settings, |estimator, direct| {
+        run_estimator(
+            scene, settings, share, start_from, progress, estimator, direct, pool, threads, &model,
+            control, start,
+        )
+    })
+}
+
+/// The bootstrap and chain seeds of a Metropolis render (`None` for the other algorithms),
+/// made once by a split render's plan (`jobs::plan`) for all its jobs.
+fn plan_chain_start(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &RenderSettings,
+) -> Result<Option<ChainStart>> {
+    if !settings.algorithm.is_metropolis() {
+        return Ok(None);
+    }
+    let own_pool;
+    let pool = if settings.threads == 0 {
+        shared_pool()?
+    } else {
+        own_pool = JoinedPool::new(settings.threads as usize)?;
+        own_pool.pool()
+    };
+    let deadline = (settings.time_limit_seconds > 0.0)
+        .then(|| Instant::now() + Duration::from_secs_f64(settings.time_limit_seconds));
+    let control = Control::new(deadline, true);
+    let model = camera.model(settings.width, settings.height);
+    with_estimator(scene, settings, |estimator, _| {
+        Ok(pool.install(|| estimator.chain_start(&model, settings, &control)))
+    })
+}
+
+/// Builds the estimator `settings` ask for (and the direct pass's path tracer) and hands
+/// them to `f`.
+fn with_estimator<R>(
+    scene: &Scene,
+    settings: &RenderSettings,
+    f: impl FnOnce(&Estimator, Option<&PathTracer>) -> Result<R>,
+) -> Result<R> {
     // A Metropolis render with a direct pass leaves the shortest paths to a path tracer
     // (with a max depth below 2, all of them: the chains then have nothing to render).
     let direct = (settings.algorithm.is_metropolis() && settings.direct_samples_per_mutation > 0)
@@ -304,6 +425,25 @@ fn render_film(
         Algorithm::PathSpaceMlt => Estimator::PathSpaceMlt(&bdpt),
         Algorithm::Erpt => Estimator::Erpt(&bdpt),
     };
+    f(&estimator, direct.as_ref())
+}
+
+/// The rest of `render_film`, with the estimator built.
+#[allow(clippy::too_many_arguments)]
+fn run_estimator(
+    scene: &Scene,
+    settings: &RenderSettings,
+    share: JobShare,
+    start_from: Option<&ChainStart>,
+    progress: Option<Progress>,
+    estimator: &Estimator,
+    direct: Option<&PathTracer>,
+    pool: &rayon::ThreadPool,
+    threads: u32,
+    model: &CameraModel,
+    control: Control,
+    start: Instant,
+) -> Result<(Film, RenderStats, Option<ChainTally>)> {
     let mut film = try_film(settings, estimator.chain_groups(), scene)?;
     let pixels = settings.width as u64 * settings.height as u64;
     // Progress counts camera samples and mutations alike; without a count (time limit
@@ -339,13 +479,12 @@ fn render_film(
         let done = &done;
         let control = &control;
         let film = &mut film;
-        let estimator = &estimator;
-        let direct = direct.as_ref();
-        let model = &model;
         let worker = s.spawn(move || {
             // Signals even when the render panics, so the caller never waits forever.
             let _signal = SignalOnDrop(done);
-            pool.install(|| estimator.run(model, settings, direct, share, film, control))
+            pool.install(|| {
+                estimator.run(model, settings, direct, share, start_from, film, control)
+            })
         });
         while !done.wait(PROGRESS_INTERVAL) {
             if let Some(callback) = progress.as_mut() {
@@ -354,9 +493,8 @@ fn render_film(
                     control.cancel();
                 }
             }
-            if deadline.is_some_and(|d| Instant::now() >= d) {
-                control.stop();
-            }
+            // Past the deadline, this stops the workers.
+            control.should_stop();
         }
         worker.join()
     });

@@ -376,6 +376,55 @@ pub(crate) fn resample_seeds(
     seeds
 }
 
+/// Stream offset of the seeds of path-space MLT's chains after the warm-up, apart from the
+/// warm-up's own.
+pub(crate) const ADAPTED_PHASE_SEED: u64 = 0xada7_7ed0_0000_0000;
+
+/// What every chain of a render starts from: the bootstrap's estimate and the rays it
+/// traced, and each chain's group and bootstrap sample (resampled), for the chains of the
+/// render and, for path-space MLT adapting its weights, for those after the warm-up. Made
+/// once, by the render or by the plan of a split render, whose jobs all start from it.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct ChainStart {
+    pub estimate: NormalizationEstimate,
+    pub rays: u64,
+    pub seeds: Vec<(usize, u64)>,
+    pub adapted_seeds: Vec<(usize, u64)>,
+}
+
+impl ChainStart {
+    /// Runs the bootstrap and draws the chains' seeds (none when it found no light).
+    pub fn new<T: PrimarySpaceTarget>(
+        target: &T,
+        camera: &CameraModel,
+        settings: &MetropolisSettings,
+        adapted_phase: bool,
+        control: &Control,
+    ) -> Self {
+        let boot = bootstrap(target, camera, settings, control);
+        let b = boot.estimate.b();
+        let normalization: f64 = b.iter().sum();
+        let (seeds, adapted_seeds) = if normalization > 0.0 && normalization.is_finite() {
+            let plan = ChainPlan::new(&b, camera, settings);
+            let draw = |seed| resample_seeds(&boot, &plan.chains_per_group, seed);
+            let adapted = if adapted_phase {
+                draw(settings.seed ^ ADAPTED_PHASE_SEED)
+            } else {
+                Vec::new()
+            };
+            (draw(settings.seed), adapted)
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        ChainStart {
+            estimate: boot.estimate,
+            rays: boot.rays,
+            seeds,
+            adapted_seeds,
+        }
+    }
+}
+
 /// What a render's chains are to do: their total mutations and how they are split.
 #[derive(Clone)]
 pub(crate) struct ChainPlan {

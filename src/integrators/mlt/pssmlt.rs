@@ -5,8 +5,8 @@
 
 use super::acceptance;
 use super::driver::{
-    Bootstrap, ChainPlan, Deposits, MarkovChain, MetropolisOutcome, WeightedChain, bootstrap,
-    deposit, finish_without_light, resample_seeds, restart_as_bootstrap, run_rounds, tally,
+    ChainPlan, ChainStart, Deposits, MarkovChain, MetropolisOutcome, WeightedChain, deposit,
+    finish_without_light, restart_as_bootstrap, run_rounds, tally,
 };
 use super::normalization::{
     Moments, NormalizationEstimate, NormalizationPass, PassImage, PointWeight,
@@ -91,7 +91,7 @@ fn plan_pass_image<T: PrimarySpaceTarget>(
     target: &T,
     camera: &CameraModel,
     settings: &MetropolisSettings,
-    boot: &Bootstrap,
+    boot: &ChainStart,
     plan: &ChainPlan,
     pass: &NormalizationPass<T>,
     control: &Control,
@@ -201,6 +201,7 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
     target: &T,
     camera: &CameraModel,
     settings: &MetropolisSettings,
+    start: Option<&ChainStart>,
     film: &mut Film,
     control: &Control,
     after_round: &mut dyn FnMut(&mut Film, f64),
@@ -214,9 +215,12 @@ where
         let nothing = NormalizationEstimate::new(0);
         return finish_without_light(camera, settings, &nothing, film, control, after_round);
     }
-    // 1. Bootstrap.
+    // 1. Bootstrap (or its result, made by a split render's plan).
     let n = settings.bootstrap_samples as u64;
-    let boot = bootstrap(target, camera, settings, control);
+    let boot = match start {
+        Some(start) => start.clone(),
+        None => ChainStart::new(target, camera, settings, false, control),
+    };
     let b = boot.estimate.b();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
@@ -226,13 +230,14 @@ where
     // 2. Chains, allotted to groups and seeded from resampled bootstrap samples; a job of
     // a split render makes its share of them.
     let plan = ChainPlan::new(&b, camera, settings);
-    let seeds: Vec<(u64, (usize, u64))> =
-        resample_seeds(&boot, &plan.chains_per_group, settings.seed)
-            .into_iter()
-            .enumerate()
-            .map(|(c, seed)| (c as u64, seed))
-            .filter(|&(c, _)| settings.share.owns(c))
-            .collect();
+    let seeds: Vec<(u64, (usize, u64))> = boot
+        .seeds
+        .iter()
+        .copied()
+        .enumerate()
+        .map(|(c, seed)| (c as u64, seed))
+        .filter(|&(c, _)| settings.share.owns(c))
+        .collect();
     let owned: Vec<u64> = seeds.iter().map(|&(c, _)| c).collect();
     let pass = NormalizationPass::new(
         target,
@@ -245,7 +250,6 @@ where
     let (offsets, pass_image) =
         plan_pass_image(target, camera, settings, &boot, &plan, &pass, control);
     let mut pass = pass.with_image(pass_image);
-    drop(boot.kept);
     let mut chains: Vec<WeightedChain<Chain<T>>> = seeds
         .into_par_iter()
         .map(|(c, (group, index))| {

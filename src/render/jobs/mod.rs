@@ -18,11 +18,15 @@
 
 pub(crate) mod wire;
 
-use super::{JobShare, Progress, RenderSettings, RenderStats, StopReason, render_film};
+use super::{
+    JobShare, Progress, RenderSettings, RenderStats, StopReason, plan_chain_start, render_film,
+};
 use crate::error::{Error, MLT_STATUS_INVALID_ARGUMENT, Result};
 use crate::film::{Film, read_film, write_film};
 use crate::filter::FilterStats;
-use crate::integrators::mlt::driver::{ChainTally, MutationCounts, MutationWeights, finish};
+use crate::integrators::mlt::driver::{
+    ChainStart, ChainTally, MutationCounts, MutationWeights, finish,
+};
 use crate::integrators::mlt::normalization::{Moments, NormalizationEstimate, NormalizationStats};
 use crate::render::Algorithm;
 use crate::scene::{Camera, Scene};
@@ -41,12 +45,15 @@ pub struct RenderPlan {
     camera: Camera,
     /// `Scene::fingerprint` of the scene the plan was made for.
     scene: u64,
+    /// A Metropolis render's bootstrap and chain seeds, made once for every job.
+    chain_start: Option<ChainStart>,
     /// A hash of the plan's bytes: partial results name the plan they belong to.
     id: u64,
 }
 
-/// Plans a render of `scene` to be split into jobs. Validates everything `render` would;
-/// `settings.threads` is only the default of the jobs, which each choose their own.
+/// Plans a render of `scene` to be split into jobs. Validates everything `render` would.
+/// For the Metropolis algorithms it runs the bootstrap (with `settings.threads`, within the
+/// time limit) and fixes every chain's group and seed, so the jobs need not repeat it.
 pub fn plan(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result<RenderPlan> {
     settings.validate()?;
     camera.validate()?;
@@ -55,6 +62,7 @@ pub fn plan(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result
         settings: *settings,
         camera: *camera,
         scene: scene.fingerprint(),
+        chain_start: plan_chain_start(scene, camera, settings)?,
         id: 0,
     };
     let mut w = Writer::default();
@@ -89,12 +97,14 @@ impl RenderPlan {
         let settings = read_settings(&mut r)?;
         let camera = read_camera(&mut r)?;
         let scene = r.u64()?;
+        let chain_start = read_chain_start(&mut r, &settings)?;
         let id = r.u64()?;
         r.end()?;
         let plan = RenderPlan {
             settings,
             camera,
             scene,
+            chain_start,
             id,
         };
         let mut w = Writer::default();
@@ -114,6 +124,7 @@ impl RenderPlan {
         write_settings(w, &self.settings);
         write_camera(w, &self.camera);
         w.u64(self.scene);
+        write_chain_start(w, self.chain_start.as_ref());
     }
 }
 
@@ -221,7 +232,14 @@ pub fn render_job(
         index: job,
         count: jobs,
     };
-    let (film, stats, tally) = render_film(scene, &plan.camera, &settings, share, progress)?;
+    let (film, stats, tally) = render_film(
+        scene,
+        &plan.camera,
+        &settings,
+        share,
+        plan.chain_start.as_ref(),
+        progress,
+    )?;
     Ok(PartialRender {
         plan: plan.id,
         job,
@@ -316,6 +334,8 @@ pub fn merge(
         }
         stats.normalization = finish(&mut film, tally);
     }
+    // The plan's bootstrap traced rays for every job.
+    stats.rays += plan.chain_start.as_ref().map_or(0, |start| start.rays);
     stats.filter = film.write_rgb(&mut rgb_out[..needed], None);
     Ok(stats)
 }
@@ -628,5 +648,52 @@ fn read_tally(r: &mut Reader) -> Result<Option<ChainTally>> {
         pass_layer: has_pass_layer.then_some(pass_layer),
         pass_samples: r.u64()?,
         mutations_per_chain: r.u64()?,
+    }))
+}
+
+fn write_seeds(w: &mut Writer, seeds: &[(usize, u64)]) {
+    w.len(seeds.len());
+    for &(group, index) in seeds {
+        w.u32(group as u32);
+        w.u64(index);
+    }
+}
+
+fn write_chain_start(w: &mut Writer, start: Option<&ChainStart>) {
+    w.bool(start.is_some());
+    let Some(start) = start else {
+        return;
+    };
+    write_estimate(w, &start.estimate);
+    w.u64(start.rays);
+    write_seeds(w, &start.seeds);
+    write_seeds(w, &start.adapted_seeds);
+}
+
+fn read_chain_start(r: &mut Reader, settings: &RenderSettings) -> Result<Option<ChainStart>> {
+    if !r.bool()? {
+        return Ok(None);
+    }
+    let estimate = read_estimate(r)?;
+    let rays = r.u64()?;
+    let groups = estimate.group_sums.len();
+    let samples = settings.resolved_bootstrap_samples() as u64;
+    let mut seeds = || -> Result<Vec<(usize, u64)>> {
+        (0..r.len(12)?)
+            .map(|_| {
+                let (group, index) = (r.u32()? as usize, r.u64()?);
+                if group >= groups || index >= samples {
+                    return Err(r.malformed("a chain's seed names no bootstrap sample"));
+                }
+                Ok((group, index))
+            })
+            .collect()
+    };
+    let (seeds, adapted_seeds) = (seeds()?, seeds()?);
+    Ok(Some(ChainStart {
+        estimate,
+        rays,
+        seeds,
+        adapted_seeds,
     }))
 }

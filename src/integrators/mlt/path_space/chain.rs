@@ -10,8 +10,8 @@ use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::driver::{
-    self, ChainPlan, Deposits, MarkovChain, MetropolisOutcome, Mutation, MutationCounts,
-    MutationWeights, WeightedChain,
+    self, ChainPlan, ChainStart, Deposits, MarkovChain, MetropolisOutcome, Mutation,
+    MutationCounts, MutationWeights, WeightedChain,
 };
 use crate::integrators::mlt::normalization::NormalizationPass;
 use crate::integrators::mlt::primary_space::{self, MetropolisSettings, PathSample};
@@ -193,6 +193,7 @@ impl<'a> MarkovChain for PathChain<'a> {
 pub(crate) fn run(
     target: &PathSpaceTarget,
     settings: &MetropolisSettings,
+    start: Option<&ChainStart>,
     adapt_weights: bool,
     film: &mut Film,
     control: &Control,
@@ -201,7 +202,10 @@ pub(crate) fn run(
     let camera = &target.camera;
     // 1. Bootstrap with BDPT, all strategies summed: b = ∫ f.
     let n = settings.bootstrap_samples as u64;
-    let boot = driver::bootstrap(&target.bdpt, camera, settings, control);
+    let boot = match start {
+        Some(start) => start.clone(),
+        None => ChainStart::new(&target.bdpt, camera, settings, adapt_weights, control),
+    };
     let b = boot.estimate.b()[0];
     if b <= 0.0 || !b.is_finite() {
         let mut outcome = driver::finish_without_light(
@@ -230,8 +234,7 @@ pub(crate) fn run(
         &owned,
         plan.chain_count,
     );
-    let seed_chains = |boot: &driver::Bootstrap, seed: u64, first_stream: u64, which: &[u64]| {
-        let seeds = driver::resample_seeds(boot, &plan.chains_per_group, seed);
+    let seed_chains = |seeds: &[(usize, u64)], first_stream: u64, which: &[u64]| {
         which
             .par_iter()
             .map(|&c| {
@@ -251,7 +254,7 @@ pub(crate) fn run(
     } else {
         plan.mutations_per_chain
     };
-    let mut chains = seed_chains(&boot, settings.seed, 0, &owned);
+    let mut chains = seed_chains(&boot.seeds, 0, &owned);
     // The second phase seeds its chains from the bootstrap too; otherwise free it now.
     let boot = adapting.then_some(boot);
     let (mut outcome, made) = driver::run_rounds(
@@ -279,7 +282,7 @@ pub(crate) fn run(
             normalization_work_fraction: 0.0,
             ..*settings
         };
-        let mut others_chains = seed_chains(&boot, settings.seed, 0, &others);
+        let mut others_chains = seed_chains(&boot.seeds, 0, &others);
         let mut others_pass = NormalizationPass::new(
             &target.bdpt,
             camera,
@@ -324,12 +327,7 @@ pub(crate) fn run(
     // Fresh chains, seeded independently of the warm-up (see `adapted_weights`).
     let rays: Vec<u64> = chains.iter().map(|c| c.chain.rays()).collect();
     pass.start_phase(&rays, &vec![0; rays.len()]);
-    let mut chains = seed_chains(
-        &boot,
-        settings.seed ^ ADAPTED_PHASE_SEED,
-        plan.chain_count,
-        &owned,
-    );
+    let mut chains = seed_chains(&boot.adapted_seeds, plan.chain_count, &owned);
     drop(boot);
     let (rest, made) = driver::run_rounds(
         &adapted,
@@ -349,9 +347,6 @@ pub(crate) fn run(
     outcome.tally = Some(driver::tally(film, pass, &chains, &plan, settings, made));
     outcome
 }
-
-/// Distinguishes the seeds of the chains after a warm-up from the warm-up's own.
-const ADAPTED_PHASE_SEED: u64 = 0xada7_7ed0_0000_0000;
 
 /// Mutation weights adapted to the acceptance counted over a warm-up: each weight times its
 /// mutation's acceptance rate, within a factor of `MAX_ADAPTATION` of the given weight (a
