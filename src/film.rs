@@ -7,8 +7,8 @@
 //! all (`Film::merge`).
 
 use crate::filter::{FilterSettings, FilterStats, filter_splats};
-use crate::render::jobs::wire::{Reader, Writer};
 use crate::spectrum::Spectrum;
+use crate::wire::{Reader, Writer};
 use glam::Vec3;
 use rayon::prelude::*;
 

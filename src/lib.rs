@@ -42,6 +42,7 @@ pub mod scene;
 mod spectral;
 pub mod spectrum;
 mod texture;
+mod wire;
 
 #[cfg(feature = "cli")]
 pub mod io;

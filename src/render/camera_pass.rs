@@ -3,8 +3,8 @@
 //! `integrators::camera_passes`, each band's samples added to its pixels and its splats
 //! to the film.
 
-use super::JobShare;
 use crate::control::Control;
+use crate::control::JobShare;
 use crate::film::{Film, Splat};
 use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
 use crate::integrators::{PixelEstimator, SampleCounters};

@@ -470,7 +470,7 @@ fn run_estimator(
         } else {
             camera_pass::ROWS
         };
-        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(&model, share, rows)
+        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(model, share, rows)
     };
 
     let mut progress = progress;

@@ -16,8 +16,6 @@
 //! partial result names its plan's id and its job. A buffer from another plan, scene or
 //! version, a corrupted or truncated one, a job missing or given twice, is an error.
 
-pub(crate) mod wire;
-
 use super::{
     JobShare, Progress, RenderSettings, RenderStats, StopReason, plan_chain_start, render_film,
 };
@@ -30,7 +28,7 @@ use crate::integrators::mlt::driver::{
 use crate::integrators::mlt::normalization::{Moments, NormalizationEstimate, NormalizationStats};
 use crate::render::Algorithm;
 use crate::scene::{Camera, Scene};
-use wire::{Reader, Writer};
+use crate::wire::{Reader, Writer};
 
 const PLAN_MAGIC: &[u8; 8] = b"MLTPLAN\0";
 const PARTIAL_MAGIC: &[u8; 8] = b"MLTPART\0";

@@ -10,7 +10,14 @@ use xxhash_rust::xxh3::xxh3_64;
 /// Raised with every change to what a frame holds: an older or newer buffer is refused.
 pub(crate) const FORMAT_VERSION: u32 = 1;
 
-const HEADER_LEN: usize = 8 + 4 + 4 + 8;
+/// The library that writes and reads a frame: renders from two versions of the kernel need
+/// not agree bit for bit.
+const LIBRARY_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// Bytes the version takes in a frame, zero-padded.
+const VERSION_LEN: usize = 16;
+const _: () = assert!(LIBRARY_VERSION.len() <= VERSION_LEN);
+
+const HEADER_LEN: usize = 8 + 4 + VERSION_LEN + 8;
 const CHECKSUM_LEN: usize = 8;
 
 /// Builds a payload field by field.
@@ -69,7 +76,9 @@ impl Writer {
         let mut out = Vec::with_capacity(HEADER_LEN + self.bytes.len() + CHECKSUM_LEN);
         out.extend_from_slice(magic);
         out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-        out.extend_from_slice(&crate::capi::mlt_version().to_le_bytes());
+        let mut version = [0u8; VERSION_LEN];
+        version[..LIBRARY_VERSION.len()].copy_from_slice(LIBRARY_VERSION.as_bytes());
+        out.extend_from_slice(&version);
         out.extend_from_slice(&(self.bytes.len() as u64).to_le_bytes());
         out.extend_from_slice(&self.bytes);
         let checksum = xxh3_64(&out);
@@ -98,23 +107,21 @@ impl<'a> Reader<'a> {
                 bytes.len()
             )));
         }
-        let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
-        let (format, library) = (word(8), word(12));
+        let format = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
         if format != FORMAT_VERSION {
             return Err(invalid(format!(
-                "the {what} is in format {format}, this library (version {}) reads format {FORMAT_VERSION}",
-                version_string(crate::capi::mlt_version())
+                "the {what} is in format {format}, this library (mlt {LIBRARY_VERSION}) reads format {FORMAT_VERSION}"
             )));
         }
-        if library != crate::capi::mlt_version() {
-            // Renders from two versions of the kernel need not agree bit for bit.
+        let version = &bytes[12..12 + VERSION_LEN];
+        let version_end = version.iter().position(|&b| b == 0).unwrap_or(VERSION_LEN);
+        let library = String::from_utf8_lossy(&version[..version_end]);
+        if library != LIBRARY_VERSION {
             return Err(invalid(format!(
-                "the {what} was made by mlt {}, this is mlt {}: every job of a render must run the same version",
-                version_string(library),
-                version_string(crate::capi::mlt_version())
+                "the {what} was made by mlt {library}, this is mlt {LIBRARY_VERSION}: every job of a render must run the same version"
             )));
         }
-        let length = u64::from_le_bytes(bytes[16..24].try_into().unwrap());
+        let length = u64::from_le_bytes(bytes[12 + VERSION_LEN..HEADER_LEN].try_into().unwrap());
         let expected = (HEADER_LEN + CHECKSUM_LEN) as u64;
         if length.checked_add(expected) != Some(bytes.len() as u64) {
             return Err(invalid(format!(
@@ -211,15 +218,6 @@ impl<'a> Reader<'a> {
             Err(self.malformed("bytes are left over"))
         }
     }
-}
-
-fn version_string(version: u32) -> String {
-    format!(
-        "{}.{}.{}",
-        version / 10000,
-        version / 100 % 100,
-        version % 100
-    )
 }
 
 #[cfg(test)]
