@@ -2,7 +2,8 @@
 // and C++20). It checks what the C++ layer adds to the C interface: the defaults of its
 // structs against the library's, errors as mlt::Error with the right status and message,
 // the progress callback (a lambda that cancels, one that throws: the render is cancelled
-// and the exception reaches the caller), the spans, and the scene handle's ownership.
+// and the exception reaches the caller), the spans, the scene handle's ownership, and a
+// render split into jobs (mlt::Bytes owning what mlt gives).
 // Prints one "ok: ..." line per check and "all checks passed" at the end; exits with 1 on
 // the first failure.
 //
@@ -14,6 +15,7 @@
 
 #include <mlt.hpp>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -548,6 +550,64 @@ void sceneOwnership() {
     ok("mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer");
 }
 
+void splitRenders() {
+    const Ground ground;
+    const mlt::Scene scene(ground.desc());
+    const mlt::Camera camera = topCamera();
+    const mlt::RenderSettings settings = quickSettings();
+    const mlt::Image whole = mlt::render_image(scene, camera, settings);
+
+    // Plan, three jobs (their bytes kept in mlt::Bytes or copied into vectors, as a host
+    // receiving them from other machines has them), merged in another order.
+    const mlt::Bytes plan = mlt::render_plan(scene, camera, settings);
+    CHECK(!plan.empty() && plan.size() == plan.to_vector().size());
+    std::vector<mlt::Bytes> owned;
+    std::vector<std::vector<std::uint8_t>> copied;
+    for (std::uint32_t job = 0; job < 3; ++job) {
+        mlt::JobResult result = mlt::render_job(scene, plan, job, 3, job % 2);
+        CHECK(result.result.completed() && result.result.stats.samples > 0);
+        copied.push_back(result.partial.to_vector());
+        owned.push_back(std::move(result.partial));
+        CHECK(result.partial.empty()); // NOLINT(bugprone-use-after-move): checking it
+    }
+    std::vector<float> merged(whole.rgb.size());
+    std::reverse(owned.begin(), owned.end());
+    const mlt::RenderResult result = mlt::render_merge(plan, owned, merged);
+    CHECK(result.completed() && result.stats.samples == whole.result.stats.samples);
+    CHECK(merged == whole.rgb);
+    std::vector<float> fromCopies(whole.rgb.size());
+    const std::vector<mlt::Span<const std::uint8_t>> spans{copied[1], copied[2], copied[0]};
+    CHECK(mlt::render_merge(plan.to_vector(), spans, fromCopies).completed());
+    CHECK(fromCopies == whole.rgb);
+    ok("mlt::render_plan, render_job and render_merge: 3 jobs merge into render's image");
+
+    // Bad input throws, and a progress lambda cancels a job, which still gives its part.
+    copied[1][copied[1].size() / 2] ^= 1;
+    expectError([&] { mlt::render_merge(plan, copied, merged); },
+                mlt::Status::InvalidArgument, "partials[1]", __LINE__);
+    expectError([&] { mlt::render_merge(plan, std::vector<mlt::Bytes>(), merged); },
+                mlt::Status::InvalidArgument, "partial_count is 0", __LINE__);
+    expectError([&] { mlt::render_job(scene, plan, 3, 3); }, mlt::Status::InvalidArgument,
+                "job 3 does not exist", __LINE__);
+    mlt::RenderSettings metropolis = settings;
+    metropolis.algorithm = mlt::Algorithm::Mmlt;
+    expectError([&] { mlt::render_job(scene, mlt::render_plan(scene, camera, metropolis), 0, 2); },
+                mlt::Status::Unsupported, "", __LINE__);
+    const mlt::Bytes long_plan = mlt::render_plan(scene, camera, longSettings());
+    const mlt::JobResult cancelled =
+        mlt::render_job(scene, long_plan, 0, 2, 1, [](const mlt::Progress &) { return false; });
+    CHECK(cancelled.result.status == mlt::Status::Cancelled && !cancelled.partial.empty());
+    CHECK(contains(cancelled.result.message, "job 0 of 2"));
+    static_assert(std::is_nothrow_move_constructible_v<mlt::Bytes>, "");
+    static_assert(!std::is_copy_constructible_v<mlt::Bytes>, "");
+    mlt::Bytes moved = mlt::render_plan(scene, camera, settings);
+    MltBytes raw = moved.release();
+    CHECK(moved.empty() && raw.data != nullptr);
+    const mlt::Bytes adopted = mlt::Bytes::adopt(raw);
+    CHECK(adopted.size() == plan.size());
+    ok("split renders throw on bad input; a cancelled job gives its partial result; mlt::Bytes owns its bytes");
+}
+
 } // namespace
 
 int main() try {
@@ -556,6 +616,7 @@ int main() try {
     callbacks();
     spansAndImages();
     sceneOwnership();
+    splitRenders();
     std::cout << "all checks passed (C++" << (__cplusplus / 100) % 100 << ")\n";
     return 0;
 } catch (const std::exception &e) {

@@ -1141,6 +1141,24 @@ typedef struct MltHit {
   float v;
 } MltHit;
 
+/**
+ * Bytes mlt made for the host: a render plan (`mlt_render_plan`) or a job's partial result
+ * (`mlt_render_job`), to keep, send to another machine and pass back to mlt as a pointer
+ * and a size. The host owns them until `mlt_bytes_release` frees them. The bytes carry a
+ * format version, mlt's version and a checksum: a buffer that is corrupted, cut short, from
+ * another plan or from another version of mlt is refused with `MLT_STATUS_INVALID_ARGUMENT`.
+ *
+ * A fixed pair (it has no `struct_size` and will not grow). The calls that fill one write
+ * it without reading it: release the buffer it held first, or it leaks.
+ */
+typedef struct MltBytes {
+  /**
+   * The bytes; NULL when `size` is 0 (released).
+   */
+  uint8_t *data;
+  size_t size;
+} MltBytes;
+
 
 
 
@@ -1363,6 +1381,85 @@ MLT_API enum MltStatus mlt_intersect(const struct MltScene *scene, const struct 
  * `rays` and `occluded_out` must hold `count` elements.
  */
 MLT_API enum MltStatus mlt_occluded(const struct MltScene *scene, const struct MltRay *rays, size_t count, uint8_t *occluded_out);
+
+/**
+ * Plans a render of `scene` seen by `camera` with `settings`, to be split into jobs that
+ * other threads, processes or machines render (`mlt_render_job`) and one merges
+ * (`mlt_render_merge`) into the image `mlt_render` gives, bit for bit. Validates what
+ * `mlt_render` would. On success `*plan_out` receives the plan's bytes (a few hundred), to
+ * release with `mlt_bytes_release`; it is written without being read, so release what it
+ * held first. `settings.threads` is not used: each job chooses its own.
+ *
+ * A plan names its scene by a fingerprint of the scene's description (arrays, materials,
+ * lights, textures and backend): every job must build its scene from the same one.
+ * `MLT_ALGORITHM_PATH` and `MLT_ALGORITHM_BDPT` split; the Metropolis algorithms and ERPT
+ * plan, but their jobs return `MLT_STATUS_UNSUPPORTED` for now.
+ *
+ * # Safety
+ * `camera` and `settings` must point to initialized structs; `plan_out` must be writable.
+ * (`scene` is looked up among the live scenes: any other pointer is refused.)
+ */
+MLT_API enum MltStatus mlt_render_plan(const struct MltScene *scene, const struct MltCamera *camera, const struct MltRenderSettings *settings, struct MltBytes *plan_out);
+
+/**
+ * Renders job `job` of `jobs` (numbered from 0; `jobs` from 1 to `MLT_MAX_JOBS`) of the
+ * plan in `plan` (`plan_size` bytes, as `mlt_render_plan` gave them) on `scene`, which
+ * must be built from the same description as the plan's. `threads` is this job's (0: the
+ * process-wide pool of one thread per core, as `MltRenderSettings.threads`), and so are
+ * `progress` and `user_data` (may be NULL), called as for `mlt_render`. The plan's time
+ * limit applies to each job.
+ *
+ * On success `*partial_out` receives the job's partial result, to pass to
+ * `mlt_render_merge` with the others and release with `mlt_bytes_release` (it is written
+ * without being read: release what it held first), and `stats_out` (may be NULL; its
+ * `filter_*` fields are 0, the filter runs at the merge) what the job did.
+ * `MLT_STATUS_CANCELLED` and `MLT_STATUS_TIME_LIMIT_REACHED` also write both: the
+ * partial result holds what the job rendered, and merges into the image of a render
+ * stopped the same way. On any other status neither is written.
+ *
+ * # Safety
+ * If non-null, `plan` must point to `plan_size` readable bytes; `partial_out` must be
+ * writable, `stats_out` NULL or writable. (`scene` is looked up among the live scenes.)
+ */
+MLT_API enum MltStatus mlt_render_job(const struct MltScene *scene, const uint8_t *plan, size_t plan_size, uint32_t job, uint32_t jobs, uint32_t threads, MltProgressCallback progress, void *user_data, struct MltBytes *partial_out, struct MltRenderStats *stats_out);
+
+/**
+ * Merges the partial results of every job of the plan in `plan` (`plan_size` bytes) and
+ * writes the image into `rgb_out` (`out_len` floats, at least width × height × 3) as
+ * `mlt_render` would: bit for bit the image one `mlt_render` of the plan gives, whatever
+ * the number of jobs, their threads and the order of the partial results.
+ *
+ * `partials[i]` points to the `partial_sizes[i]` bytes of a job's partial result, as
+ * `mlt_render_job` gave them; `partial_count` is the number of jobs, each given once in
+ * any order. They are decoded one at a time, so the merge holds one decoded partial
+ * result besides the image's sums. A partial result that is corrupted, cut short, from
+ * another plan or split, a job missing or given twice, is `MLT_STATUS_INVALID_ARGUMENT`
+ * naming it. `stats_out` (may be NULL) receives the jobs' counts added up (`seconds` is
+ * the sum of the jobs' times, `threads` the most any job used).
+ *
+ * Returns `MLT_STATUS_OK` when every job completed; `MLT_STATUS_CANCELLED` (some job was
+ * cancelled) or `MLT_STATUS_TIME_LIMIT_REACHED` (some job reached the time limit) also
+ * write a valid image, normalized by the samples the jobs took. On any other status
+ * neither `rgb_out` nor `stats_out` is written.
+ *
+ * # Safety
+ * If non-null, `plan` must point to `plan_size` readable bytes; `partials` and
+ * `partial_sizes` to `partial_count` elements, each `partials[i]` to `partial_sizes[i]`
+ * readable bytes; `rgb_out` to `out_len` writable floats, not accessed by the host until
+ * the call returns; `stats_out` NULL or writable.
+ */
+MLT_API enum MltStatus mlt_render_merge(const uint8_t *plan, size_t plan_size, const uint8_t *const *partials, const size_t *partial_sizes, size_t partial_count, float *rgb_out, size_t out_len, struct MltRenderStats *stats_out);
+
+/**
+ * Frees bytes mlt gave (`mlt_render_plan`, `mlt_render_job`) and sets `data` to NULL and
+ * `size` to 0, so releasing twice is harmless. NULL, and an `MltBytes` whose `data` is
+ * NULL, are no-ops. Bytes mlt did not give, or released already through a copy of the
+ * `MltBytes`, are looked up, not freed: ignored, and `mlt_last_error_message` says so.
+ *
+ * # Safety
+ * `bytes` must be NULL or point to a readable and writable `MltBytes`.
+ */
+MLT_API void mlt_bytes_release(struct MltBytes *bytes);
 
 #ifdef __cplusplus
 }  // extern "C"

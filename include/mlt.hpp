@@ -18,6 +18,10 @@
  *     bool (false cancels) or void. Exceptions never cross into the library: one thrown by
  *     the callable is caught, the render is cancelled, and the exception is rethrown from
  *     mlt::render once the library has returned.
+ *   - A render splits into jobs: mlt::render_plan gives the plan as mlt::Bytes (owned, freed
+ *     by the destructor), mlt::render_job renders job k of N of it into a partial result,
+ *     and mlt::render_merge merges the partial results, from any byte containers, into
+ *     the image mlt::render gives, bit for bit.
  *
  *     mlt::Scene scene(desc);                          // throws mlt::Error on bad input
  *     mlt::RenderSettings settings;                    // the library's defaults
@@ -1237,6 +1241,21 @@ struct ProgressForwarder {
     }
 };
 
+/// How a render, job or merge that returned `status` ended: throws Error unless it is Ok,
+/// Cancelled or TimeLimitReached (each of which wrote its outputs).
+inline RenderResult result_of(MltStatus status, const char *operation,
+                              const MltRenderStats &c_stats) {
+    RenderResult result;
+    result.status = static_cast<Status>(status);
+    if (status == MLT_STATUS_CANCELLED || status == MLT_STATUS_TIME_LIMIT_REACHED) {
+        result.message = mlt_last_error_message();
+    } else {
+        check(status, operation);
+    }
+    result.stats = RenderStats::from_c(c_stats);
+    return result;
+}
+
 inline RenderResult render(const Scene &scene, const Camera &camera,
                            const RenderSettings &settings, Span<float> rgb_out,
                            MltProgressCallback callback, void *user_data,
@@ -1250,15 +1269,7 @@ inline RenderResult render(const Scene &scene, const Camera &camera,
                       callback, user_data, &c_stats);
     // The library has returned: the callable's exception may go on.
     if (callback_error && *callback_error) std::rethrow_exception(*callback_error);
-    RenderResult result;
-    result.status = static_cast<Status>(status);
-    if (status == MLT_STATUS_CANCELLED || status == MLT_STATUS_TIME_LIMIT_REACHED) {
-        result.message = mlt_last_error_message();
-    } else {
-        check(status, "mlt_render");
-    }
-    result.stats = RenderStats::from_c(c_stats);
-    return result;
+    return result_of(status, "mlt_render", c_stats);
 }
 
 } // namespace detail
@@ -1317,6 +1328,144 @@ Image render_image(const Scene &scene, const Camera &camera, const RenderSetting
     Image image = detail::image_for(settings);
     image.result = render(scene, camera, settings, image.rgb, std::forward<F>(progress));
     return image;
+}
+
+// ---------------------------------------------------------------------------------------
+// A render split into jobs: plan, job k of N, merge
+// ---------------------------------------------------------------------------------------
+
+/// Bytes mlt made, a plan (render_plan) or a job's partial result (render_job), owned:
+/// move-only, freed by the destructor (mlt_bytes_release). data() and size() are what to
+/// keep or send to another machine. A Span<const std::uint8_t> converts from it, as from
+/// any contiguous container of bytes, which is what render_job and render_merge take: the
+/// bytes may come back in the host's own buffers.
+class Bytes {
+public:
+    Bytes() noexcept = default;
+    ~Bytes() { mlt_bytes_release(&bytes_); }
+    Bytes(Bytes &&other) noexcept : bytes_(std::exchange(other.bytes_, empty_bytes())) {}
+    Bytes &operator=(Bytes &&other) noexcept {
+        if (this != &other) {
+            mlt_bytes_release(&bytes_);
+            bytes_ = std::exchange(other.bytes_, empty_bytes());
+        }
+        return *this;
+    }
+    Bytes(const Bytes &) = delete;
+    Bytes &operator=(const Bytes &) = delete;
+
+    /// Takes over bytes mlt gave (an MltBytes a C call filled).
+    static Bytes adopt(MltBytes bytes) noexcept {
+        Bytes b;
+        b.bytes_ = bytes;
+        return b;
+    }
+
+    const std::uint8_t *data() const noexcept { return bytes_.data; }
+    std::size_t size() const noexcept { return bytes_.size; }
+    bool empty() const noexcept { return bytes_.size == 0; }
+    const std::uint8_t *begin() const noexcept { return bytes_.data; }
+    const std::uint8_t *end() const noexcept { return bytes_.data + bytes_.size; }
+    /// A copy in a vector.
+    std::vector<std::uint8_t> to_vector() const { return {begin(), end()}; }
+
+    /// Frees what this holds and gives its MltBytes for a C call to fill.
+    MltBytes *reset() noexcept {
+        mlt_bytes_release(&bytes_);
+        return &bytes_;
+    }
+    /// Gives up ownership: the caller frees the result with mlt_bytes_release.
+    MltBytes release() noexcept { return std::exchange(bytes_, empty_bytes()); }
+
+private:
+    static constexpr MltBytes empty_bytes() noexcept { return MltBytes{nullptr, 0}; }
+
+    MltBytes bytes_ = empty_bytes();
+};
+
+/// Most jobs a render splits into.
+inline constexpr std::uint32_t max_jobs = MLT_MAX_JOBS;
+
+/// Plans a render of `scene` seen by `camera` with `settings`, to be split into jobs
+/// (mlt_render_plan): the bytes every job and the merge take. Throws Error on invalid input.
+inline Bytes render_plan(const Scene &scene, const Camera &camera,
+                         const RenderSettings &settings) {
+    const MltCamera c_camera = camera.to_c();
+    const MltRenderSettings c_settings = settings.to_c();
+    Bytes plan;
+    detail::check(mlt_render_plan(scene.get(), &c_camera, &c_settings, plan.reset()),
+                  "mlt_render_plan");
+    return plan;
+}
+
+/// What a job rendered: its partial result, for render_merge, and how it ended (a
+/// cancelled or timed-out job still gives its partial result).
+struct JobResult {
+    Bytes partial;
+    RenderResult result;
+};
+
+namespace detail {
+inline JobResult render_job(const Scene &scene, Span<const std::uint8_t> plan,
+                            std::uint32_t job, std::uint32_t jobs, std::uint32_t threads,
+                            MltProgressCallback callback, void *user_data,
+                            const std::exception_ptr *callback_error) {
+    MltRenderStats c_stats;
+    check(mlt_render_stats_default(&c_stats), "mlt_render_stats_default");
+    JobResult out;
+    const MltStatus status =
+        mlt_render_job(scene.get(), plan.data(), plan.size(), job, jobs, threads, callback,
+                       user_data, out.partial.reset(), &c_stats);
+    // The library has returned: the callable's exception may go on (out.partial frees
+    // what the job gave).
+    if (callback_error && *callback_error) std::rethrow_exception(*callback_error);
+    out.result = result_of(status, "mlt_render_job", c_stats);
+    return out;
+}
+} // namespace detail
+
+/// Renders job `job` of `jobs` (numbered from 0) of `plan` (mlt_render_job) on `scene`,
+/// which must be built from the same description as the plan's, with `threads` of its own
+/// (0: every core). Throws Error on invalid input (a corrupted plan, job >= jobs, another
+/// scene; Status::Unsupported for an algorithm that does not split yet).
+inline JobResult render_job(const Scene &scene, Span<const std::uint8_t> plan,
+                            std::uint32_t job, std::uint32_t jobs, std::uint32_t threads = 0) {
+    return detail::render_job(scene, plan, job, jobs, threads, nullptr, nullptr, nullptr);
+}
+
+/// As above, calling `progress(const Progress &)` as render() does.
+template <class F>
+JobResult render_job(const Scene &scene, Span<const std::uint8_t> plan, std::uint32_t job,
+                     std::uint32_t jobs, std::uint32_t threads, F &&progress) {
+    static_assert(std::is_invocable_v<F &, const Progress &>,
+                  "the progress callback is called as progress(const mlt::Progress &)");
+    detail::ProgressForwarder<std::remove_reference_t<F>> forwarder{progress, nullptr};
+    return detail::render_job(scene, plan, job, jobs, threads, &decltype(forwarder)::call,
+                              &forwarder, &forwarder.error);
+}
+
+/// Merges the partial results of every job of `plan`, given once each in any order, into
+/// `rgb_out` (at least width × height × 3 floats): the image render() gives, bit for bit
+/// (mlt_render_merge). `partials` is a range of contiguous byte containers (Bytes,
+/// std::vector<std::uint8_t>, Span<const std::uint8_t>, ...). Throws Error on invalid input
+/// (a partial result corrupted, of another plan, missing or given twice); returns how the
+/// jobs ended, with their stats added up.
+template <class Partials>
+RenderResult render_merge(Span<const std::uint8_t> plan, const Partials &partials,
+                          Span<float> rgb_out) {
+    std::vector<const std::uint8_t *> pointers;
+    std::vector<std::size_t> sizes;
+    for (const auto &partial : partials) {
+        const Span<const std::uint8_t> bytes(partial);
+        pointers.push_back(bytes.data());
+        sizes.push_back(bytes.size());
+    }
+    MltRenderStats c_stats;
+    detail::check(mlt_render_stats_default(&c_stats), "mlt_render_stats_default");
+    const MltStatus status =
+        mlt_render_merge(plan.data(), plan.size(), pointers.data(), sizes.data(),
+                         pointers.size(), rgb_out.data(), rgb_out.size(), &c_stats);
+    return detail::result_of(status, "mlt_render_merge", c_stats);
 }
 
 } // namespace mlt

@@ -366,7 +366,8 @@ fn cornell_cpp_renders_and_answers_ray_queries() {
 /// `c_examples/cpp_checks.cpp` checks what `include/mlt.hpp` adds to the C API: defaults
 /// equal to the library's, errors as `mlt::Error` with the status and message, progress
 /// lambdas that cancel or throw (the render is cancelled and the exception reaches the
-/// caller), spans (and `std::span` in C++20), and the scene handle's ownership.
+/// caller), spans (and `std::span` in C++20), the scene handle's ownership, and split
+/// renders (`mlt::render_plan`, `render_job`, `render_merge`, `mlt::Bytes`).
 #[test]
 fn cpp_header_reports_errors_and_cancels_from_callbacks() {
     for std in CPP_STANDARDS {
@@ -388,6 +389,8 @@ fn cpp_header_reports_errors_and_cancels_from_callbacks() {
             "ok: a lambda's exception cancels the render and is rethrown after it",
             "ok: an exception from the final progress call is rethrown",
             "ok: mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer",
+            "ok: mlt::render_plan, render_job and render_merge: 3 jobs merge into render's image",
+            "ok: split renders throw on bad input; a cancelled job gives its partial result; mlt::Bytes owns its bytes",
             &format!("all checks passed (C++{version})"),
         ] {
             assert!(stdout.contains(line), "{name}: no {line:?} in\n{stdout}");
@@ -574,6 +577,79 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
     }
 }
 
+/// `c_examples/split_render.c` plans a render, renders it as 3 jobs whose partial results
+/// go through temporary files, merges them in another order, checks the image against
+/// `mlt_render` bit for bit and that a corrupted partial result is refused. Its image must
+/// also be the Rust API's render, bit for bit. Built as C99 and as C++, with the path tracer
+/// and BDPT.
+#[test]
+fn split_render_c_merges_three_jobs_into_the_bits_of_one_render() {
+    let scene = common::cornell_box().scene();
+    for (exe_name, as_cpp, flags) in [
+        ("split_render_c99", false, &["-std=c99"][..]),
+        ("split_render_cpp", true, &["-x", "c++"][..]),
+    ] {
+        let exe = build("split_render.c", exe_name, as_cpp, flags);
+        for (algorithm, name) in [
+            (mlt::Algorithm::Path, "path"),
+            (mlt::Algorithm::Bdpt, "bdpt"),
+        ] {
+            let pfm_path = scratch_dir().join(format!("{exe_name}_{name}.pfm"));
+            let _ = std::fs::remove_file(&pfm_path);
+            let output = Command::new(&exe)
+                .arg(&pfm_path)
+                .args(["32", "24", "4", name])
+                .output()
+                .unwrap();
+            let stdout = String::from_utf8_lossy(&output.stdout);
+            assert!(
+                output.status.success(),
+                "{exe_name} {name} failed ({}):\n{stdout}{}",
+                output.status,
+                String::from_utf8_lossy(&output.stderr)
+            );
+            for line in [
+                "job 2 of 3:",
+                "merged 3 jobs:",
+                "a corrupted partial result is refused: partials[1]: the partial render's checksum does not match",
+                "the merged image equals mlt_render's bit for bit",
+            ] {
+                assert!(
+                    stdout.contains(line),
+                    "{exe_name} {name}: no {line:?} in\n{stdout}"
+                );
+            }
+            let settings = mlt::RenderSettings {
+                width: 32,
+                height: 24,
+                algorithm,
+                samples_per_pixel: 4,
+                seed: 7,
+                ..Default::default()
+            };
+            let mut expected = vec![0.0f32; settings.output_len().unwrap()];
+            mlt::render(
+                &scene,
+                &common::cornell_camera(),
+                &settings,
+                &mut expected,
+                None,
+            )
+            .unwrap();
+            let image = read_pfm(&pfm_path);
+            assert_eq!((image.width, image.height), (32, 24));
+            assert!(
+                image
+                    .rgb
+                    .iter()
+                    .zip(&expected)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{exe_name} {name}: the merged image differs from the Rust API's render"
+            );
+        }
+    }
+}
+
 /// A host program of c_examples/ and how a memory check runs it.
 struct HostRun {
     source: &'static str,
@@ -617,7 +693,7 @@ const STRESS: HostRun = HostRun {
 /// What runs under both the sanitizers and memcheck, sized for memcheck (about 50 times
 /// slower). minimal.c and cornell.cpp use the default 2^18 bootstrap samples, too many for
 /// memcheck; the stress program covers what they call.
-const CHECKED_HOSTS: [HostRun; 4] = [
+const CHECKED_HOSTS: [HostRun; 5] = [
     HostRun {
         source: "sky.c",
         std: "c99",
@@ -636,6 +712,11 @@ const CHECKED_HOSTS: [HostRun; 4] = [
     HostRun {
         args: &["4", "12"],
         ..STRESS
+    },
+    HostRun {
+        source: "split_render.c",
+        std: "c99",
+        args: &["OUT", "16", "16", "2"],
     },
 ];
 

@@ -197,6 +197,14 @@ fn sentinel_scene() -> *mut MltScene {
 
 const SENTINEL_F32: f32 = -12345.0;
 
+/// An `MltBytes` holding nothing, as a host declares one before a call fills it.
+fn empty_bytes() -> MltBytes {
+    MltBytes {
+        data: null_mut(),
+        size: 0,
+    }
+}
+
 fn default_material() -> MltMaterial {
     let mut m = std::mem::MaybeUninit::<MltMaterial>::uninit();
     // SAFETY: writable memory for an MltMaterial.
@@ -637,6 +645,17 @@ fn released_and_foreign_scene_pointers_are_refused() {
     let camera = floor_camera();
     let settings = small_settings(4, 4, 1);
     let rays = [ray([0.0, 1.0, 0.0], [0.0, -1.0, 0.0])];
+    let plan = {
+        let live = floor.create();
+        let mut bytes = empty_bytes();
+        // SAFETY: a live scene and valid pointers.
+        assert_ok(unsafe { mlt_render_plan(live.0, &camera, &settings, &mut bytes) });
+        // SAFETY: the bytes mlt gave, read before they are released.
+        let plan = unsafe { std::slice::from_raw_parts(bytes.data, bytes.size) }.to_vec();
+        // SAFETY: filled by mlt_render_plan, released once.
+        unsafe { mlt_bytes_release(&mut bytes) };
+        plan
+    };
     for (what, scene) in [
         ("released", released),
         ("foreign", stack),
@@ -647,9 +666,23 @@ fn released_and_foreign_scene_pointers_are_refused() {
         let mut hits = [SENTINEL_HIT];
         let mut flags = [0xABu8];
         let mut info = scene_info_default();
+        let (mut plan_out, mut partial_out) = (empty_bytes(), empty_bytes());
         // SAFETY: every other pointer is valid; `scene` must be refused before use.
         let statuses = unsafe {
             [
+                mlt_render_plan(scene, &camera, &settings, &mut plan_out),
+                mlt_render_job(
+                    scene,
+                    plan.as_ptr(),
+                    plan.len(),
+                    0,
+                    1,
+                    1,
+                    None,
+                    null_mut(),
+                    &mut partial_out,
+                    null_mut(),
+                ),
                 mlt_scene_get_info(scene, &mut info),
                 mlt_render(
                     scene,
@@ -674,6 +707,10 @@ fn released_and_foreign_scene_pointers_are_refused() {
         );
         assert_eq!(hits[0].triangle_id, SENTINEL_HIT.triangle_id, "{what}");
         assert_eq!((flags[0], info.triangle_count), (0xAB, 0), "{what}");
+        assert!(
+            plan_out.data.is_null() && partial_out.data.is_null(),
+            "{what}: bytes written"
+        );
         // SAFETY: looked up, not dereferenced; ignored with a message.
         unsafe { mlt_scene_release(scene) };
         assert!(
@@ -949,6 +986,41 @@ fn unknown_struct_sizes_are_refused_where_each_struct_is_read() {
             )
         });
         results.push((format!("stats_out.struct_size = {size}"), result));
+    }
+    // mlt_render_plan reads the camera and the settings too.
+    for size in unknown_sizes::<MltRenderSettings>() {
+        let bad = MltRenderSettings {
+            struct_size: size as u32,
+            ..settings
+        };
+        let mut plan = empty_bytes();
+        // SAFETY: valid pointers.
+        let status = unsafe { mlt_render_plan(scene.0, &camera, &bad, &mut plan) };
+        let result = check_error(
+            status,
+            MLT_STATUS_INVALID_ARGUMENT,
+            &["settings.struct_size"],
+        )
+        .and_then(|()| ensure(plan.data.is_null(), "plan_out written"));
+        results.push((
+            format!("mlt_render_plan settings.struct_size = {size}"),
+            result,
+        ));
+    }
+    for size in unknown_sizes::<MltCamera>() {
+        let bad = MltCamera {
+            struct_size: size as u32,
+            ..camera
+        };
+        let mut plan = empty_bytes();
+        // SAFETY: valid pointers.
+        let status = unsafe { mlt_render_plan(scene.0, &bad, &settings, &mut plan) };
+        let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["camera.struct_size"])
+            .and_then(|()| ensure(plan.data.is_null(), "plan_out written"));
+        results.push((
+            format!("mlt_render_plan camera.struct_size = {size}"),
+            result,
+        ));
     }
     for size in unknown_sizes::<MltSceneInfo>() {
         let mut info = MltSceneInfo {
@@ -1924,6 +1996,56 @@ fn last_error_is_cleared_by_each_kind_of_success() {
     let _ = HostScene::floor_and_light().create();
     fail();
     let _ = default_settings();
+    fail();
+    let mut plan = empty_bytes();
+    // SAFETY: valid pointers.
+    assert_ok(unsafe {
+        mlt_render_plan(
+            scene.0,
+            &floor_camera(),
+            &small_settings(4, 4, 1),
+            &mut plan,
+        )
+    });
+    fail();
+    let mut partial = empty_bytes();
+    // SAFETY: the plan's bytes as mlt gave them.
+    assert_ok(unsafe {
+        mlt_render_job(
+            scene.0,
+            plan.data,
+            plan.size,
+            0,
+            1,
+            1,
+            None,
+            null_mut(),
+            &mut partial,
+            null_mut(),
+        )
+    });
+    fail();
+    let mut image = [0.0f32; 48];
+    let partials = [partial.data.cast_const()];
+    // SAFETY: one partial result of `partial.size` bytes; 48 floats.
+    assert_ok(unsafe {
+        mlt_render_merge(
+            plan.data,
+            plan.size,
+            partials.as_ptr(),
+            &partial.size,
+            1,
+            image.as_mut_ptr(),
+            48,
+            null_mut(),
+        )
+    });
+    fail();
+    // SAFETY: filled by mlt, released once each.
+    unsafe { mlt_bytes_release(&mut partial) };
+    assert_eq!(last_error(), "", "a release clears the last error");
+    // SAFETY: as above.
+    unsafe { mlt_bytes_release(&mut plan) };
 }
 
 #[test]

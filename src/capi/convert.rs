@@ -5,7 +5,7 @@ use super::types::*;
 use crate::accel::Backend;
 use crate::error::*;
 use crate::integrators::mlt::driver::MutationWeights;
-use crate::render::{Algorithm, RenderSettings};
+use crate::render::{Algorithm, RenderSettings, RenderStats};
 use crate::scene::{
     AlphaMode, Camera, Material, MaterialKind, PunctualLight, PunctualLightKind, SunDesc,
     TextureRef,
@@ -262,6 +262,30 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         normalization_work_fraction: s.normalization_work_fraction,
         spectral: flag(s.spectral, "settings.spectral")?,
     })
+}
+
+/// What a render, a job or a merge did, as the host receives it (`struct_size` 0: the
+/// host's stays, `write_host` skips it).
+pub(super) fn stats_to_c(stats: &RenderStats) -> MltRenderStats {
+    MltRenderStats {
+        struct_size: 0,
+        samples: stats.samples,
+        rays: stats.rays,
+        invalid_samples: stats.invalid_samples,
+        seconds: stats.seconds,
+        threads: stats.threads,
+        accepted_mutations: stats.accepted_mutations,
+        normalization: stats.normalization.value,
+        mutations: stats.mutations,
+        mutations_proposed: stats.mutation_counts.proposed,
+        mutations_accepted: stats.mutation_counts.accepted,
+        mutation_weights: stats.mutation_weights.0,
+        filter_changed_fraction: stats.filter.changed_fraction,
+        filter_mean_neighbours: stats.filter.mean_neighbours,
+        normalization_samples: stats.normalization.samples,
+        normalization_relative_error: stats.normalization.relative_error,
+        normalization_largest_share: stats.normalization.largest_share,
+    }
 }
 
 /// A C boolean field `name`: 0 or 1, anything else is a mistake.

@@ -12,15 +12,19 @@
 //!
 //! The C types and constants are in `types` (what include/mlt.h declares), the checks of
 //! host pointers and the panic guard in `marshal`, the conversions between C and Rust values
-//! in `convert`, the reading and writing of growing structs in `extensible`; this file holds
-//! the exports.
+//! in `convert`, the reading and writing of growing structs in `extensible`, the live scene
+//! handles in `handles` and the byte buffers mlt gives the host in `buffers`; this file holds
+//! the exports, but for those of a render split into jobs, in `jobs`.
 
+mod buffers;
 mod convert;
 mod extensible;
 mod handles;
+mod jobs;
 mod marshal;
 mod types;
 
+pub use jobs::*;
 pub use types::*;
 
 use crate::accel::Backend;
@@ -520,27 +524,8 @@ pub unsafe extern "C" fn mlt_render_ex(
         };
         let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
         if let Some(fields) = stats_fields {
-            let value = MltRenderStats {
-                struct_size: 0, // the host's stays
-                samples: stats.samples,
-                rays: stats.rays,
-                invalid_samples: stats.invalid_samples,
-                seconds: stats.seconds,
-                threads: stats.threads,
-                accepted_mutations: stats.accepted_mutations,
-                normalization: stats.normalization.value,
-                mutations: stats.mutations,
-                mutations_proposed: stats.mutation_counts.proposed,
-                mutations_accepted: stats.mutation_counts.accepted,
-                mutation_weights: stats.mutation_weights.0,
-                filter_changed_fraction: stats.filter.changed_fraction,
-                filter_mean_neighbours: stats.filter.mean_neighbours,
-                normalization_samples: stats.normalization.samples,
-                normalization_relative_error: stats.normalization.relative_error,
-                normalization_largest_share: stats.normalization.largest_share,
-            };
             // SAFETY: checked by host_fields above; writable by the contract.
-            unsafe { write_host(stats_out, fields, &value) };
+            unsafe { write_host(stats_out, fields, &stats_to_c(&stats)) };
         }
         Ok(match stats.stop {
             StopReason::Completed => MLT_STATUS_OK,

@@ -620,6 +620,22 @@ pub struct MltHit {
     pub v: f32,
 }
 
+/// Bytes mlt made for the host: a render plan (`mlt_render_plan`) or a job's partial result
+/// (`mlt_render_job`), to keep, send to another machine and pass back to mlt as a pointer
+/// and a size. The host owns them until `mlt_bytes_release` frees them. The bytes carry a
+/// format version, mlt's version and a checksum: a buffer that is corrupted, cut short, from
+/// another plan or from another version of mlt is refused with `MLT_STATUS_INVALID_ARGUMENT`.
+///
+/// A fixed pair (it has no `struct_size` and will not grow). The calls that fill one write
+/// it without reading it: release the buffer it held first, or it leaks.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct MltBytes {
+    /// The bytes; NULL when `size` is 0 (released).
+    pub data: *mut u8,
+    pub size: usize,
+}
+
 /// An immutable scene: triangles, materials, lights and the acceleration structure. Thread
 /// safe: any number of threads may render and query one scene at the same time.
 /// Reference-counted: `mlt_scene_retain` adds a reference, `mlt_scene_release` drops one,
