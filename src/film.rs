@@ -325,10 +325,25 @@ impl Film {
     ) {
         let shift = grid_log2 - self.scene_units.grid_log2();
         assert!(
-            (0..64).contains(&shift),
-            "a grid of 2^{grid_log2} is finer than the film's or too coarse"
+            shift >= 0,
+            "a grid of 2^{grid_log2} is finer than the film's"
         );
-        let convert = |v: [i64; 3]| v.map(|c| (c as i128) << shift);
+        // Beyond the film's range (a deposit energy far above the scene's brightest light),
+        // values are clamped as `FixedPoint::fixed` clamps them.
+        let limit = 1i128 << 125;
+        let bound = if shift < 126 { limit >> shift } else { 0 };
+        let convert = |v: [i64; 3]| {
+            v.map(|c| {
+                let c = c as i128;
+                if c == 0 {
+                    0
+                } else if c.abs() <= bound {
+                    c << shift
+                } else {
+                    c.signum() * limit
+                }
+            })
+        };
         self.light_paths += light_paths;
         for (total, sum) in self.splats.iter_mut().zip(sums) {
             add_sums(std::slice::from_mut(total), &[convert(sum)]);
