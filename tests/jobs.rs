@@ -194,3 +194,47 @@ fn bad_buffers_jobs_and_scenes_are_refused() {
     let other_plan = jobs::plan(&scene, &camera, &other_seed).unwrap();
     invalid(merge(vec![job(0, 1)], &other_plan), "another plan");
 }
+
+/// A job cut short (here cancelled after its first round; a time limit stops it the same
+/// way) still merges into a correctly normalized image: its chains' work is scaled up to the
+/// mutations planned. In the furnace every pixel's radiance is known.
+#[test]
+fn a_job_cut_short_still_merges_into_the_right_brightness() {
+    let (albedo, emission) = ([0.5; 3], [1.0; 3]);
+    let scene = furnace_scene(albedo, emission);
+    let settings = RenderSettings {
+        width: 32,
+        height: 32,
+        algorithm: Algorithm::Mmlt,
+        mutations_per_pixel: 512,
+        bootstrap_samples: 1 << 14,
+        chains: 64,
+        seed: 3,
+        ..Default::default()
+    };
+    let plan = jobs::plan(&scene, &furnace_camera(), &settings).unwrap();
+    let mut stop_at_once = |_: f32| false;
+    let cut = jobs::render_job(&scene, &plan, 0, 2, 1, Some(&mut stop_at_once)).unwrap();
+    assert_eq!(cut.stats().stop, StopReason::Cancelled);
+    let whole = jobs::render_job(&scene, &plan, 1, 2, 1, None).unwrap();
+    assert!(
+        cut.stats().mutations < whole.stats().mutations / 4,
+        "the job was not cut: {} mutations against {}",
+        cut.stats().mutations,
+        whole.stats().mutations
+    );
+    let (cut, whole) = (cut.to_bytes(), whole.to_bytes());
+    let mut images = [cut.clone(), whole.clone()].map(|_| vec![0.0f32; 32 * 32 * 3]);
+    for (order, image) in [[&cut, &whole], [&whole, &cut]].iter().zip(&mut images) {
+        let partials = order.map(|b| PartialRender::from_bytes(b).unwrap());
+        let stats = jobs::merge(&plan, partials, image).unwrap();
+        assert_eq!(stats.stop, StopReason::Cancelled);
+    }
+    assert!(
+        same_bits(&images[0], &images[1]),
+        "the merge depends on the order"
+    );
+    let truth = furnace_truth(albedo, emission, settings.max_depth)[0];
+    let (mean, error) = mean_and_standard_error(&images[0]);
+    assert_within_and_sharp("cut merge, red", mean[0], truth, error[0], 4.0);
+}
