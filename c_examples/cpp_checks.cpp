@@ -589,10 +589,6 @@ void splitRenders() {
                 mlt::Status::InvalidArgument, "partial_count is 0", __LINE__);
     expectError([&] { mlt::render_job(scene, plan, 3, 3); }, mlt::Status::InvalidArgument,
                 "job 3 does not exist", __LINE__);
-    mlt::RenderSettings metropolis = settings;
-    metropolis.algorithm = mlt::Algorithm::Mmlt;
-    expectError([&] { mlt::render_job(scene, mlt::render_plan(scene, camera, metropolis), 0, 2); },
-                mlt::Status::Unsupported, "", __LINE__);
     const mlt::Bytes long_plan = mlt::render_plan(scene, camera, longSettings());
     const mlt::JobResult cancelled =
         mlt::render_job(scene, long_plan, 0, 2, 1, [](const mlt::Progress &) { return false; });

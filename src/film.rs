@@ -585,6 +585,13 @@ pub(crate) fn read_film(r: &mut Reader) -> Result<Film, crate::Error> {
         strength: r.f32()?,
         radius: r.u32()?,
     };
+    let in_range = (crate::filter::MLT_MIN_FILTER_BUFFERS..=crate::filter::MLT_MAX_FILTER_BUFFERS)
+        .contains(&filter.buffers)
+        && filter.radius <= crate::filter::MLT_MAX_FILTER_RADIUS
+        && (0.0..=crate::filter::MLT_MAX_FILTER_STRENGTH).contains(&filter.strength);
+    if filtered && !in_range {
+        return Err(r.malformed("the filter's settings are out of range"));
+    }
     let partials = sums(r, pixels)?;
     let expected_partials = if filtered {
         splats.len() * filter.buffers as usize

@@ -115,6 +115,7 @@ impl RenderPlan {
         }
         settings.validate()?;
         camera.validate()?;
+        camera.model(settings.width, settings.height).validate()?;
         Ok(plan)
     }
 
@@ -273,6 +274,17 @@ pub fn merge(
             return Err(Error::invalid(format!(
                 "job {} of {} belongs to another plan (id {:016x}, not {:016x})",
                 partial.job, partial.jobs, partial.plan, plan.id
+            )));
+        }
+        if (partial.film.width, partial.film.height) != (plan.settings.width, plan.settings.height)
+        {
+            return Err(Error::invalid(format!(
+                "job {}'s image is {} x {}, the plan's {} x {}",
+                partial.job,
+                partial.film.width,
+                partial.film.height,
+                plan.settings.width,
+                plan.settings.height
             )));
         }
         if seen.is_empty() {
