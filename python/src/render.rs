@@ -8,7 +8,7 @@ use crate::convert;
 use crate::errors;
 use crate::scene::Scene;
 use numpy::{PyArray1, PyArray3, PyArrayMethods};
-use pyo3::exceptions::PyMemoryError;
+use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -67,6 +67,14 @@ where
     T: Send,
     F: Send + FnOnce(&mut dyn FnMut(f32) -> bool) -> T,
 {
+    if let Some(progress) = &progress
+        && !progress.is_callable()
+    {
+        return Err(PyTypeError::new_err(format!(
+            "progress must be callable (it is given the fraction done), not {}",
+            progress.get_type().name()?
+        )));
+    }
     let callback = progress.map(Bound::unbind);
     let token = cancel.map(|c| c.get().flag.clone());
     let mut raised: Option<PyErr> = None;

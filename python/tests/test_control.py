@@ -64,6 +64,11 @@ def test_exception_in_progress_cancels_and_is_reraised(lit_plane: mlt.Scene) -> 
     assert time.monotonic() - start < LIMIT / 4
 
 
+def test_progress_must_be_callable(lit_plane: mlt.Scene) -> None:
+    with pytest.raises(TypeError, match="progress must be callable .*, not int"):
+        mlt.render(lit_plane, CAMERA, until_limit(), progress=1)  # type: ignore[arg-type]
+
+
 def test_cancel_token_from_another_thread(lit_plane: mlt.Scene) -> None:
     token = mlt.CancelToken()
     timer = threading.Timer(0.3, token.cancel)

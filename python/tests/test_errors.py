@@ -6,13 +6,14 @@ import pickle
 import re
 
 import numpy as np
+import numpy.typing as npt
 import pytest
 from conftest import CAMERA, REPOSITORY, SCENES, quad
 
 import mlt
 
 
-def build(positions: object = None, indices: object = None, **kwargs: object) -> mlt.Scene:
+def build(positions: npt.ArrayLike | None = None, indices: npt.ArrayLike | None = None, **kwargs: object) -> mlt.Scene:
     good_positions, good_indices = quad()
     return mlt.Scene.from_arrays(
         good_positions if positions is None else positions,
@@ -34,7 +35,7 @@ def invalid(match: str) -> pytest.RaisesExc[mlt.InvalidArgumentError]:
         ([["a", "b", "c"]] * 4, "positions has dtype <U1"),
     ],
 )
-def test_positions_of_the_wrong_shape_or_dtype(positions: object, match: str) -> None:
+def test_positions_of_the_wrong_shape_or_dtype(positions: npt.ArrayLike, match: str) -> None:
     with invalid(match):
         build(positions=positions)
 
@@ -50,7 +51,7 @@ def test_positions_of_the_wrong_shape_or_dtype(positions: object, match: str) ->
         (np.array([[0, 2, 1], [0, 9, 2]]), r"desc.indices\[4\] \(triangle 1\) is 9, but there are only 4 vertices"),
     ],
 )
-def test_bad_indices(indices: object, match: str) -> None:
+def test_bad_indices(indices: npt.ArrayLike, match: str) -> None:
     with invalid(match):
         build(indices=indices)
 

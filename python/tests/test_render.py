@@ -70,7 +70,7 @@ def test_constant_environment_seen_everywhere() -> None:
     ],
     ids=["directional", "delta-sun"],
 )
-def test_diffuse_plane_under_a_delta_light(light: object) -> None:
+def test_diffuse_plane_under_a_delta_light(light: mlt.PunctualLight | mlt.Sun) -> None:
     # A Lambertian plane of albedo rho facing a delta light of irradiance E along its
     # normal reflects rho E / pi towards the camera; with one bounce and a delta light
     # there is nothing to sample, so every pixel is exact.
@@ -107,7 +107,7 @@ def test_material_ids_pick_each_triangles_material() -> None:
         [[-10, -10, 0], [0, -10, 0], [0, 10, 0], [-10, 10, 0], [10, -10, 0], [10, 10, 0]], np.float32
     )
     indices = np.array([[0, 2, 1], [0, 3, 2], [1, 5, 4], [1, 2, 5]], np.uint32)
-    materials = [
+    materials: list[mlt.Material | dict[str, object]] = [
         {"kind": "diffuse", "color": (0.5, 0.5, 0.5), "emission": (1.0, 0.0, 0.0)},
         mlt.Material.diffuse((0.5, 0.5, 0.5), emission=(0.0, 0.0, 1.0)),
     ]
