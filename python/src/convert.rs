@@ -37,14 +37,14 @@ fn field<'py, T: FromPyObjectOwned<'py>>(
         .map_err(|e| with_context(py, e.into(), &format!("{owner}.{name}")))
 }
 
-/// A string field in lower case with `-` for `_`, as the enumerations' names are given.
+/// A string field (an enumeration's name).
 fn name_field(obj: &Bound<'_, PyAny>, owner: &str, name: &str) -> PyResult<String> {
-    Ok(field::<String>(obj, owner, name)?
-        .to_ascii_lowercase()
-        .replace('_', "-"))
+    field::<String>(obj, owner, name)
 }
 
-/// `value` as one of `choices` (`(name, value)`), or an error listing them.
+/// `value` as one of `choices` (`(name, value)`), or an error listing them. Case, and `-`
+/// against `_`, do not matter (`"pssmlt_bdpt"` is `"pssmlt-bdpt"`, `"Metallic-Roughness"`
+/// is `"metallic_roughness"`).
 fn choose<T: Copy>(
     py: Python<'_>,
     owner: &str,
@@ -54,7 +54,7 @@ fn choose<T: Copy>(
 ) -> PyResult<T> {
     choices
         .iter()
-        .find(|(n, _)| *n == value)
+        .find(|(n, _)| same_name(n, value))
         .map(|&(_, v)| v)
         .ok_or_else(|| {
             let names: Vec<String> = choices.iter().map(|(n, _)| format!("{n:?}")).collect();
@@ -66,6 +66,14 @@ fn choose<T: Copy>(
                 ),
             )
         })
+}
+
+fn same_name(a: &str, b: &str) -> bool {
+    let canonical = |c: char| match c {
+        '-' => '_',
+        c => c.to_ascii_lowercase(),
+    };
+    a.len() == b.len() && a.chars().map(canonical).eq(b.chars().map(canonical))
 }
 
 const ALGORITHMS: [(&str, Algorithm); 7] = [
@@ -82,14 +90,13 @@ const MATERIAL_KINDS: [(&str, MaterialKind); 4] = [
     ("diffuse", MaterialKind::Diffuse),
     ("mirror", MaterialKind::Mirror),
     ("dielectric", MaterialKind::Dielectric),
-    ("metallic-roughness", MaterialKind::MetallicRoughness),
+    ("metallic_roughness", MaterialKind::MetallicRoughness),
 ];
 
 const BACKENDS: [(&str, Backend); 2] = [("bvh", Backend::Bvh), ("embree", Backend::Embree)];
 
 pub fn backend(py: Python<'_>, name: &str) -> PyResult<Backend> {
-    let name = name.to_ascii_lowercase();
-    choose(py, "Scene", "backend", &name, &BACKENDS)
+    choose(py, "Scene", "backend", name, &BACKENDS)
 }
 
 pub fn camera(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {
@@ -233,8 +240,8 @@ pub fn texture(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<TextureDesc<'st
             &value,
             &[
                 ("repeat", WrapMode::Repeat),
-                ("clamp-to-edge", WrapMode::ClampToEdge),
-                ("mirrored-repeat", WrapMode::MirroredRepeat),
+                ("clamp_to_edge", WrapMode::ClampToEdge),
+                ("mirrored_repeat", WrapMode::MirroredRepeat),
             ],
         )
     };

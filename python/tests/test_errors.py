@@ -93,7 +93,7 @@ def test_error_carries_status_code_and_message() -> None:
 
 
 def test_bad_materials() -> None:
-    with invalid(r'materials\[0\].kind is "plastic"; expected one of "diffuse", "mirror"'):
+    with invalid(r'materials\[0\].kind is "plastic"; expected one of "diffuse", "mirror", "dielectric", "metallic_roughness"$'):
         build(materials=[mlt.Material(kind="plastic")])
     with invalid(r"desc.materials\[1\].color.y is 1.5; a reflectance above 1 would create energy"):
         build(materials=[mlt.Material(), mlt.Material(color=(0.5, 1.5, 0.5))])
@@ -105,6 +105,15 @@ def test_bad_materials() -> None:
         build(materials=[mlt.Material(color=(1.0, 0.0))])  # type: ignore[arg-type]
     with invalid("desc.materials is empty"):
         build(materials=[])
+
+
+def test_names_ignore_case_and_dashes() -> None:
+    # Enumerations are strings: "metallic-roughness", "PSSMLT_BDPT" and "BVH" name the same.
+    scene = build(
+        materials=[mlt.Material(kind="Metallic-Roughness", emission=(1.0, 1.0, 1.0))], backend="BVH"  # type: ignore[arg-type]
+    )
+    image, _ = mlt.render(scene, CAMERA, mlt.RenderSettings(width=4, height=4, algorithm="PSSMLT_BDPT", mutations_per_pixel=1, bootstrap_samples=64, chains=4))
+    assert np.isfinite(image).all() and image.mean() > 0
 
 
 def test_bad_settings_and_camera() -> None:
