@@ -1,0 +1,74 @@
+"""mlt: an embeddable Metropolis light transport renderer.
+
+Build a :class:`Scene` from numpy arrays (:meth:`Scene.from_arrays`) or load one from an
+OBJ or glTF file (:meth:`Scene.load`), then :func:`render` it with a :class:`Camera` and
+:class:`RenderSettings` into a float32 numpy array of shape (height, width, 3), linear
+RGB::
+
+    import mlt
+
+    scene, camera = mlt.Scene.load("tests/scenes/cornell-box.obj")
+    image, stats = mlt.render(scene, camera, mlt.RenderSettings(width=128, height=128))
+
+The GIL is released while rendering. ``progress=`` takes a callable of the fraction done
+(return False to stop), ``cancel=`` a :class:`CancelToken` another thread may cancel; Ctrl-C
+stops a render too. Errors from mlt are :class:`MltError`; invalid input is
+:class:`InvalidArgumentError`, also a ``ValueError``.
+"""
+
+from __future__ import annotations
+
+from ._errors import InvalidArgumentError, LoadError, MltError, UnsupportedError
+from ._mlt import (
+    EMBREE_AVAILABLE,
+    CancelToken,
+    FilterStats,
+    MutationCounts,
+    NormalizationStats,
+    RenderStats,
+    Scene,
+    SceneInfo,
+    __version__,
+    load_environment,
+    render,
+    render_with_unfiltered,
+)
+from ._types import (
+    Algorithm,
+    Camera,
+    Environment,
+    Material,
+    PunctualLight,
+    RenderSettings,
+    Sun,
+    Texture,
+    TextureRef,
+)
+
+__all__ = [
+    "EMBREE_AVAILABLE",
+    "Algorithm",
+    "Camera",
+    "CancelToken",
+    "Environment",
+    "FilterStats",
+    "InvalidArgumentError",
+    "LoadError",
+    "Material",
+    "MltError",
+    "MutationCounts",
+    "NormalizationStats",
+    "PunctualLight",
+    "RenderSettings",
+    "RenderStats",
+    "Scene",
+    "SceneInfo",
+    "Sun",
+    "Texture",
+    "TextureRef",
+    "UnsupportedError",
+    "__version__",
+    "load_environment",
+    "render",
+    "render_with_unfiltered",
+]

@@ -1,0 +1,321 @@
+"""The value types of the mlt API: plain dataclasses mirroring the Rust structs.
+
+The extension (``mlt._mlt``) reads them by attribute when it builds a scene or renders,
+so any object with the same attributes works too. Defaults are the Rust crate's;
+``tests/test_api.py`` checks them against it. Validation happens in Rust, which raises
+:class:`mlt.InvalidArgumentError` naming the offending field.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Optional, Sequence, Tuple, Union
+
+if TYPE_CHECKING:
+    import os
+
+    import numpy.typing as npt
+
+Vec3 = Tuple[float, float, float]
+
+
+class Algorithm(str, enum.Enum):
+    """The light-transport algorithm of a render (``RenderSettings.algorithm``).
+
+    A member is its own string (``Algorithm.MMLT == "mmlt"``), so settings accept either.
+    The names are ``mlt-render --algorithm``'s.
+    """
+
+    #: Unidirectional path tracing with next-event estimation and MIS.
+    PATH = "path"
+    #: Bidirectional path tracing: every connection strategy, combined by MIS.
+    BDPT = "bdpt"
+    #: Primary-sample-space Metropolis light transport (Kelemen) over the path tracer.
+    PSSMLT = "pssmlt"
+    #: Multiplexed MLT (Hachisuka) over BDPT: the default.
+    MMLT = "mmlt"
+    #: Primary-sample-space MLT over BDPT, all strategies of a sample summed.
+    PSSMLT_BDPT = "pssmlt-bdpt"
+    #: Path-space MLT (Veach & Guibas): chains over light paths.
+    PATH_SPACE_MLT = "path-space-mlt"
+    #: Energy redistribution path tracing (Cline, Talbot & Egbert).
+    ERPT = "erpt"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+@dataclass
+class TextureRef:
+    """A material's use of a texture: its index in ``Scene.from_arrays(textures=...)`` and
+    the ``KHR_texture_transform`` applied to the texture coordinates first (scale, then
+    rotate by ``rotation`` radians counter-clockwise, then offset)."""
+
+    texture: int
+    offset: Tuple[float, float] = (0.0, 0.0)
+    rotation: float = 0.0
+    scale: Tuple[float, float] = (1.0, 1.0)
+
+
+@dataclass
+class Material:
+    """A surface material (``mlt::Material``).
+
+    ``kind`` is ``"diffuse"`` (Lambertian, albedo ``color``), ``"mirror"`` (a perfect
+    mirror reflecting ``color``), ``"dielectric"`` (smooth glass of index ``ior``, tinted
+    by ``color``) or ``"metallic_roughness"`` (glTF 2.0's model: base colour ``color``,
+    ``metallic``, perceptual ``roughness``, ``ior``, ``transmission``).
+
+    Any material emits ``emission`` (linear RGB radiance) from its front side
+    (counter-clockwise winding): emissive triangles are area lights. Colours are linear
+    RGB in [0, 1]. The defaults are ``mlt::Material::diffuse``'s, with the loaders'
+    0.8 grey albedo.
+
+    Textures (``TextureRef``) refer to ``Scene.from_arrays(textures=...)`` and need
+    ``texcoords``: ``base_color_texture`` multiplies ``color`` and ``alpha``,
+    ``metallic_roughness_texture`` multiplies ``roughness`` (green) and ``metallic``
+    (blue), ``normal_texture`` is a tangent-space normal map scaled by ``normal_scale``,
+    ``emission_texture`` multiplies ``emission``. ``alpha_mode="mask"`` cuts the surface
+    out where alpha < ``alpha_cutoff``.
+
+    ``energy_compensation`` (metallic-roughness) adds Kulla and Conty's multiple-scattering
+    lobe to rough metals. ``abbe_number`` (0: none) makes a dielectric disperse light in
+    spectral renders.
+    """
+
+    kind: str = "diffuse"
+    color: Vec3 = (0.8, 0.8, 0.8)
+    emission: Vec3 = (0.0, 0.0, 0.0)
+    ior: float = 1.5
+    metallic: float = 0.0
+    roughness: float = 1.0
+    transmission: float = 0.0
+    alpha: float = 1.0
+    alpha_mode: str = "opaque"
+    alpha_cutoff: float = 0.5
+    base_color_texture: Optional[TextureRef] = None
+    metallic_roughness_texture: Optional[TextureRef] = None
+    normal_texture: Optional[TextureRef] = None
+    normal_scale: float = 1.0
+    emission_texture: Optional[TextureRef] = None
+    energy_compensation: bool = False
+    abbe_number: float = 0.0
+
+    @classmethod
+    def diffuse(cls, albedo: Sequence[float], emission: Sequence[float] = (0.0, 0.0, 0.0)) -> Material:
+        """Lambertian reflection with the given albedo."""
+        return cls(kind="diffuse", color=_vec3(albedo), emission=_vec3(emission))
+
+    @classmethod
+    def mirror(cls, reflectance: Sequence[float] = (1.0, 1.0, 1.0)) -> Material:
+        """A perfect mirror."""
+        return cls(kind="mirror", color=_vec3(reflectance))
+
+    @classmethod
+    def dielectric(cls, ior: float = 1.5, tint: Sequence[float] = (1.0, 1.0, 1.0), abbe_number: float = 0.0) -> Material:
+        """Smooth glass with index of refraction ``ior``."""
+        return cls(kind="dielectric", color=_vec3(tint), ior=ior, abbe_number=abbe_number)
+
+    @classmethod
+    def metallic_roughness(
+        cls, base_color: Sequence[float], metallic: float, roughness: float, **fields: object
+    ) -> Material:
+        """glTF's metallic-roughness model (index of refraction 1.5, no transmission
+        unless given in ``fields``)."""
+        return cls(
+            kind="metallic_roughness",
+            color=_vec3(base_color),
+            metallic=metallic,
+            roughness=roughness,
+            **fields,  # type: ignore[arg-type]
+        )
+
+    def with_emission(self, radiance: Sequence[float]) -> Material:
+        """A copy that emits ``radiance``."""
+        return dataclasses.replace(self, emission=_vec3(radiance))
+
+
+@dataclass
+class Camera:
+    """A perspective camera (``mlt::Camera``) looking from ``eye`` towards ``target``.
+
+    ``fov_y_deg`` is the vertical field of view in degrees, in (0, 180). A positive
+    ``lens_radius`` makes a thin lens focused at ``focus_distance`` (0: the distance from
+    eye to target). The defaults are the Cornell box's camera (``mlt::Camera::default``).
+    """
+
+    eye: Vec3 = (278.0, 273.0, -800.0)
+    target: Vec3 = (278.0, 273.0, -799.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov_y_deg: float = 39.307648
+    lens_radius: float = 0.0
+    focus_distance: float = 0.0
+
+
+@dataclass(kw_only=True)
+class RenderSettings:
+    """What a render is asked for (``mlt::RenderSettings``), with the Rust defaults.
+
+    Metropolis algorithms (``pssmlt``, ``mmlt``, ``pssmlt-bdpt``, ``path-space-mlt``) do
+    ``mutations_per_pixel``; the others take ``samples_per_pixel`` (0 for either: until
+    ``time_limit_seconds``). ``threads`` 0 shares one pool of one thread per core between
+    renders; the image never depends on the thread count, only on ``seed``. See the Rust
+    documentation of ``mlt::RenderSettings`` for every field.
+    """
+
+    width: int = 256
+    height: int = 256
+    algorithm: Union[Algorithm, str] = Algorithm.MMLT
+    samples_per_pixel: int = 64
+    max_depth: int = 5
+    seed: int = 0
+    threads: int = 0
+    time_limit_seconds: float = 0.0
+    mutations_per_pixel: int = 32
+    bootstrap_samples: int = 0
+    chains: int = 1024
+    large_step_probability: float = 0.3
+    small_step_sigma: float = 0.01
+    direct_samples_per_mutation: int = 1
+    normalization_work_fraction: float = 0.05
+    #: Path-space MLT: bidirectional, lens, caustic and multi-chain weights.
+    mutation_weights: Tuple[float, float, float, float] = (0.5, 0.25, 0.25, 0.25)
+    adapt_mutation_weights: bool = False
+    perturb_in_sample_space: bool = False
+    erpt_chain_length: int = 10
+    erpt_deposit_energy: float = 0.0
+    #: 0: no post-process filter; else its partial images (2 to 32; 8 is a good start).
+    filter_buffers: int = 0
+    filter_strength: float = 0.45
+    filter_radius: int = 7
+    spectral: bool = False
+
+
+@dataclass
+class Environment:
+    """Light arriving from infinitely far away: an equirectangular (latitude-longitude)
+    map of linear RGB radiance, ``pixels`` of shape (height, width, 3), +Y up, its centre
+    looking along +Z; turned about +Y by ``rotation_degrees`` and multiplied by
+    ``scale``."""
+
+    pixels: npt.ArrayLike
+    rotation_degrees: float = 0.0
+    scale: float = 1.0
+
+    @classmethod
+    def constant(cls, radiance: Sequence[float]) -> Environment:
+        """A sky of one radiance in every direction (a 1 x 1 map)."""
+        return cls(pixels=[[_vec3(radiance)]])
+
+    @classmethod
+    def from_file(cls, path: Union[str, os.PathLike[str]], rotation_degrees: float = 0.0, scale: float = 1.0) -> Environment:
+        """Reads a ``.hdr`` or ``.exr`` map (what ``mlt-render --env`` reads)."""
+        from . import _mlt
+
+        return cls(pixels=_mlt.load_environment(path), rotation_degrees=rotation_degrees, scale=scale)
+
+
+@dataclass
+class Sun:
+    """The sun: a disc of uniform radiance in ``direction`` (from the scene towards it)
+    with half-angle ``angular_radius_degrees`` (0: a delta direction; the real sun is
+    0.27, the default, as ``mlt-render --sun``'s), giving ``irradiance`` (linear RGB) on
+    a plane facing it."""
+
+    direction: Vec3
+    irradiance: Vec3
+    angular_radius_degrees: float = 0.27
+
+    @classmethod
+    def from_radiance(cls, direction: Sequence[float], radiance: Sequence[float], angular_radius_degrees: float = 0.27) -> Sun:
+        """A sun whose disc (radius > 0) has the given radiance: its irradiance is the
+        radiance times pi sin^2 of the radius (``mlt::SunDesc::from_radiance``)."""
+        solid = math.pi * math.sin(math.radians(angular_radius_degrees)) ** 2
+        return cls(
+            direction=_vec3(direction),
+            irradiance=_vec3([c * solid for c in radiance]),
+            angular_radius_degrees=angular_radius_degrees,
+        )
+
+
+@dataclass
+class PunctualLight:
+    """A point, spot or directional light (``KHR_lights_punctual``): reached by
+    connections only, never hit by a ray.
+
+    ``intensity`` is linear RGB radiant intensity (W/sr) for point and spot lights and
+    irradiance for a directional one. ``direction`` is a spot's axis or the direction a
+    directional light travels; spots fall off smoothly between ``inner_cone_degrees`` and
+    ``outer_cone_degrees``."""
+
+    kind: str
+    position: Vec3 = (0.0, 0.0, 0.0)
+    direction: Vec3 = (0.0, 0.0, -1.0)
+    intensity: Vec3 = (1.0, 1.0, 1.0)
+    inner_cone_degrees: float = 0.0
+    outer_cone_degrees: float = 45.0
+
+    @classmethod
+    def point(cls, position: Sequence[float], intensity: Sequence[float]) -> PunctualLight:
+        return cls(kind="point", position=_vec3(position), intensity=_vec3(intensity))
+
+    @classmethod
+    def spot(
+        cls,
+        position: Sequence[float],
+        direction: Sequence[float],
+        intensity: Sequence[float],
+        inner_cone_degrees: float,
+        outer_cone_degrees: float,
+    ) -> PunctualLight:
+        return cls(
+            kind="spot",
+            position=_vec3(position),
+            direction=_vec3(direction),
+            intensity=_vec3(intensity),
+            inner_cone_degrees=inner_cone_degrees,
+            outer_cone_degrees=outer_cone_degrees,
+        )
+
+    @classmethod
+    def directional(cls, direction: Sequence[float], irradiance: Sequence[float]) -> PunctualLight:
+        return cls(kind="directional", direction=_vec3(direction), intensity=_vec3(irradiance))
+
+
+@dataclass
+class Texture:
+    """A texture the materials refer to by index (``TextureRef.texture``).
+
+    ``data`` is (height, width) or (height, width, channels) with 1 to 4 channels (grey,
+    grey + alpha, RGB, RGBA), rows from the top: uint8 (255 is 1) or float32 (linear,
+    finite, >= 0). ``encoding`` is ``"srgb"`` (8-bit colour images: base colour,
+    emission) or ``"linear"``; ``wrap_u``/``wrap_v`` are ``"repeat"``,
+    ``"clamp_to_edge"`` or ``"mirrored_repeat"``; ``filter`` is ``"bilinear"`` or
+    ``"nearest"``."""
+
+    data: npt.ArrayLike
+    encoding: str = "linear"
+    wrap_u: str = "repeat"
+    wrap_v: str = "repeat"
+    filter: str = "bilinear"
+
+
+def _vec3(value: Sequence[float]) -> Vec3:
+    x, y, z = value
+    return (float(x), float(y), float(z))
+
+
+__all__ = [
+    "Algorithm",
+    "Camera",
+    "Environment",
+    "Material",
+    "PunctualLight",
+    "RenderSettings",
+    "Sun",
+    "Texture",
+    "TextureRef",
+]

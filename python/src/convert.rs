@@ -1,0 +1,416 @@
+//! The value types (`mlt/_types.py`'s dataclasses, or any object with their attributes)
+//! to and from the Rust structs. Only conversions here: the Rust API validates values.
+
+use crate::arrays::{self, Array};
+use crate::errors::{invalid, with_context};
+use mlt::{
+    Algorithm, AlphaMode, Backend, Camera, Material, MaterialKind, MutationWeights, PunctualLight,
+    PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc, TextureEncoding,
+    TextureFilter, TextureRef, WrapMode,
+};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyType};
+use std::borrow::Cow;
+
+/// The attribute `name` of `obj` (an instance of the value type `owner`), its conversion
+/// error naming `owner.name`.
+fn field<'py, T: FromPyObjectOwned<'py>>(
+    obj: &Bound<'py, PyAny>,
+    owner: &str,
+    name: &str,
+) -> PyResult<T> {
+    let py = obj.py();
+    // A missing attribute means the object is not of the type asked for.
+    let value = obj.getattr(name).map_err(|_| {
+        let class = obj
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_owned(), |n| n.to_string());
+        PyTypeError::new_err(format!(
+            "{owner} has no field {name}: expected an mlt value type, got {class}"
+        ))
+    })?;
+    value
+        .extract::<T>()
+        .map_err(|e| with_context(py, e.into(), &format!("{owner}.{name}")))
+}
+
+/// A string field (an enumeration's name).
+fn name_field(obj: &Bound<'_, PyAny>, owner: &str, name: &str) -> PyResult<String> {
+    field::<String>(obj, owner, name)
+}
+
+/// `value` as one of `choices` (`(name, value)`), or an error listing them. Case, and `-`
+/// against `_`, do not matter (`"pssmlt_bdpt"` is `"pssmlt-bdpt"`, `"Metallic-Roughness"`
+/// is `"metallic_roughness"`).
+fn choose<T: Copy>(
+    py: Python<'_>,
+    owner: &str,
+    name: &str,
+    value: &str,
+    choices: &[(&str, T)],
+) -> PyResult<T> {
+    choices
+        .iter()
+        .find(|(n, _)| same_name(n, value))
+        .map(|&(_, v)| v)
+        .ok_or_else(|| {
+            let names: Vec<String> = choices.iter().map(|(n, _)| format!("{n:?}")).collect();
+            invalid(
+                py,
+                &format!(
+                    "{owner}.{name} is {value:?}; expected one of {}",
+                    names.join(", ")
+                ),
+            )
+        })
+}
+
+fn same_name(a: &str, b: &str) -> bool {
+    let canonical = |c: char| match c {
+        '-' => '_',
+        c => c.to_ascii_lowercase(),
+    };
+    a.len() == b.len() && a.chars().map(canonical).eq(b.chars().map(canonical))
+}
+
+const ALGORITHMS: [(&str, Algorithm); 7] = [
+    ("path", Algorithm::Path),
+    ("bdpt", Algorithm::Bdpt),
+    ("pssmlt", Algorithm::Pssmlt),
+    ("mmlt", Algorithm::Mmlt),
+    ("pssmlt-bdpt", Algorithm::PssmltBdpt),
+    ("path-space-mlt", Algorithm::PathSpaceMlt),
+    ("erpt", Algorithm::Erpt),
+];
+
+const MATERIAL_KINDS: [(&str, MaterialKind); 4] = [
+    ("diffuse", MaterialKind::Diffuse),
+    ("mirror", MaterialKind::Mirror),
+    ("dielectric", MaterialKind::Dielectric),
+    ("metallic_roughness", MaterialKind::MetallicRoughness),
+];
+
+const BACKENDS: [(&str, Backend); 2] = [("bvh", Backend::Bvh), ("embree", Backend::Embree)];
+
+pub fn backend(py: Python<'_>, name: &str) -> PyResult<Backend> {
+    choose(py, "Scene", "backend", name, &BACKENDS)
+}
+
+pub fn camera(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {
+    let owner = "Camera";
+    Ok(Camera {
+        eye: field(obj, owner, "eye")?,
+        target: field(obj, owner, "target")?,
+        up: field(obj, owner, "up")?,
+        fov_y_deg: field(obj, owner, "fov_y_deg")?,
+        lens_radius: field(obj, owner, "lens_radius")?,
+        focus_distance: field(obj, owner, "focus_distance")?,
+    })
+}
+
+pub fn settings(obj: &Bound<'_, PyAny>) -> PyResult<RenderSettings> {
+    let owner = "RenderSettings";
+    let algorithm = name_field(obj, owner, "algorithm")?;
+    Ok(RenderSettings {
+        width: field(obj, owner, "width")?,
+        height: field(obj, owner, "height")?,
+        algorithm: choose(obj.py(), owner, "algorithm", &algorithm, &ALGORITHMS)?,
+        samples_per_pixel: field(obj, owner, "samples_per_pixel")?,
+        max_depth: field(obj, owner, "max_depth")?,
+        seed: field(obj, owner, "seed")?,
+        threads: field(obj, owner, "threads")?,
+        time_limit_seconds: field(obj, owner, "time_limit_seconds")?,
+        mutations_per_pixel: field(obj, owner, "mutations_per_pixel")?,
+        bootstrap_samples: field(obj, owner, "bootstrap_samples")?,
+        chains: field(obj, owner, "chains")?,
+        large_step_probability: field(obj, owner, "large_step_probability")?,
+        small_step_sigma: field(obj, owner, "small_step_sigma")?,
+        direct_samples_per_mutation: field(obj, owner, "direct_samples_per_mutation")?,
+        normalization_work_fraction: field(obj, owner, "normalization_work_fraction")?,
+        mutation_weights: MutationWeights(field(obj, owner, "mutation_weights")?),
+        adapt_mutation_weights: field(obj, owner, "adapt_mutation_weights")?,
+        perturb_in_sample_space: field(obj, owner, "perturb_in_sample_space")?,
+        erpt_chain_length: field(obj, owner, "erpt_chain_length")?,
+        erpt_deposit_energy: field(obj, owner, "erpt_deposit_energy")?,
+        filter_buffers: field(obj, owner, "filter_buffers")?,
+        filter_strength: field(obj, owner, "filter_strength")?,
+        filter_radius: field(obj, owner, "filter_radius")?,
+        spectral: field(obj, owner, "spectral")?,
+    })
+}
+
+static MATERIAL_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// A material: an `mlt.Material` (or an object with its attributes), or a dict of its
+/// fields (`{"kind": "diffuse", "color": (1, 0, 0)}`; unknown keys are an error).
+pub fn material(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Material> {
+    let py = obj.py();
+    let owner = format!("materials[{index}]");
+    let owned;
+    let obj = match obj.cast::<PyDict>() {
+        Ok(dict) => {
+            let class = MATERIAL_CLASS.import(py, "mlt._types", "Material")?;
+            owned = class
+                .call((), Some(dict))
+                .map_err(|e| with_context(py, e, &owner))?;
+            &owned
+        }
+        Err(_) => obj,
+    };
+    let owner = owner.as_str();
+    let kind = name_field(obj, owner, "kind")?;
+    let alpha_mode = name_field(obj, owner, "alpha_mode")?;
+    Ok(Material {
+        kind: choose(py, owner, "kind", &kind, &MATERIAL_KINDS)?,
+        color: field(obj, owner, "color")?,
+        emission: field(obj, owner, "emission")?,
+        ior: field(obj, owner, "ior")?,
+        metallic: field(obj, owner, "metallic")?,
+        roughness: field(obj, owner, "roughness")?,
+        transmission: field(obj, owner, "transmission")?,
+        alpha: field(obj, owner, "alpha")?,
+        alpha_mode: choose(
+            py,
+            owner,
+            "alpha_mode",
+            &alpha_mode,
+            &[("opaque", AlphaMode::Opaque), ("mask", AlphaMode::Mask)],
+        )?,
+        alpha_cutoff: field(obj, owner, "alpha_cutoff")?,
+        base_color_texture: texture_ref(obj, owner, "base_color_texture")?,
+        metallic_roughness_texture: texture_ref(obj, owner, "metallic_roughness_texture")?,
+        normal_texture: texture_ref(obj, owner, "normal_texture")?,
+        normal_scale: field(obj, owner, "normal_scale")?,
+        emission_texture: texture_ref(obj, owner, "emission_texture")?,
+        energy_compensation: field(obj, owner, "energy_compensation")?,
+        abbe_number: field(obj, owner, "abbe_number")?,
+    })
+}
+
+fn texture_ref(obj: &Bound<'_, PyAny>, owner: &str, name: &str) -> PyResult<Option<TextureRef>> {
+    let value: Option<Bound<PyAny>> = field(obj, owner, name)?;
+    let Some(value) = value else {
+        return Ok(None);
+    };
+    let owner = format!("{owner}.{name}");
+    Ok(Some(TextureRef {
+        texture: field(&value, &owner, "texture")?,
+        offset: field(&value, &owner, "offset")?,
+        rotation: field(&value, &owner, "rotation")?,
+        scale: field(&value, &owner, "scale")?,
+    }))
+}
+
+/// A texture's description with its texels copied.
+pub fn texture(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<TextureDesc<'static>> {
+    let py = obj.py();
+    let owner = format!("textures[{index}]");
+    let data_name = format!("{owner}.data");
+    let data = Array::new(&obj.getattr("data")?, &data_name)?;
+    let (height, width, channels) = match data.shape[..] {
+        [h, w] => (h, w, 1),
+        [h, w, c] => (h, w, c),
+        _ => {
+            return Err(invalid(
+                py,
+                &format!(
+                    "{data_name} has shape {}; expected (height, width) or (height, width, channels)",
+                    data.shape_text()
+                ),
+            ));
+        }
+    };
+    let side = |n: usize, what: &str| {
+        u32::try_from(n).map_err(|_| invalid(py, &format!("{data_name} is {n} texels {what}")))
+    };
+    let texels = match data.to_u8()? {
+        Some(bytes) => TexelData::U8(Cow::Owned(bytes)),
+        None => TexelData::F32(Cow::Owned(data.to_f32(&data_name)?)),
+    };
+    let owner = owner.as_str();
+    let wrap = |name: &str| -> PyResult<WrapMode> {
+        let value = name_field(obj, owner, name)?;
+        choose(
+            py,
+            owner,
+            name,
+            &value,
+            &[
+                ("repeat", WrapMode::Repeat),
+                ("clamp_to_edge", WrapMode::ClampToEdge),
+                ("mirrored_repeat", WrapMode::MirroredRepeat),
+            ],
+        )
+    };
+    let encoding = name_field(obj, owner, "encoding")?;
+    let filter = name_field(obj, owner, "filter")?;
+    Ok(TextureDesc {
+        width: side(width, "wide")?,
+        height: side(height, "high")?,
+        channels: side(channels, "deep")?,
+        data: texels,
+        encoding: choose(
+            py,
+            owner,
+            "encoding",
+            &encoding,
+            &[
+                ("srgb", TextureEncoding::Srgb),
+                ("linear", TextureEncoding::Linear),
+            ],
+        )?,
+        wrap_u: wrap("wrap_u")?,
+        wrap_v: wrap("wrap_v")?,
+        filter: choose(
+            py,
+            owner,
+            "filter",
+            &filter,
+            &[
+                ("bilinear", TextureFilter::Bilinear),
+                ("nearest", TextureFilter::Nearest),
+            ],
+        )?,
+    })
+}
+
+pub fn sun(obj: &Bound<'_, PyAny>) -> PyResult<SunDesc> {
+    let owner = "Sun";
+    Ok(SunDesc {
+        direction: field(obj, owner, "direction")?,
+        angular_radius_degrees: field(obj, owner, "angular_radius_degrees")?,
+        irradiance: field(obj, owner, "irradiance")?,
+    })
+}
+
+pub fn punctual_light(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<PunctualLight> {
+    let owner = format!("lights[{index}]");
+    let owner = owner.as_str();
+    let kind = name_field(obj, owner, "kind")?;
+    Ok(PunctualLight {
+        kind: choose(
+            obj.py(),
+            owner,
+            "kind",
+            &kind,
+            &[
+                ("point", PunctualLightKind::Point),
+                ("spot", PunctualLightKind::Spot),
+                ("directional", PunctualLightKind::Directional),
+            ],
+        )?,
+        position: field(obj, owner, "position")?,
+        direction: field(obj, owner, "direction")?,
+        intensity: field(obj, owner, "intensity")?,
+        inner_cone_degrees: field(obj, owner, "inner_cone_degrees")?,
+        outer_cone_degrees: field(obj, owner, "outer_cone_degrees")?,
+    })
+}
+
+/// An environment's texels (flat RGB), width, height, rotation and scale.
+pub struct OwnedEnvironment {
+    pub pixels: Vec<f32>,
+    pub width: u32,
+    pub height: u32,
+    pub rotation_degrees: f32,
+    pub scale: f32,
+}
+
+pub fn environment(obj: &Bound<'_, PyAny>) -> PyResult<OwnedEnvironment> {
+    let py = obj.py();
+    let name = "Environment.pixels";
+    let pixels = Array::new(&obj.getattr("pixels")?, name)?;
+    pixels.check_shape(
+        name,
+        &[None, None, Some(3)],
+        "(height, width, 3): RGB texels",
+    )?;
+    let side = |n: usize| {
+        u32::try_from(n).map_err(|_| invalid(py, &format!("{name} has {n} texels on a side")))
+    };
+    let (height, width) = match pixels.shape[..] {
+        [h, w, _] => (side(h)?, side(w)?),
+        _ => (0, 0), // Empty: the Rust API names the size.
+    };
+    Ok(OwnedEnvironment {
+        pixels: pixels.to_f32(name)?,
+        width,
+        height,
+        rotation_degrees: field(obj, "Environment", "rotation_degrees")?,
+        scale: field(obj, "Environment", "scale")?,
+    })
+}
+
+/// The lights besides emissive triangles, owned, to lend to a `SceneDesc`.
+#[derive(Default)]
+pub struct OwnedLights {
+    pub environment: Option<OwnedEnvironment>,
+    pub sun: Option<SunDesc>,
+    pub punctual: Vec<PunctualLight>,
+}
+
+impl OwnedLights {
+    pub fn extract(
+        environment: Option<&Bound<'_, PyAny>>,
+        sun: Option<&Bound<'_, PyAny>>,
+        lights: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let punctual = match lights {
+            Some(lights) => lights
+                .try_iter()?
+                .enumerate()
+                .map(|(i, light)| punctual_light(&light?, i))
+                .collect::<PyResult<_>>()?,
+            None => Vec::new(),
+        };
+        Ok(OwnedLights {
+            environment: environment.map(self::environment).transpose()?,
+            sun: sun.map(self::sun).transpose()?,
+            punctual,
+        })
+    }
+
+    pub fn desc(&self) -> mlt::LightsDesc<'_> {
+        mlt::LightsDesc {
+            environment: self.environment.as_ref().map(|e| mlt::EnvironmentDesc {
+                pixels: &e.pixels,
+                width: e.width,
+                height: e.height,
+                rotation_degrees: e.rotation_degrees,
+                scale: e.scale,
+            }),
+            sun: self.sun,
+            punctual: &self.punctual,
+        }
+    }
+}
+
+/// An optional per-vertex array of `columns` floats (`None`: empty).
+pub fn vertex_rows(
+    obj: Option<&Bound<'_, PyAny>>,
+    name: &str,
+    columns: usize,
+) -> PyResult<Vec<f32>> {
+    obj.map_or(Ok(Vec::new()), |obj| arrays::rows_f32(obj, name, columns))
+}
+
+static CAMERA_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// An `mlt.Camera`.
+pub fn camera_to_py<'py>(py: Python<'py>, camera: &Camera) -> PyResult<Bound<'py, PyAny>> {
+    // Tuples, as the dataclass declares (arrays would convert to lists).
+    let tuple = |v: [f32; 3]| (v[0], v[1], v[2]);
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("eye", tuple(camera.eye))?;
+    kwargs.set_item("target", tuple(camera.target))?;
+    kwargs.set_item("up", tuple(camera.up))?;
+    kwargs.set_item("fov_y_deg", camera.fov_y_deg)?;
+    kwargs.set_item("lens_radius", camera.lens_radius)?;
+    kwargs.set_item("focus_distance", camera.focus_distance)?;
+    CAMERA_CLASS
+        .import(py, "mlt._types", "Camera")?
+        .call((), Some(&kwargs))
+}

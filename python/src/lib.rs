@@ -1,0 +1,68 @@
+//! `mlt._mlt`: the Python extension of mlt, wrapping the crate's public Rust API. The
+//! package `mlt` (`mlt/__init__.py`) re-exports it with the value types of `mlt/_types.py`
+//! (dataclasses the conversions here read by attribute) and the exceptions of
+//! `mlt/_errors.py`.
+//!
+//! Layout: `scene` (Scene, loaders), `render` (render, the GIL-free progress and cancel
+//! plumbing any long call can reuse, stats), `convert` (value types to Rust structs),
+//! `arrays` (array-likes in), `errors` (mlt's errors as exceptions).
+
+mod arrays;
+mod convert;
+mod errors;
+mod render;
+mod scene;
+
+use pyo3::prelude::*;
+
+/// Which of the value types' defaults differ from the Rust crate's: `(name, python, rust)`
+/// for each one that does (none, if the dataclasses are in step). `settings`, `camera` and
+/// `material` are default-constructed `RenderSettings`, `Camera` and `Material`.
+#[pyfunction]
+fn _defaults_mismatches(
+    settings: &Bound<'_, PyAny>,
+    camera: &Bound<'_, PyAny>,
+    material: &Bound<'_, PyAny>,
+) -> PyResult<Vec<(String, String, String)>> {
+    let mut mismatches = Vec::new();
+    let mut check = |name: &str, python: String, rust: String| {
+        if python != rust {
+            mismatches.push((name.to_owned(), python, rust));
+        }
+    };
+    check(
+        "RenderSettings",
+        format!("{:?}", convert::settings(settings)?),
+        format!("{:?}", mlt::RenderSettings::default()),
+    );
+    check(
+        "Camera",
+        format!("{:?}", convert::camera(camera)?),
+        format!("{:?}", mlt::Camera::default()),
+    );
+    check(
+        "Material",
+        format!("{:?}", convert::material(material, 0)?),
+        // The loaders' default albedo (a Rust material has no default colour).
+        format!("{:?}", mlt::Material::diffuse([0.8; 3])),
+    );
+    Ok(mismatches)
+}
+
+#[pymodule]
+fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<scene::SceneInfo>()?;
+    m.add_class::<render::CancelToken>()?;
+    m.add_class::<render::RenderStats>()?;
+    m.add_class::<render::NormalizationStats>()?;
+    m.add_class::<render::MutationCounts>()?;
+    m.add_class::<render::FilterStats>()?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render_with_unfiltered, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::load_environment, m)?)?;
+    m.add_function(wrap_pyfunction!(_defaults_mismatches, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("EMBREE_AVAILABLE", mlt::Backend::Embree.is_available())?;
+    Ok(())
+}
