@@ -114,6 +114,7 @@ fn add_sums(sums: &mut [FixedRgb], other: &[FixedRgb]) {
     }
 }
 
+#[derive(Clone)]
 pub struct Film {
     pub width: u32,
     pub height: u32,

@@ -12,7 +12,14 @@ RGB::
 
 The GIL is released while rendering. ``progress=`` takes a callable of the fraction done
 (return False to stop), ``cancel=`` a :class:`CancelToken` another thread may cancel; Ctrl-C
-stops a render too. Errors from mlt are :class:`MltError`; invalid input is
+stops a render too.
+
+A frame too big for one machine splits into jobs that merge into the same bits:
+:func:`plan` once, :func:`render_job` for job k of N on any process holding the same scene,
+:func:`merge` of the :class:`PartialRender` results. Plans and partial results pickle (as
+their checksummed bytes); :mod:`mlt.dask` runs the three steps on a Dask cluster.
+
+Errors from mlt are :class:`MltError`; invalid input is
 :class:`InvalidArgumentError`, also a ``ValueError``.
 """
 
@@ -25,12 +32,17 @@ from ._mlt import (
     FilterStats,
     MutationCounts,
     NormalizationStats,
+    PartialRender,
+    RenderPlan,
     RenderStats,
     Scene,
     SceneInfo,
     __version__,
     load_environment,
+    merge,
+    plan,
     render,
+    render_job,
     render_with_unfiltered,
 )
 from ._types import (
@@ -58,7 +70,9 @@ __all__ = [
     "MltError",
     "MutationCounts",
     "NormalizationStats",
+    "PartialRender",
     "PunctualLight",
+    "RenderPlan",
     "RenderSettings",
     "RenderStats",
     "Scene",
@@ -69,6 +83,9 @@ __all__ = [
     "UnsupportedError",
     "__version__",
     "load_environment",
+    "merge",
+    "plan",
     "render",
+    "render_job",
     "render_with_unfiltered",
 ]

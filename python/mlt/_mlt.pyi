@@ -19,6 +19,11 @@ __all__ = [
     "FilterStats",
     "render",
     "render_with_unfiltered",
+    "RenderPlan",
+    "PartialRender",
+    "plan",
+    "render_job",
+    "merge",
     "load_environment",
     "_defaults_mismatches",
     "__version__",
@@ -140,6 +145,53 @@ class RenderStats:
     def mutation_weights(self) -> Tuple[float, float, float, float]: ...
     @property
     def filter(self) -> FilterStats: ...
+    @staticmethod
+    def _from_state(
+        state: Tuple[
+            str,
+            int,
+            int,
+            int,
+            int,
+            float,
+            int,
+            int,
+            Tuple[float, int, float, float],
+            Tuple[Tuple[int, int, int, int], Tuple[int, int, int, int]],
+            Tuple[float, float, float, float],
+            Tuple[float, float],
+        ],
+    ) -> RenderStats: ...
+    def __reduce__(self) -> Tuple[Callable[..., RenderStats], Tuple[object, ...]]: ...
+
+@final
+class RenderPlan:
+    @staticmethod
+    def from_bytes(data: bytes) -> RenderPlan: ...
+    def to_bytes(self) -> bytes: ...
+    @property
+    def id(self) -> int: ...
+    @property
+    def settings(self) -> RenderSettings: ...
+    @property
+    def camera(self) -> Camera: ...
+    def __reduce__(self) -> Tuple[Callable[[bytes], RenderPlan], Tuple[bytes]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+
+@final
+class PartialRender:
+    @staticmethod
+    def from_bytes(data: bytes) -> PartialRender: ...
+    def to_bytes(self) -> bytes: ...
+    @property
+    def job(self) -> int: ...
+    @property
+    def jobs(self) -> int: ...
+    @property
+    def plan_id(self) -> int: ...
+    @property
+    def stats(self) -> RenderStats: ...
+    def __reduce__(self) -> Tuple[Callable[[bytes], PartialRender], Tuple[bytes]]: ...
 
 def render(
     scene: Scene,
@@ -157,6 +209,20 @@ def render_with_unfiltered(
     progress: Optional[_Progress] = None,
     cancel: Optional[CancelToken] = None,
 ) -> Tuple[_Image, _Image, RenderStats]: ...
+def plan(scene: Scene, camera: Camera, settings: Optional[RenderSettings] = None) -> RenderPlan: ...
+def render_job(
+    scene: Scene,
+    plan: RenderPlan,
+    job: int,
+    jobs: int,
+    *,
+    threads: int = 0,
+    progress: Optional[_Progress] = None,
+    cancel: Optional[CancelToken] = None,
+) -> PartialRender: ...
+def merge(
+    plan: RenderPlan, partials: Iterable[Union[PartialRender, bytes]]
+) -> Tuple[_Image, RenderStats]: ...
 def load_environment(path: _Path) -> _Image: ...
 def _defaults_mismatches(
     settings: RenderSettings, camera: Camera, material: Material

@@ -142,6 +142,75 @@ pub fn settings(obj: &Bound<'_, PyAny>) -> PyResult<RenderSettings> {
     })
 }
 
+/// The Python float that prints as `value` does (0.3f32 as 0.3, not 0.30000001192092896),
+/// so values read back from Rust compare equal to the ones given; it converts back to the
+/// same f32.
+fn shortest(value: f32) -> f64 {
+    value.to_string().parse().unwrap_or(f64::from(value))
+}
+
+/// The Python name of an algorithm (`mlt.Algorithm`'s value).
+pub fn algorithm_name(algorithm: Algorithm) -> &'static str {
+    ALGORITHMS
+        .iter()
+        .find(|&&(_, a)| a == algorithm)
+        .map_or("?", |&(name, _)| name)
+}
+
+static SETTINGS_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+static ALGORITHM_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// An `mlt.RenderSettings`, the inverse of `settings`.
+pub fn settings_to_py<'py>(
+    py: Python<'py>,
+    settings: &RenderSettings,
+) -> PyResult<Bound<'py, PyAny>> {
+    let algorithm = ALGORITHM_CLASS
+        .import(py, "mlt._types", "Algorithm")?
+        .call1((algorithm_name(settings.algorithm),))?;
+    let kwargs = PyDict::new(py);
+    kwargs.set_item("width", settings.width)?;
+    kwargs.set_item("height", settings.height)?;
+    kwargs.set_item("algorithm", algorithm)?;
+    kwargs.set_item("samples_per_pixel", settings.samples_per_pixel)?;
+    kwargs.set_item("max_depth", settings.max_depth)?;
+    kwargs.set_item("seed", settings.seed)?;
+    kwargs.set_item("threads", settings.threads)?;
+    kwargs.set_item("time_limit_seconds", settings.time_limit_seconds)?;
+    kwargs.set_item("mutations_per_pixel", settings.mutations_per_pixel)?;
+    kwargs.set_item("bootstrap_samples", settings.bootstrap_samples)?;
+    kwargs.set_item("chains", settings.chains)?;
+    kwargs.set_item(
+        "large_step_probability",
+        shortest(settings.large_step_probability),
+    )?;
+    kwargs.set_item("small_step_sigma", shortest(settings.small_step_sigma))?;
+    kwargs.set_item(
+        "direct_samples_per_mutation",
+        settings.direct_samples_per_mutation,
+    )?;
+    kwargs.set_item(
+        "normalization_work_fraction",
+        shortest(settings.normalization_work_fraction),
+    )?;
+    let w = settings.mutation_weights.0.map(shortest);
+    kwargs.set_item("mutation_weights", (w[0], w[1], w[2], w[3]))?;
+    kwargs.set_item("adapt_mutation_weights", settings.adapt_mutation_weights)?;
+    kwargs.set_item("perturb_in_sample_space", settings.perturb_in_sample_space)?;
+    kwargs.set_item("erpt_chain_length", settings.erpt_chain_length)?;
+    kwargs.set_item(
+        "erpt_deposit_energy",
+        shortest(settings.erpt_deposit_energy),
+    )?;
+    kwargs.set_item("filter_buffers", settings.filter_buffers)?;
+    kwargs.set_item("filter_strength", shortest(settings.filter_strength))?;
+    kwargs.set_item("filter_radius", settings.filter_radius)?;
+    kwargs.set_item("spectral", settings.spectral)?;
+    SETTINGS_CLASS
+        .import(py, "mlt._types", "RenderSettings")?
+        .call((), Some(&kwargs))
+}
+
 static MATERIAL_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// A material: an `mlt.Material` (or an object with its attributes), or a dict of its
@@ -402,14 +471,14 @@ static CAMERA_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 /// An `mlt.Camera`.
 pub fn camera_to_py<'py>(py: Python<'py>, camera: &Camera) -> PyResult<Bound<'py, PyAny>> {
     // Tuples, as the dataclass declares (arrays would convert to lists).
-    let tuple = |v: [f32; 3]| (v[0], v[1], v[2]);
+    let tuple = |v: [f32; 3]| (shortest(v[0]), shortest(v[1]), shortest(v[2]));
     let kwargs = PyDict::new(py);
     kwargs.set_item("eye", tuple(camera.eye))?;
     kwargs.set_item("target", tuple(camera.target))?;
     kwargs.set_item("up", tuple(camera.up))?;
-    kwargs.set_item("fov_y_deg", camera.fov_y_deg)?;
-    kwargs.set_item("lens_radius", camera.lens_radius)?;
-    kwargs.set_item("focus_distance", camera.focus_distance)?;
+    kwargs.set_item("fov_y_deg", shortest(camera.fov_y_deg))?;
+    kwargs.set_item("lens_radius", shortest(camera.lens_radius))?;
+    kwargs.set_item("focus_distance", shortest(camera.focus_distance))?;
     CAMERA_CLASS
         .import(py, "mlt._types", "Camera")?
         .call((), Some(&kwargs))

@@ -4,12 +4,13 @@
 //! `mlt/_errors.py`.
 //!
 //! Layout: `scene` (Scene, loaders), `render` (render, the GIL-free progress and cancel
-//! plumbing any long call can reuse, stats), `convert` (value types to Rust structs),
+//! plumbing any long call can reuse, stats), `jobs` (plan, render_job, merge), `convert` (value types to Rust structs),
 //! `arrays` (array-likes in), `errors` (mlt's errors as exceptions).
 
 mod arrays;
 mod convert;
 mod errors;
+mod jobs;
 mod render;
 mod scene;
 
@@ -58,8 +59,13 @@ fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<render::NormalizationStats>()?;
     m.add_class::<render::MutationCounts>()?;
     m.add_class::<render::FilterStats>()?;
+    m.add_class::<jobs::RenderPlan>()?;
+    m.add_class::<jobs::PartialRender>()?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(render::render_with_unfiltered, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::render_job, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::merge, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_environment, m)?)?;
     m.add_function(wrap_pyfunction!(_defaults_mismatches, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

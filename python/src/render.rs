@@ -1,7 +1,7 @@
 //! `mlt.render`: runs a render with the GIL released, reporting progress to a Python
 //! callable on the calling thread and stopping on its request, a `CancelToken`, or Ctrl-C.
 //!
-//! `detached` is the part any long call shares (a future render job will use it as it is):
+//! `detached` is the part any long call shares (`render_job` uses it too):
 //! it takes the work as a closure given the progress function the Rust API expects.
 
 use crate::convert;
@@ -332,8 +332,107 @@ impl RenderStats {
     }
 }
 
+/// `RenderStats`' fields as plain values, for pickling.
+type StatsState = (
+    String,
+    u64,
+    u64,
+    u64,
+    u64,
+    f64,
+    u32,
+    u64,
+    (f64, u64, f64, f64),
+    ((u64, u64, u64, u64), (u64, u64, u64, u64)),
+    (f32, f32, f32, f32),
+    (f64, f64),
+);
+
 #[pymethods]
 impl RenderStats {
+    /// Rebuilds stats pickled by `__reduce__`.
+    #[staticmethod]
+    fn _from_state(py: Python<'_>, state: StatsState) -> PyResult<Self> {
+        let (
+            stop,
+            samples,
+            mutations,
+            rays,
+            invalid_samples,
+            seconds,
+            threads,
+            accepted,
+            normalization,
+            counts,
+            mutation_weights,
+            filter,
+        ) = state;
+        let stop = ["completed", "cancelled", "time_limit_reached"]
+            .into_iter()
+            .find(|&name| name == stop)
+            .ok_or_else(|| errors::invalid(py, &format!("{stop:?} is not a stop reason")))?;
+        let (value, norm_samples, relative_error, largest_share) = normalization;
+        let (proposed, accepted_counts) = counts;
+        let (changed_fraction, mean_neighbours) = filter;
+        Ok(RenderStats {
+            stop,
+            samples,
+            mutations,
+            rays,
+            invalid_samples,
+            seconds,
+            threads,
+            accepted_mutations: accepted,
+            normalization: Py::new(
+                py,
+                NormalizationStats {
+                    value,
+                    samples: norm_samples,
+                    relative_error,
+                    largest_share,
+                },
+            )?,
+            mutation_counts: Py::new(
+                py,
+                MutationCounts {
+                    proposed,
+                    accepted: accepted_counts,
+                },
+            )?,
+            mutation_weights,
+            filter: Py::new(
+                py,
+                FilterStats {
+                    changed_fraction,
+                    mean_neighbours,
+                },
+            )?,
+        })
+    }
+
+    /// Pickles as its fields' values (the stats travel back from cluster workers).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (StatsState,))> {
+        let stats = slf.get();
+        let n = stats.normalization.get();
+        let counts = stats.mutation_counts.get();
+        let filter = stats.filter.get();
+        let state: StatsState = (
+            stats.stop.to_owned(),
+            stats.samples,
+            stats.mutations,
+            stats.rays,
+            stats.invalid_samples,
+            stats.seconds,
+            stats.threads,
+            stats.accepted_mutations,
+            (n.value, n.samples, n.relative_error, n.largest_share),
+            (counts.proposed, counts.accepted),
+            stats.mutation_weights,
+            (filter.changed_fraction, filter.mean_neighbours),
+        );
+        Ok((slf.get_type().getattr("_from_state")?, (state,)))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "RenderStats(stop={:?}, samples={}, mutations={}, rays={}, seconds={:.3}, threads={})",

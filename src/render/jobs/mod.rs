@@ -128,6 +128,7 @@ impl RenderPlan {
 }
 
 /// What one job rendered: its film's exact sums and its counters.
+#[derive(Clone)]
 pub struct PartialRender {
     plan: u64,
     job: u32,
