@@ -1386,14 +1386,15 @@ MLT_API enum MltStatus mlt_occluded(const struct MltScene *scene, const struct M
  * Plans a render of `scene` seen by `camera` with `settings`, to be split into jobs that
  * other threads, processes or machines render (`mlt_render_job`) and one merges
  * (`mlt_render_merge`) into the image `mlt_render` gives, bit for bit. Validates what
- * `mlt_render` would. On success `*plan_out` receives the plan's bytes (a few hundred), to
- * release with `mlt_bytes_release`; it is written without being read, so release what it
- * held first. `settings.threads` is not used: each job chooses its own.
+ * `mlt_render` would. On success `*plan_out` receives the plan's bytes (a few hundred, and
+ * a Metropolis plan's chain seeds), to release with `mlt_bytes_release`; it is written
+ * without being read, so release what it held first. `settings.threads` is the plan
+ * step's own: each job chooses its threads.
  *
  * A plan names its scene by a fingerprint of the scene's description (arrays, materials,
  * lights, textures and backend): every job must build its scene from the same one.
- * `MLT_ALGORITHM_PATH` and `MLT_ALGORITHM_BDPT` split; the Metropolis algorithms and ERPT
- * plan, but their jobs return `MLT_STATUS_UNSUPPORTED` for now.
+ * Every algorithm splits. A Metropolis plan runs the bootstrap and fixes every chain's
+ * group and seed; the others' plans are immediate.
  *
  * # Safety
  * `camera` and `settings` must point to initialized structs; `plan_out` must be writable.
