@@ -579,7 +579,18 @@ void splitRenders() {
     const std::vector<mlt::Span<const std::uint8_t>> spans{copied[1], copied[2], copied[0]};
     CHECK(mlt::render_merge(plan.to_vector(), spans, fromCopies).completed());
     CHECK(fromCopies == whole.rgb);
-    ok("mlt::render_plan, render_job and render_merge: 3 jobs merge into render's image");
+    // Two partial results combined into one, merged with the third.
+    const std::vector<mlt::Span<const std::uint8_t>> firstTwo{copied[1], copied[0]};
+    const mlt::Bytes pair = mlt::render_combine(plan, firstTwo);
+    CHECK(!pair.empty());
+    std::vector<float> fromPair(whole.rgb.size());
+    const std::vector<mlt::Span<const std::uint8_t>> pairAndLast{copied[2], pair};
+    CHECK(mlt::render_merge(plan, pairAndLast, fromPair).completed());
+    CHECK(fromPair == whole.rgb);
+    expectError([&] { mlt::render_combine(plan, std::vector<mlt::Span<const std::uint8_t>>{pair, copied[0]}); },
+                mlt::Status::InvalidArgument, "job 0 of 3 is given twice", __LINE__);
+    ok("mlt::render_plan, render_job, render_combine and render_merge: 3 jobs merge into "
+       "render's image");
 
     // Bad input throws, and a progress lambda cancels a job, which still gives its part.
     copied[1][copied[1].size() / 2] ^= 1;

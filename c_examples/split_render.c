@@ -3,8 +3,9 @@
  *
  * The frame is planned once (mlt_render_plan); each of 3 jobs renders its share of the
  * plan (mlt_render_job), as 3 machines would, and its partial result goes out as bytes (a
- * temporary file here: a network or a shared disk in a farm); the merge (mlt_render_merge)
- * reads them back, in another order, into the image. mlt sums every sample in fixed point,
+ * temporary file here: a network or a shared disk in a farm); they are read back in another
+ * order, two of them added into one (mlt_render_combine, as a node of a merge tree does for
+ * a large farm), and the merge (mlt_render_merge) makes the image. mlt sums every sample in fixed point,
  * so the merged image is the one a single mlt_render gives, bit for bit: the program checks
  * that, shows that a corrupted partial result is refused, writes the image as PFM (see
  * minimal.c for the conventions every mlt call follows) and exits non-zero on a mismatch.
@@ -142,6 +143,9 @@ int main(int argc, char **argv) {
     MltRenderStats stats;
     MltBytes plan = {NULL, 0};
     MltBytes partial = {NULL, 0};
+    MltBytes pair = {NULL, 0};
+    const uint8_t *tree[2];
+    size_t tree_sizes[2];
     FILE *files[JOBS] = {NULL, NULL, NULL};
     uint8_t *received[JOBS] = {NULL, NULL, NULL};
     const uint8_t *partials[JOBS];
@@ -188,8 +192,8 @@ int main(int argc, char **argv) {
     desc.materials_len = MATERIAL_COUNT;
     if (!check(mlt_scene_create(&desc, &scene), "mlt_scene_create")) return 1;
 
-    /* The Cornell box's camera is the default. The path tracer and BDPT split into jobs
-     * (the Metropolis algorithms do not yet: their jobs return MLT_STATUS_UNSUPPORTED). */
+    /* The Cornell box's camera is the default. Every algorithm splits into jobs; this
+     * example takes the path tracer or BDPT. */
     if (!check(mlt_camera_default(&camera), "mlt_camera_default")) goto done;
     if (!check(mlt_render_settings_default(&settings), "mlt_render_settings_default"))
         goto done;
@@ -236,7 +240,9 @@ int main(int argc, char **argv) {
         mlt_bytes_release(&partial); /* frees the bytes mlt gave; partial is empty again */
     }
 
-    /* 3. The merge: the partial results in any order, each given once. */
+    /* 3. The merge: the partial results in any order, each job given once. A farm of many
+     *    jobs merges in a tree: a node adds a few partial results into one, which merges
+     *    (or combines again) like any other. Here the first two arrivals are combined. */
     image_len = (size_t)settings.width * settings.height * 3;
     merged = (float *)malloc(sizeof(float) * image_len);
     whole = (float *)malloc(sizeof(float) * image_len);
@@ -249,8 +255,16 @@ int main(int argc, char **argv) {
         }
         partials[i] = received[i];
     }
+    if (!check(mlt_render_combine(plan.data, plan.size, partials, sizes, 2, &pair),
+               "mlt_render_combine"))
+        goto done;
+    printf("combined 2 partial results: %zu bytes\n", pair.size);
+    tree[0] = pair.data;
+    tree_sizes[0] = pair.size;
+    tree[1] = partials[2];
+    tree_sizes[1] = sizes[2];
     if (!check(mlt_render_stats_default(&stats), "mlt_render_stats_default")) goto done;
-    status = mlt_render_merge(plan.data, plan.size, partials, sizes, JOBS, merged, image_len,
+    status = mlt_render_merge(plan.data, plan.size, tree, tree_sizes, 2, merged, image_len,
                               &stats);
     if (!check(status, "mlt_render_merge")) goto done;
     printf("merged %d jobs: %llu samples, %llu rays\n", JOBS,
@@ -285,6 +299,7 @@ done:
     free(merged);
     free(whole);
     mlt_bytes_release(&partial); /* release of an empty MltBytes is a no-op */
+    mlt_bytes_release(&pair);
     mlt_bytes_release(&plan);
     mlt_scene_release(scene);
     return ok ? 0 : 1;

@@ -1430,10 +1430,10 @@ MLT_API enum MltStatus mlt_render_job(const struct MltScene *scene, const uint8_
  * `mlt_render` would: bit for bit the image one `mlt_render` of the plan gives, whatever
  * the number of jobs, their threads and the order of the partial results.
  *
- * `partials[i]` points to the `partial_sizes[i]` bytes of a job's partial result, as
- * `mlt_render_job` gave them; `partial_count` is the number of jobs, each given once in
- * any order. They are decoded one at a time, so the merge holds one decoded partial
- * result besides the image's sums. A partial result that is corrupted, cut short, from
+ * `partials[i]` points to the `partial_sizes[i]` bytes of a partial result, as
+ * `mlt_render_job` (one job) or `mlt_render_combine` (several) gave them; together they
+ * hold every job once, in any order. They are decoded one at a time, so the merge holds one
+ * decoded partial result besides the image's sums. A partial result that is corrupted, cut short, from
  * another plan or split, a job missing or given twice, is `MLT_STATUS_INVALID_ARGUMENT`
  * naming it. `stats_out` (may be NULL) receives the jobs' counts added up (`seconds` is
  * the sum of the jobs' times, `threads` the most any job used).
@@ -1452,7 +1452,27 @@ MLT_API enum MltStatus mlt_render_job(const struct MltScene *scene, const uint8_
 MLT_API enum MltStatus mlt_render_merge(const uint8_t *plan, size_t plan_size, const uint8_t *const *partials, const size_t *partial_sizes, size_t partial_count, float *rgb_out, size_t out_len, struct MltRenderStats *stats_out);
 
 /**
- * Frees bytes mlt gave (`mlt_render_plan`, `mlt_render_job`) and sets `data` to NULL and
+ * Adds partial results of the plan in `plan` (`plan_size` bytes) that hold disjoint sets of
+ * jobs (`partials[i]`, `partial_sizes[i]` bytes each, as `mlt_render_job` or an earlier
+ * `mlt_render_combine` gave them; any number from 1, in any order) into one partial result
+ * that holds all their jobs, for `mlt_render_merge` or a further combine. Merging it gives
+ * the bits merging its parts would: a cluster can add N jobs' results in a tree, each node
+ * reading a few, instead of one node reading all N.
+ *
+ * On success `*combined_out` receives the combined partial result, to release with
+ * `mlt_bytes_release` (it is written without being read: release what it held first). A
+ * partial result that is corrupted, cut short, from another plan or split, or a job held
+ * twice, is `MLT_STATUS_INVALID_ARGUMENT` naming it, and nothing is written.
+ *
+ * # Safety
+ * If non-null, `plan` must point to `plan_size` readable bytes; `partials` and
+ * `partial_sizes` to `partial_count` elements, each `partials[i]` to `partial_sizes[i]`
+ * readable bytes; `combined_out` must be writable.
+ */
+MLT_API enum MltStatus mlt_render_combine(const uint8_t *plan, size_t plan_size, const uint8_t *const *partials, const size_t *partial_sizes, size_t partial_count, struct MltBytes *combined_out);
+
+/**
+ * Frees bytes mlt gave (`mlt_render_plan`, `mlt_render_job`, `mlt_render_combine`) and sets `data` to NULL and
  * `size` to 0, so releasing twice is harmless. NULL, and an `MltBytes` whose `data` is
  * NULL, are no-ops. Bytes mlt did not give, or released already through a copy of the
  * `MltBytes`, are looked up, not freed: ignored, and `mlt_last_error_message` says so.

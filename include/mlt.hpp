@@ -20,8 +20,9 @@
  *     mlt::render once the library has returned.
  *   - A render splits into jobs: mlt::render_plan gives the plan as mlt::Bytes (owned, freed
  *     by the destructor), mlt::render_job renders job k of N of it into a partial result,
- *     and mlt::render_merge merges the partial results, from any byte containers, into
- *     the image mlt::render gives, bit for bit.
+ *     mlt::render_combine adds a few partial results into one (to merge in a tree), and
+ *     mlt::render_merge merges the partial results, from any byte containers, into the
+ *     image mlt::render gives, bit for bit.
  *
  *     mlt::Scene scene(desc);                          // throws mlt::Error on bad input
  *     mlt::RenderSettings settings;                    // the library's defaults
@@ -1331,10 +1332,10 @@ Image render_image(const Scene &scene, const Camera &camera, const RenderSetting
 }
 
 // ---------------------------------------------------------------------------------------
-// A render split into jobs: plan, job k of N, merge
+// A render split into jobs: plan, job k of N, combine, merge
 // ---------------------------------------------------------------------------------------
 
-/// Bytes mlt made, a plan (render_plan) or a job's partial result (render_job), owned:
+/// Bytes mlt made, a plan (render_plan) or a partial result (render_job, render_combine), owned:
 /// move-only, freed by the destructor (mlt_bytes_release). data() and size() are what to
 /// keep or send to another machine. A Span<const std::uint8_t> converts from it, as from
 /// any contiguous container of bytes, which is what render_job and render_merge take: the
@@ -1444,15 +1445,18 @@ JobResult render_job(const Scene &scene, Span<const std::uint8_t> plan, std::uin
                               &forwarder, &forwarder.error);
 }
 
-/// Merges the partial results of every job of `plan`, given once each in any order, into
+/// Merges the partial results of every job of `plan` (render_job's or render_combine's),
+/// holding each job once, in any order, into
 /// `rgb_out` (at least width × height × 3 floats): the image render() gives, bit for bit
 /// (mlt_render_merge). `partials` is a range of contiguous byte containers (Bytes,
 /// std::vector<std::uint8_t>, Span<const std::uint8_t>, ...). Throws Error on invalid input
 /// (a partial result corrupted, of another plan, missing or given twice); returns how the
 /// jobs ended, with their stats added up.
+namespace detail {
+/// The pointers and sizes of a range of contiguous byte containers, for the C calls.
 template <class Partials>
-RenderResult render_merge(Span<const std::uint8_t> plan, const Partials &partials,
-                          Span<float> rgb_out) {
+std::pair<std::vector<const std::uint8_t *>, std::vector<std::size_t>>
+partial_pointers(const Partials &partials) {
     std::vector<const std::uint8_t *> pointers;
     std::vector<std::size_t> sizes;
     for (const auto &partial : partials) {
@@ -1460,6 +1464,29 @@ RenderResult render_merge(Span<const std::uint8_t> plan, const Partials &partial
         pointers.push_back(bytes.data());
         sizes.push_back(bytes.size());
     }
+    return {std::move(pointers), std::move(sizes)};
+}
+} // namespace detail
+
+/// Adds partial results of `plan` that hold disjoint sets of jobs (render_job's, or earlier
+/// render_combine's; a range of contiguous byte containers) into one partial result holding
+/// all their jobs (mlt_render_combine), for render_merge or a further combine: merging it
+/// gives the bits merging its parts would. Throws Error on invalid input (a partial result
+/// corrupted, of another plan, or a job held twice).
+template <class Partials>
+Bytes render_combine(Span<const std::uint8_t> plan, const Partials &partials) {
+    const auto [pointers, sizes] = detail::partial_pointers(partials);
+    Bytes combined;
+    detail::check(mlt_render_combine(plan.data(), plan.size(), pointers.data(), sizes.data(),
+                                     pointers.size(), combined.reset()),
+                  "mlt_render_combine");
+    return combined;
+}
+
+template <class Partials>
+RenderResult render_merge(Span<const std::uint8_t> plan, const Partials &partials,
+                          Span<float> rgb_out) {
+    const auto [pointers, sizes] = detail::partial_pointers(partials);
     MltRenderStats c_stats;
     detail::check(mlt_render_stats_default(&c_stats), "mlt_render_stats_default");
     const MltStatus status =

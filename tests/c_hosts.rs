@@ -389,7 +389,7 @@ fn cpp_header_reports_errors_and_cancels_from_callbacks() {
             "ok: a lambda's exception cancels the render and is rethrown after it",
             "ok: an exception from the final progress call is rethrown",
             "ok: mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer",
-            "ok: mlt::render_plan, render_job and render_merge: 3 jobs merge into render's image",
+            "ok: mlt::render_plan, render_job, render_combine and render_merge: 3 jobs merge into render's image",
             "ok: split renders throw on bad input; a cancelled job gives its partial result; mlt::Bytes owns its bytes",
             &format!("all checks passed (C++{version})"),
         ] {
@@ -578,7 +578,7 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
 }
 
 /// `c_examples/split_render.c` plans a render, renders it as 3 jobs whose partial results
-/// go through temporary files, merges them in another order, checks the image against
+/// go through temporary files, combines two and merges them in another order, checks the image against
 /// `mlt_render` bit for bit and that a corrupted partial result is refused. Its image must
 /// also be the Rust API's render, bit for bit. Built as C99 and as C++, with the path tracer
 /// and BDPT.
@@ -610,6 +610,7 @@ fn split_render_c_merges_three_jobs_into_the_bits_of_one_render() {
             );
             for line in [
                 "job 2 of 3:",
+                "combined 2 partial results:",
                 "merged 3 jobs:",
                 "a corrupted partial result is refused: partials[1]: the partial render's checksum does not match",
                 "the merged image equals mlt_render's bit for bit",

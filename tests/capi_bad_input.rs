@@ -2041,7 +2041,22 @@ fn last_error_is_cleared_by_each_kind_of_success() {
         )
     });
     fail();
+    let mut combined = empty_bytes();
+    // SAFETY: one partial result of `partial.size` bytes.
+    assert_ok(unsafe {
+        mlt_render_combine(
+            plan.data,
+            plan.size,
+            partials.as_ptr(),
+            &partial.size,
+            1,
+            &mut combined,
+        )
+    });
+    fail();
     // SAFETY: filled by mlt, released once each.
+    unsafe { mlt_bytes_release(&mut combined) };
+    // SAFETY: as above.
     unsafe { mlt_bytes_release(&mut partial) };
     assert_eq!(last_error(), "", "a release clears the last error");
     // SAFETY: as above.

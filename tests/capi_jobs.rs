@@ -1,5 +1,5 @@
 //! A render split into jobs through the C ABI (`mlt_render_plan`, `mlt_render_job`,
-//! `mlt_render_merge`, `mlt_bytes_release`), called exactly as a C host calls them: the
+//! `mlt_render_combine`, `mlt_render_merge`, `mlt_bytes_release`), called exactly as a C host calls them: the
 //! merged image has the bits of `mlt_render_ex`'s for any number of jobs, thread counts and
 //! order of the partial results; every bad argument is `MLT_STATUS_INVALID_ARGUMENT` with a
 //! message naming it and leaves the outputs untouched; byte buffers are freed once, and a
@@ -310,6 +310,48 @@ fn assert_merge_refused(plan: &[u8], partials: &[&[u8]], out_len: usize, needles
     assert_eq!(stats.samples, 77, "stats_out written on failure");
 }
 
+/// `mlt_render_combine` of `partials`: the status and the message it left, and the combined
+/// partial result (if written) copied.
+fn combine(plan: &[u8], partials: &[&[u8]]) -> ((MltStatus, String), Option<Vec<u8>>) {
+    let pointers: Vec<*const u8> = partials.iter().map(|p| p.as_ptr()).collect();
+    let sizes: Vec<usize> = partials.iter().map(|p| p.len()).collect();
+    let mut combined = Bytes(sentinel_bytes());
+    // SAFETY: valid pointers of the stated lengths.
+    let status = unsafe {
+        mlt_render_combine(
+            plan.as_ptr(),
+            plan.len(),
+            pointers.as_ptr(),
+            sizes.as_ptr(),
+            partials.len(),
+            &mut combined.0,
+        )
+    };
+    let outcome = (status, last_error());
+    if is_sentinel(&combined.0) {
+        std::mem::forget(combined);
+        (outcome, None)
+    } else {
+        (outcome, Some(combined.as_slice().to_vec()))
+    }
+}
+
+/// A combine that must succeed.
+#[track_caller]
+fn combine_ok(plan: &[u8], partials: &[&[u8]]) -> Vec<u8> {
+    let (outcome, combined) = combine(plan, partials);
+    assert_outcome(outcome, MLT_STATUS_OK, &[]);
+    combined.expect("combined_out written")
+}
+
+/// Asserts a combine is refused as invalid, naming `needles`, with `combined_out` untouched.
+#[track_caller]
+fn assert_combine_refused(plan: &[u8], partials: &[&[u8]], needles: &[&str]) {
+    let (outcome, combined) = combine(plan, partials);
+    assert_outcome(outcome, MLT_STATUS_INVALID_ARGUMENT, needles);
+    assert!(combined.is_none(), "combined_out written on failure");
+}
+
 fn same_bits(a: &[f32], b: &[f32]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
@@ -436,6 +478,174 @@ fn every_algorithm_splits_exactly() {
             "algorithm {algorithm} in 2 jobs differs from mlt_render"
         );
     }
+}
+
+/// Partial results combined in a tree (two jobs, then that with a third), merged with the
+/// rest: `mlt_render_ex`'s image, bit for bit, for the path tracer and MMLT.
+#[test]
+fn combined_partial_results_merge_exactly() {
+    let (scene, camera) = cornell();
+    for algorithm in [MLT_ALGORITHM_PATH, MLT_ALGORITHM_MMLT] {
+        let settings = MltRenderSettings {
+            width: 12,
+            height: 10,
+            samples_per_pixel: 2,
+            mutations_per_pixel: 2,
+            bootstrap_samples: 4096,
+            chains: 16,
+            ..settings(algorithm)
+        };
+        let plan = plan(&scene, &camera, &settings);
+        let five: Vec<Vec<u8>> = (0..5).map(|k| job_ok(&scene, &plan, k, 5)).collect();
+        let pair = combine_ok(&plan, &[&five[3], &five[0]]);
+        let three = combine_ok(&plan, &[&five[4], &pair]);
+        let (status, merged, stats) =
+            merge(&plan, &[&five[2], &three, &five[1]], image_len(&settings));
+        assert_ok(status);
+        let (whole, whole_stats) = render(&scene, &camera, &settings);
+        assert!(
+            same_bits(&whole, &merged),
+            "algorithm {algorithm}: combined jobs differ from mlt_render"
+        );
+        assert_eq!(stats.samples, whole_stats.samples);
+        assert_eq!(stats.mutations, whole_stats.mutations);
+    }
+}
+
+#[test]
+fn combine_bad_input() {
+    let (scene, camera) = cornell();
+    let settings = settings(MLT_ALGORITHM_PATH);
+    let plan = plan(&scene, &camera, &settings);
+    let three: Vec<Vec<u8>> = (0..3).map(|k| job_ok(&scene, &plan, k, 3)).collect();
+    let [p0, p1, p2] = [&three[0][..], &three[1][..], &three[2][..]];
+    let pair = combine_ok(&plan, &[p0, p1]);
+
+    // Pointers, counts and sizes.
+    let pointers = [p0.as_ptr()];
+    let sizes = [p0.len()];
+    let mut out = Bytes(sentinel_bytes());
+    type Call<'a> = Box<dyn Fn(&mut MltBytes) -> MltStatus + 'a>;
+    let cases: [(&str, Call); 7] = [
+        (
+            "plan is NULL",
+            // SAFETY (each case): valid pointers but the one named.
+            Box::new(|out| unsafe {
+                mlt_render_combine(null(), 9, pointers.as_ptr(), sizes.as_ptr(), 1, out)
+            }),
+        ),
+        (
+            "plan_size is 0",
+            Box::new(|out| unsafe {
+                mlt_render_combine(plan.as_ptr(), 0, pointers.as_ptr(), sizes.as_ptr(), 1, out)
+            }),
+        ),
+        (
+            "partial_count is 0",
+            Box::new(|out| unsafe {
+                mlt_render_combine(
+                    plan.as_ptr(),
+                    plan.len(),
+                    pointers.as_ptr(),
+                    sizes.as_ptr(),
+                    0,
+                    out,
+                )
+            }),
+        ),
+        (
+            "MLT_MAX_JOBS",
+            Box::new(|out| unsafe {
+                mlt_render_combine(
+                    plan.as_ptr(),
+                    plan.len(),
+                    pointers.as_ptr(),
+                    sizes.as_ptr(),
+                    MLT_MAX_JOBS as usize + 1,
+                    out,
+                )
+            }),
+        ),
+        (
+            "partials",
+            Box::new(|out| unsafe {
+                mlt_render_combine(plan.as_ptr(), plan.len(), null(), sizes.as_ptr(), 1, out)
+            }),
+        ),
+        (
+            "partial_sizes",
+            Box::new(|out| unsafe {
+                mlt_render_combine(plan.as_ptr(), plan.len(), pointers.as_ptr(), null(), 1, out)
+            }),
+        ),
+        (
+            "partial_sizes[0] is 0",
+            Box::new(|out| unsafe {
+                mlt_render_combine(
+                    plan.as_ptr(),
+                    plan.len(),
+                    pointers.as_ptr(),
+                    [0usize].as_ptr(),
+                    1,
+                    out,
+                )
+            }),
+        ),
+    ];
+    for (needle, call) in &cases {
+        let status = call(&mut out.0);
+        assert_invalid(status, &[needle]);
+        assert!(is_sentinel(&out.0), "combined_out written on failure");
+    }
+    std::mem::forget(out);
+    // SAFETY: valid pointers but the NULL output.
+    let status = unsafe {
+        mlt_render_combine(
+            plan.as_ptr(),
+            plan.len(),
+            pointers.as_ptr(),
+            sizes.as_ptr(),
+            1,
+            null_mut(),
+        )
+    };
+    assert_invalid(status, &["combined_out"]);
+
+    // The buffers and the set of jobs.
+    let mut corrupted = p1.to_vec();
+    corrupted[p1.len() / 2] ^= 0x10;
+    assert_combine_refused(&plan, &[p0, &corrupted], &["partials[1]", "corrupted"]);
+    assert_combine_refused(
+        &plan,
+        &[p0, &p2[..p2.len() - 1]],
+        &["partials[1]", "truncated"],
+    );
+    assert_combine_refused(&plan, &[&pair, p1], &["job 1 of 3 is given twice"]);
+    assert_combine_refused(
+        &plan,
+        &[&pair, p2, p0, p1],
+        &["partial_count is 4", "3 jobs"],
+    );
+    let other_plan = self::plan(
+        &scene,
+        &camera,
+        &MltRenderSettings {
+            seed: 99,
+            ..settings
+        },
+    );
+    assert_combine_refused(&other_plan, &[p0], &["another plan"]);
+    // A merge whose first partial result holds every job, then a corrupted one: refused,
+    // the image unwritten.
+    let all = combine_ok(&plan, &[&pair, p2]);
+    assert_merge_refused(
+        &plan,
+        &[&all, &corrupted],
+        image_len(&settings),
+        &["partials[1]"],
+    );
+    let (status, _, _) = merge(&plan, &[&all], image_len(&settings));
+    assert_ok(status);
 }
 
 // ---------------------------------------------------------------------------------------

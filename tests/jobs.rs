@@ -238,3 +238,91 @@ fn a_job_cut_short_still_merges_into_the_right_brightness() {
     let (mean, error) = mean_and_standard_error(&images[0]);
     assert_within_and_sharp("cut merge, red", mean[0], truth, error[0], 4.0);
 }
+
+/// Partial results combined in a tree (some in twos, one alone, one combination combined
+/// again), through bytes and in shuffled order, merge into the bits of the whole render, and
+/// a combination names the jobs it holds.
+#[test]
+fn combined_partial_results_merge_into_the_same_bits() {
+    let (scene, camera) = load_canonical("cornell-box");
+    for settings in [
+        settings(Algorithm::Path),
+        settings(Algorithm::Mmlt),
+        RenderSettings {
+            filter_buffers: 4,
+            ..settings(Algorithm::Pssmlt)
+        },
+        settings(Algorithm::PathSpaceMlt),
+        settings(Algorithm::Erpt),
+    ] {
+        let algorithm = settings.algorithm;
+        let mut whole = vec![0.0f32; settings.output_len().unwrap()];
+        let stats = mlt::render(&scene, &camera, &settings, &mut whole, None).unwrap();
+        let plan = jobs::plan(&scene, &camera, &settings).unwrap();
+        let count = 7;
+        let partials: Vec<Vec<u8>> = (0..count)
+            .map(|job| {
+                jobs::render_job(&scene, &plan, job, count, 1, None)
+                    .unwrap()
+                    .to_bytes()
+            })
+            .collect();
+        let decode = |job: usize| PartialRender::from_bytes(&partials[job]).unwrap();
+        let combine = |parts: Vec<PartialRender>| {
+            let combined = jobs::combine(&plan, parts).unwrap();
+            PartialRender::from_bytes(&combined.to_bytes()).unwrap()
+        };
+        let pair = combine(vec![decode(3), decode(0)]);
+        assert_eq!(pair.held_jobs(), [0, 3]);
+        assert_eq!(pair.job(), 0);
+        assert_eq!(pair.name(), "jobs [0, 3] of 7");
+        let alone = combine(vec![decode(5)]);
+        assert_eq!(alone.held_jobs(), [5]);
+        let trio = combine(vec![decode(6), decode(1), decode(2)]);
+        let pair_and_alone = combine(vec![alone, pair]);
+        assert_eq!(pair_and_alone.held_jobs(), [0, 3, 5]);
+        let mut merged = vec![0.0f32; whole.len()];
+        let merged_stats =
+            jobs::merge(&plan, [trio, decode(4), pair_and_alone], &mut merged).unwrap();
+        assert!(
+            same_bits(&whole, &merged),
+            "{algorithm:?}: the combined jobs differ from one render"
+        );
+        assert_eq!(merged_stats.samples, stats.samples);
+        assert_eq!(merged_stats.mutations, stats.mutations);
+        assert_eq!(merged_stats.normalization, stats.normalization);
+        assert_eq!(merged_stats.filter, stats.filter);
+    }
+}
+
+#[test]
+fn combining_a_job_twice_or_from_another_plan_is_refused() {
+    let (scene, camera) = load_canonical("cornell-box");
+    let settings = settings(Algorithm::Mmlt);
+    let plan = jobs::plan(&scene, &camera, &settings).unwrap();
+    let job = |k: u32| jobs::render_job(&scene, &plan, k, 3, 1, None).unwrap();
+    let pair = jobs::combine(&plan, [job(0), job(1)]).unwrap();
+    invalid(
+        jobs::combine(&plan, [pair.clone(), job(1)]),
+        "job 1 of 3 is given twice",
+    );
+    invalid(
+        jobs::combine(&plan, Vec::<PartialRender>::new()),
+        "no partial render",
+    );
+    let other_plan = jobs::plan(
+        &scene,
+        &camera,
+        &RenderSettings {
+            seed: 6,
+            ..settings
+        },
+    )
+    .unwrap();
+    invalid(jobs::combine(&other_plan, [job(2)]), "another plan");
+    let mut image = vec![0.0f32; settings.output_len().unwrap()];
+    invalid(
+        jobs::merge(&plan, [pair], &mut image),
+        "jobs [2] of 3 are missing",
+    );
+}

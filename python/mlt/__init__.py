@@ -16,8 +16,9 @@ stops a render too.
 
 A frame too big for one machine splits into jobs that merge into the same bits:
 :func:`plan` once, :func:`render_job` for job k of N on any process holding the same scene,
-:func:`merge` of the :class:`PartialRender` results. Plans and partial results pickle (as
-their checksummed bytes); :mod:`mlt.dask` runs the three steps on a Dask cluster.
+:func:`merge` of the :class:`PartialRender` results; :func:`combine` adds a few partial
+results into one, so a cluster can merge in a tree. Plans and partial results pickle (as
+their checksummed bytes); :mod:`mlt.dask` runs the steps on a Dask cluster.
 
 Errors from mlt are :class:`MltError`; invalid input is
 :class:`InvalidArgumentError`, also a ``ValueError``.
@@ -38,6 +39,7 @@ from ._mlt import (
     Scene,
     SceneInfo,
     __version__,
+    combine,
     load_environment,
     merge,
     plan,
@@ -87,5 +89,6 @@ __all__ = [
     "plan",
     "render",
     "render_job",
+    "combine",
     "render_with_unfiltered",
 ]

@@ -23,6 +23,7 @@ __all__ = [
     "PartialRender",
     "plan",
     "render_job",
+    "combine",
     "merge",
     "load_environment",
     "_defaults_mismatches",
@@ -186,6 +187,8 @@ class PartialRender:
     @property
     def job(self) -> int: ...
     @property
+    def held_jobs(self) -> list[int]: ...
+    @property
     def jobs(self) -> int: ...
     @property
     def plan_id(self) -> int: ...
@@ -219,6 +222,9 @@ def render_job(
     threads: int = 0,
     progress: Optional[_Progress] = None,
     cancel: Optional[CancelToken] = None,
+) -> PartialRender: ...
+def combine(
+    plan: RenderPlan, partials: Iterable[Union[PartialRender, bytes]]
 ) -> PartialRender: ...
 def merge(
     plan: RenderPlan, partials: Iterable[Union[PartialRender, bytes]]

@@ -18,9 +18,10 @@ with the tasks, or any other picklable callable returning a :class:`Scene`). Eac
 process builds a source once and keeps the scenes of its last few sources.
 
 The plan runs as a task (a Metropolis plan runs the bootstrap), each job as a task given the
-plan, and the merge as a task given every partial result; plans and partial results move
-between workers as their checksummed bytes. Only the image and the stats come back to the
-client, which needs no scene.
+plan, then the partial results are added in a tree of combine tasks, ``fan_in`` at a time
+(so no worker reads all N), and a merge task makes the image; plans and partial results
+move between workers as their checksummed bytes. Only the image and the stats come back to
+the client, which needs no scene.
 """
 
 from __future__ import annotations
@@ -133,11 +134,17 @@ def _plan_task(source: SceneSource, camera: Camera, settings: RenderSettings) ->
     return _mlt.plan(_scene(source), camera, settings)
 
 
-def _job_task(source: SceneSource, plan: _mlt.RenderPlan, job: int, jobs: int, threads: int) -> _mlt.PartialRender:
-    return _mlt.render_job(_scene(source), plan, job, jobs, threads=threads)
+# Partial results travel between tasks as bytes: the task that reads one decodes it once,
+# where a PartialRender would be decoded when unpickled and copied again when combined.
+def _job_task(source: SceneSource, plan: _mlt.RenderPlan, job: int, jobs: int, threads: int) -> bytes:
+    return _mlt.render_job(_scene(source), plan, job, jobs, threads=threads).to_bytes()
 
 
-def _merge_task(plan: _mlt.RenderPlan, *partials: _mlt.PartialRender) -> Tuple[_Image, _mlt.RenderStats]:
+def _combine_task(plan: _mlt.RenderPlan, *partials: bytes) -> bytes:
+    return _mlt.combine(plan, partials).to_bytes()
+
+
+def _merge_task(plan: _mlt.RenderPlan, *partials: bytes) -> Tuple[_Image, _mlt.RenderStats]:
     return _mlt.merge(plan, partials)
 
 
@@ -154,16 +161,25 @@ def submit_frame(
     jobs: int,
     threads: int = 0,
     workers: Optional[Sequence[str]] = None,
+    fan_in: int = 8,
 ) -> Future:
-    """Submits a frame split into `jobs` jobs: a plan task, `jobs` job tasks and a merge
-    task. Returns the merge's future, of ``(image, stats)``: the image :func:`mlt.render`
-    returns for `settings`, bit for bit, whatever `jobs` and wherever the jobs ran.
+    """Submits a frame split into `jobs` jobs: a plan task, `jobs` job tasks, combine tasks
+    and a merge task. Returns the merge's future, of ``(image, stats)``: the image
+    :func:`mlt.render` returns for `settings`, bit for bit, whatever `jobs` and wherever the
+    jobs ran.
 
     `threads` is each job's thread count (0: every core of its worker's machine; give 1
     when a machine runs as many single-threaded workers as it has cores); the plan uses
     ``settings.threads``. `workers` (addresses), if given, pins job k to worker
     ``workers[k % len(workers)]``; else the scheduler places every task.
+
+    `fan_in` (at least 2) is the most partial results one task reads: while there are more,
+    they are added `fan_in` at a time by combine tasks (:func:`mlt.combine`), level after
+    level, and the merge reads the last `fan_in` or fewer. Each task then holds at most
+    `fan_in` partial results' bytes, and the levels' tasks run in parallel.
     """
+    if fan_in < 2:
+        raise ValueError(f"fan_in is {fan_in}: a combine reads at least 2 partial results")
     if settings is None:
         settings = RenderSettings()
     name = uuid.uuid4().hex
@@ -181,6 +197,16 @@ def submit_frame(
         )
         for job in range(jobs)
     ]
+    level = 0
+    while len(partials) > fan_in:
+        groups = [partials[start : start + fan_in] for start in range(0, len(partials), fan_in)]
+        partials = [
+            group[0]
+            if len(group) == 1
+            else client.submit(_combine_task, plan, *group, key=f"mlt-combine-{level}-{index}-{name}")
+            for index, group in enumerate(groups)
+        ]
+        level += 1
     return client.submit(_merge_task, plan, *partials, key=f"mlt-merge-{name}")
 
 
@@ -193,10 +219,11 @@ def render_frame(
     jobs: int,
     threads: int = 0,
     workers: Optional[Sequence[str]] = None,
+    fan_in: int = 8,
 ) -> Tuple[_Image, _mlt.RenderStats]:
     """Renders a frame as `jobs` jobs on the cluster (see :func:`submit_frame`) and returns
     ``(image, stats)``."""
-    future = submit_frame(client, scene, camera, settings, jobs=jobs, threads=threads, workers=workers)
+    future = submit_frame(client, scene, camera, settings, jobs=jobs, threads=threads, workers=workers, fan_in=fan_in)
     result: Tuple[_Image, _mlt.RenderStats] = future.result()
     return result
 

@@ -1,4 +1,4 @@
-//! `mlt.plan`, `mlt.render_job`, `mlt.merge`: a render split into jobs that merge into the
+//! `mlt.plan`, `mlt.render_job`, `mlt.combine`, `mlt.merge`: a render split into jobs that merge into the
 //! bits of one render (`mlt::jobs`). Plans and partial results pickle as their byte buffers
 //! (version and checksum included), so any process pool or cluster can carry them.
 
@@ -74,8 +74,8 @@ impl RenderPlan {
     }
 }
 
-/// What one job rendered (`mlt::jobs::PartialRender`): its film's exact sums and its
-/// counters. `to_bytes()` / `PartialRender.from_bytes()` and pickling carry it.
+/// What one job rendered (`mlt::jobs::PartialRender`), or several after `combine`: its
+/// film's exact sums and its counters. `to_bytes()` / `PartialRender.from_bytes()` and pickling carry it.
 #[pyclass(module = "mlt._mlt", frozen)]
 pub struct PartialRender {
     partial: mlt::jobs::PartialRender,
@@ -98,10 +98,16 @@ impl PartialRender {
         PyBytes::new(py, &bytes)
     }
 
-    /// This job's number, from 0.
+    /// This job's number, from 0 (for a combination, the first job it holds).
     #[getter]
     fn job(&self) -> u32 {
         self.partial.job()
+    }
+
+    /// The jobs whose work it holds, ascending: `[job]` for one job's result.
+    #[getter]
+    fn held_jobs(&self) -> Vec<u32> {
+        self.partial.held_jobs().to_vec()
     }
 
     /// How many jobs the render was split into.
@@ -116,7 +122,7 @@ impl PartialRender {
         self.partial.plan_id()
     }
 
-    /// This job's own `RenderStats`.
+    /// The `RenderStats` of the jobs it holds, added up.
     #[getter]
     fn stats(&self, py: Python<'_>) -> PyResult<RenderStats> {
         RenderStats::new(py, self.partial.stats())
@@ -132,8 +138,8 @@ impl PartialRender {
 
     fn __repr__(&self) -> String {
         format!(
-            "PartialRender(job={}, jobs={}, plan_id={:016x})",
-            self.partial.job(),
+            "PartialRender(held_jobs={:?}, jobs={}, plan_id={:016x})",
+            self.partial.held_jobs(),
             self.partial.jobs(),
             self.partial.plan_id()
         )
@@ -191,11 +197,11 @@ pub fn render_job(
     Ok(PartialRender { partial })
 }
 
-/// Merges the partial results of every job of `plan` (`PartialRender`s or their bytes, in
-/// any order) into `(image, stats)`, the image `render` would return for the plan, bit for
-/// bit. The stats add the jobs' counts; `seconds` is the sum of the jobs' times, `threads`
-/// the most any job used. Raises `InvalidArgumentError` for a job missing or given twice, or
-/// of another plan.
+/// Merges the partial results of every job of `plan` (`PartialRender`s or their bytes, one
+/// per job or `combine`d, holding every job once, in any order) into `(image, stats)`, the
+/// image `render` would return for the plan, bit for bit. The stats add the jobs' counts;
+/// `seconds` is the sum of the jobs' times, `threads` the most any job used. Raises
+/// `InvalidArgumentError` for a job missing or given twice, or of another plan.
 #[pyfunction]
 pub fn merge<'py>(
     py: Python<'py>,
@@ -209,16 +215,51 @@ pub fn merge<'py>(
             .output_len()
             .map_err(|e| errors::from_mlt(py, &e))?,
     )?;
-    // Each item is taken (and bytes decoded) one at a time, so only one job's film is
-    // held beside the sum.
+    let stats = with_partials(py, partials, "merge", |partials| {
+        mlt::jobs::merge(plan, partials, &mut image)
+    })?;
+    Ok((
+        image_array(py, image, settings)?,
+        RenderStats::new(py, &stats)?,
+    ))
+}
+
+/// Adds partial results of `plan` that hold disjoint sets of jobs (`PartialRender`s or
+/// their bytes, any number, in any order) into one `PartialRender` holding all their jobs,
+/// for `merge` or a further `combine`: merging it gives the bits merging its parts would,
+/// so a cluster can merge N jobs in a tree. Raises `InvalidArgumentError` for a job held
+/// twice, or of another plan.
+#[pyfunction]
+pub fn combine<'py>(
+    py: Python<'py>,
+    plan: &Bound<'py, RenderPlan>,
+    partials: &Bound<'py, PyAny>,
+) -> PyResult<PartialRender> {
+    let plan = &plan.get().plan;
+    let partial = with_partials(py, partials, "combine", |partials| {
+        mlt::jobs::combine(plan, partials)
+    })?;
+    Ok(PartialRender { partial })
+}
+
+/// Runs `fold` (`merge` or `combine`, named `call`) with the GIL released on the items of
+/// `partials`, each taken (and bytes decoded) one at a time, so only one job's film is held
+/// beside the sum. An item that is neither a `PartialRender` nor bytes-like, or does not
+/// decode, ends the items `fold` sees and is the error raised.
+fn with_partials<T: Send>(
+    py: Python<'_>,
+    partials: &Bound<'_, PyAny>,
+    call: &str,
+    fold: impl Send + FnOnce(&mut dyn Iterator<Item = mlt::jobs::PartialRender>) -> mlt::Result<T>,
+) -> PyResult<T> {
     let items: Vec<Py<PyAny>> = partials
         .try_iter()?
         .map(|item| item.map(Bound::unbind))
         .collect::<PyResult<_>>()?;
     let mut failure: Option<PyErr> = None;
     let result = py.detach(|| {
-        let partials = items.iter().map_while(|item| {
-            Python::attach(|py| match partial_of(item.bind(py)) {
+        let mut partials = items.iter().map_while(|item| {
+            Python::attach(|py| match partial_of(item.bind(py), call) {
                 Ok(partial) => Some(partial),
                 Err(error) => {
                     failure = Some(error);
@@ -226,21 +267,17 @@ pub fn merge<'py>(
                 }
             })
         });
-        mlt::jobs::merge(plan, partials, &mut image)
+        fold(&mut partials)
     });
     if let Some(error) = failure {
         return Err(error);
     }
-    let stats = result.map_err(|e| errors::from_mlt(py, &e))?;
-    Ok((
-        image_array(py, image, settings)?,
-        RenderStats::new(py, &stats)?,
-    ))
+    result.map_err(|e| errors::from_mlt(py, &e))
 }
 
-/// An item of `merge`'s partials: a `PartialRender` (copied) or a bytes-like buffer
-/// (decoded).
-fn partial_of(item: &Bound<'_, PyAny>) -> PyResult<mlt::jobs::PartialRender> {
+/// An item of `merge`'s or `combine`'s partials: a `PartialRender` (copied) or a bytes-like
+/// buffer (decoded).
+fn partial_of(item: &Bound<'_, PyAny>, call: &str) -> PyResult<mlt::jobs::PartialRender> {
     let py = item.py();
     if let Ok(partial) = item.cast::<PartialRender>() {
         return Ok(partial.get().partial.clone());
@@ -250,7 +287,7 @@ fn partial_of(item: &Bound<'_, PyAny>) -> PyResult<mlt::jobs::PartialRender> {
             mlt::jobs::PartialRender::from_bytes(bytes).map_err(|e| errors::from_mlt(py, &e))
         }
         Err(_) => Err(PyTypeError::new_err(format!(
-            "merge takes PartialRender objects or their bytes, not {}",
+            "{call} takes PartialRender objects or their bytes, not {}",
             item.get_type().name()?
         ))),
     }

@@ -65,6 +65,7 @@ fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render::render_with_unfiltered, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::plan, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::render_job, m)?)?;
+    m.add_function(wrap_pyfunction!(jobs::combine, m)?)?;
     m.add_function(wrap_pyfunction!(jobs::merge, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_environment, m)?)?;
     m.add_function(wrap_pyfunction!(_defaults_mismatches, m)?)?;

@@ -60,6 +60,20 @@ def test_a_frame_split_over_the_cluster_is_the_single_render(
     assert sorted(built) == workers and all(count > 0 for count in built.values())
 
 
+def test_a_tree_of_combines_merges_into_the_same_bits(client: distributed.Client) -> None:
+    # 9 jobs, 2 at a time: 9 partial results, then 5, 3 and 2 after three levels of
+    # combines, and the merge.
+    settings = mlt.RenderSettings(
+        width=24, height=20, algorithm="mmlt", mutations_per_pixel=2, chains=24, bootstrap_samples=2048, threads=1
+    )
+    image, stats = mlt.dask.render_frame(client, CORNELL_BOX, cornell_camera(), settings, jobs=9, threads=1, fan_in=2)
+    wanted, wanted_stats = mlt.render(CORNELL_BOX(), cornell_camera(), settings)
+    assert np.array_equal(image.view(np.uint32), wanted.view(np.uint32))
+    assert stats.mutations == wanted_stats.mutations
+    with pytest.raises(ValueError, match="fan_in is 1"):
+        mlt.dask.submit_frame(client, CORNELL_BOX, cornell_camera(), settings, jobs=2, fan_in=1)
+
+
 def test_a_scene_from_arrays_travels_with_the_tasks(client: distributed.Client) -> None:
     positions, indices = quad()
     source = mlt.dask.SceneArrays(

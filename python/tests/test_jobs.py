@@ -156,3 +156,26 @@ def test_bad_jobs_and_buffers_raise(cornell_box: tuple[mlt.Scene, mlt.Camera]) -
     plan_bytes = plan.to_bytes()
     with pytest.raises(mlt.InvalidArgumentError):
         mlt.RenderPlan.from_bytes(plan_bytes[: len(plan_bytes) // 2])
+
+
+@pytest.mark.parametrize("algorithm", ["path", "mmlt"])
+def test_combined_partials_merge_into_the_same_bits(cornell_box: tuple[mlt.Scene, mlt.Camera], algorithm: str) -> None:
+    scene, camera = cornell_box
+    wanted = settings(algorithm)
+    image, stats = mlt.render(scene, camera, wanted)
+    plan = mlt.plan(scene, camera, wanted)
+    jobs = 5
+    partials = [mlt.render_job(scene, plan, k, jobs, threads=1).to_bytes() for k in range(jobs)]
+    pair = mlt.combine(plan, [partials[3], partials[0]])
+    assert pair.held_jobs == [0, 3] and pair.job == 0 and pair.jobs == jobs
+    # Combined again (from an object and from bytes), then merged with the rest.
+    three = pickle.loads(pickle.dumps(mlt.combine(plan, [pair, partials[4]])))
+    assert three.held_jobs == [0, 3, 4]
+    assert three.stats.samples == sum(mlt.PartialRender.from_bytes(partials[k]).stats.samples for k in (0, 3, 4))
+    merged, merged_stats = mlt.merge(plan, [partials[2], three, partials[1]])
+    assert np.array_equal(merged.view(np.uint32), image.view(np.uint32))
+    assert merged_stats.samples == stats.samples and merged_stats.mutations == stats.mutations
+    with pytest.raises(mlt.InvalidArgumentError, match="job 3 of 5 is given twice"):
+        mlt.combine(plan, [three, partials[3]])
+    with pytest.raises(TypeError, match="combine takes PartialRender"):
+        mlt.combine(plan, [partials[1], "not a partial"])

@@ -1,4 +1,4 @@
-//! The exports of a render split into jobs (`mlt::jobs`): plan, job k of N, merge. Plans and
+//! The exports of a render split into jobs (`mlt::jobs`): plan, job k of N, combine, merge. Plans and
 //! partial results cross the boundary as bytes: mlt gives them as `MltBytes` (`buffers`),
 //! and the host passes them back as a pointer and a size, from wherever it kept or
 //! received them.
@@ -38,6 +38,84 @@ unsafe fn read_plan(plan: *const u8, plan_size: usize) -> Result<RenderPlan> {
     // SAFETY: forwarded contract.
     let bytes = unsafe { host_slice(plan, plan_size, "plan") }?;
     RenderPlan::from_bytes(bytes).map_err(|e| about("plan", e))
+}
+
+/// The partial results the host passes back (`partials[i]`, `partial_sizes[i]` bytes each),
+/// checked but not decoded.
+///
+/// # Safety
+/// If non-null, `partials` and `partial_sizes` must point to `partial_count` elements, each
+/// `partials[i]` to `partial_sizes[i]` readable bytes.
+unsafe fn host_partials<'a>(
+    partials: *const *const u8,
+    partial_sizes: *const usize,
+    partial_count: usize,
+    call: &str,
+) -> Result<Vec<&'a [u8]>> {
+    if partial_count == 0 {
+        return Err(Error::invalid(format!(
+            "partial_count is 0: {call} needs at least one partial result"
+        )));
+    }
+    if partial_count > MLT_MAX_JOBS as usize {
+        return Err(Error::invalid(format!(
+            "partial_count is {partial_count}; a render has at most MLT_MAX_JOBS ({MLT_MAX_JOBS}) jobs"
+        )));
+    }
+    // SAFETY: forwarded contract for every pointer below.
+    let pointers = unsafe { host_slice(partials, partial_count, "partials") }?;
+    let sizes = unsafe { host_slice(partial_sizes, partial_count, "partial_sizes") }?;
+    pointers
+        .iter()
+        .zip(sizes)
+        .enumerate()
+        .map(|(i, (&pointer, &size))| {
+            if pointer.is_null() {
+                return Err(Error::invalid(format!("partials[{i}] is NULL")));
+            }
+            if size == 0 {
+                return Err(Error::invalid(format!(
+                    "partial_sizes[{i}] is 0: pass the size of the bytes mlt_render_job or mlt_render_combine gave"
+                )));
+            }
+            unsafe { host_slice(pointer, size, &format!("partials[{i}]")) }
+        })
+        .collect()
+}
+
+/// Decodes `buffers` one at a time for `fold`, so it holds one decoded partial result
+/// besides its sums, and returns the first decoding error instead of `fold`'s result, which
+/// then saw only the partial results before it.
+fn decode_each<T>(
+    plan: &RenderPlan,
+    buffers: &[&[u8]],
+    fold: impl FnOnce(&mut dyn Iterator<Item = PartialRender>) -> Result<T>,
+) -> Result<T> {
+    let decode = |i: usize| {
+        PartialRender::from_bytes(buffers[i]).map_err(|e| about(&format!("partials[{i}]"), e))
+    };
+    let first = decode(0)?;
+    // Each partial result holds at least one job of its own.
+    if first.plan_id() == plan.id() && buffers.len() > first.jobs() as usize {
+        return Err(Error::invalid(format!(
+            "partial_count is {} but the render was split into {} jobs: give each job's partial result once",
+            buffers.len(),
+            first.jobs()
+        )));
+    }
+    let mut undecodable = None;
+    let rest = (1..buffers.len()).map_while(|i| match decode(i) {
+        Ok(partial) => Some(partial),
+        Err(error) => {
+            undecodable = Some(error);
+            None
+        }
+    });
+    let folded = fold(&mut std::iter::once(first).chain(rest));
+    match undecodable {
+        Some(error) => Err(error),
+        None => folded,
+    }
 }
 
 /// Plans a render of `scene` seen by `camera` with `settings`, to be split into jobs that
@@ -167,10 +245,10 @@ pub unsafe extern "C" fn mlt_render_job(
 /// `mlt_render` would: bit for bit the image one `mlt_render` of the plan gives, whatever
 /// the number of jobs, their threads and the order of the partial results.
 ///
-/// `partials[i]` points to the `partial_sizes[i]` bytes of a job's partial result, as
-/// `mlt_render_job` gave them; `partial_count` is the number of jobs, each given once in
-/// any order. They are decoded one at a time, so the merge holds one decoded partial
-/// result besides the image's sums. A partial result that is corrupted, cut short, from
+/// `partials[i]` points to the `partial_sizes[i]` bytes of a partial result, as
+/// `mlt_render_job` (one job) or `mlt_render_combine` (several) gave them; together they
+/// hold every job once, in any order. They are decoded one at a time, so the merge holds one
+/// decoded partial result besides the image's sums. A partial result that is corrupted, cut short, from
 /// another plan or split, a job missing or given twice, is `MLT_STATUS_INVALID_ARGUMENT`
 /// naming it. `stats_out` (may be NULL) receives the jobs' counts added up (`seconds` is
 /// the sum of the jobs' times, `threads` the most any job used).
@@ -200,34 +278,8 @@ pub unsafe extern "C" fn mlt_render_merge(
     guard(|| {
         // SAFETY: forwarded contract for every pointer below.
         let plan = unsafe { read_plan(plan, plan_size) }?;
-        if partial_count == 0 {
-            return Err(Error::invalid(
-                "partial_count is 0: the merge needs the partial result of every job",
-            ));
-        }
-        if partial_count > MLT_MAX_JOBS as usize {
-            return Err(Error::invalid(format!(
-                "partial_count is {partial_count}; a render has at most MLT_MAX_JOBS ({MLT_MAX_JOBS}) jobs"
-            )));
-        }
-        let pointers = unsafe { host_slice(partials, partial_count, "partials") }?;
-        let sizes = unsafe { host_slice(partial_sizes, partial_count, "partial_sizes") }?;
-        let buffers = pointers
-            .iter()
-            .zip(sizes)
-            .enumerate()
-            .map(|(i, (&pointer, &size))| {
-                if pointer.is_null() {
-                    return Err(Error::invalid(format!("partials[{i}] is NULL")));
-                }
-                if size == 0 {
-                    return Err(Error::invalid(format!(
-                        "partial_sizes[{i}] is 0: pass the size of the bytes mlt_render_job gave"
-                    )));
-                }
-                unsafe { host_slice(pointer, size, &format!("partials[{i}]")) }
-            })
-            .collect::<Result<Vec<&[u8]>>>()?;
+        let buffers =
+            unsafe { host_partials(partials, partial_sizes, partial_count, "the merge") }?;
         let settings = plan.settings();
         let needed = settings.output_len()?;
         if out_len < needed {
@@ -243,33 +295,20 @@ pub unsafe extern "C" fn mlt_render_merge(
             Some(unsafe { host_fields(stats_out, "stats_out") }?)
         };
 
-        let decode = |i: usize| {
-            PartialRender::from_bytes(buffers[i]).map_err(|e| about(&format!("partials[{i}]"), e))
-        };
-        let first = decode(0)?;
-        // `merge` writes the image once every job is in. Given no more partial results than
-        // jobs, it cannot be complete before the last one, so a partial result that fails to
-        // decode (which ends the partial results `merge` sees) always fails the merge too,
-        // before the image is written.
-        if first.plan_id() == plan.id() && partial_count > first.jobs() as usize {
-            return Err(Error::invalid(format!(
-                "partial_count is {partial_count} but the render was split into {} jobs: give each job's partial result once",
-                first.jobs()
-            )));
-        }
-        let mut undecodable = None;
-        let rest = (1..partial_count).map_while(|i| match decode(i) {
-            Ok(partial) => Some(partial),
-            Err(error) => {
-                undecodable = Some(error);
-                None
-            }
-        });
-        let merged = jobs::merge(&plan, std::iter::once(first).chain(rest), image);
-        if let Some(error) = undecodable {
-            return Err(error);
-        }
-        let stats = merged?;
+        // Merged into an image of mlt's, copied out on success: a partial result that fails
+        // to decode after the others held every job must leave `rgb_out` unwritten.
+        let mut merged = Vec::new();
+        merged.try_reserve_exact(needed).map_err(|_| {
+            Error::new(
+                MLT_STATUS_OUT_OF_MEMORY,
+                format!("no memory for the merged image ({needed} floats)"),
+            )
+        })?;
+        merged.resize(needed, 0.0f32);
+        let stats = decode_each(&plan, &buffers, |partials| {
+            jobs::merge(&plan, partials, &mut merged)
+        })?;
+        image.copy_from_slice(&merged);
         if let Some(fields) = stats_fields {
             // SAFETY: checked by host_fields above; writable by the contract.
             unsafe { write_host(stats_out, fields, &stats_to_c(&stats)) };
@@ -294,7 +333,46 @@ pub unsafe extern "C" fn mlt_render_merge(
     })
 }
 
-/// Frees bytes mlt gave (`mlt_render_plan`, `mlt_render_job`) and sets `data` to NULL and
+/// Adds partial results of the plan in `plan` (`plan_size` bytes) that hold disjoint sets of
+/// jobs (`partials[i]`, `partial_sizes[i]` bytes each, as `mlt_render_job` or an earlier
+/// `mlt_render_combine` gave them; any number from 1, in any order) into one partial result
+/// that holds all their jobs, for `mlt_render_merge` or a further combine. Merging it gives
+/// the bits merging its parts would: a cluster can add N jobs' results in a tree, each node
+/// reading a few, instead of one node reading all N.
+///
+/// On success `*combined_out` receives the combined partial result, to release with
+/// `mlt_bytes_release` (it is written without being read: release what it held first). A
+/// partial result that is corrupted, cut short, from another plan or split, or a job held
+/// twice, is `MLT_STATUS_INVALID_ARGUMENT` naming it, and nothing is written.
+///
+/// # Safety
+/// If non-null, `plan` must point to `plan_size` readable bytes; `partials` and
+/// `partial_sizes` to `partial_count` elements, each `partials[i]` to `partial_sizes[i]`
+/// readable bytes; `combined_out` must be writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn mlt_render_combine(
+    plan: *const u8,
+    plan_size: usize,
+    partials: *const *const u8,
+    partial_sizes: *const usize,
+    partial_count: usize,
+    combined_out: *mut MltBytes,
+) -> MltStatus {
+    guard(|| {
+        // SAFETY: forwarded contract for every pointer below.
+        let plan = unsafe { read_plan(plan, plan_size) }?;
+        let buffers =
+            unsafe { host_partials(partials, partial_sizes, partial_count, "the combine") }?;
+        check_pointer(combined_out, "combined_out")?;
+        let combined = decode_each(&plan, &buffers, |partials| jobs::combine(&plan, partials))?;
+        let bytes = buffers::give(combined.to_bytes());
+        // SAFETY: `combined_out` checked non-null and aligned above; writable by the contract.
+        unsafe { combined_out.write(bytes) };
+        Ok(MLT_STATUS_OK)
+    })
+}
+
+/// Frees bytes mlt gave (`mlt_render_plan`, `mlt_render_job`, `mlt_render_combine`) and sets `data` to NULL and
 /// `size` to 0, so releasing twice is harmless. NULL, and an `MltBytes` whose `data` is
 /// NULL, are no-ops. Bytes mlt did not give, or released already through a copy of the
 /// `MltBytes`, are looked up, not freed: ignored, and `mlt_last_error_message` says so.

@@ -5,6 +5,8 @@
 //! 2. [`render_job`] renders job k of N of a plan on any machine holding the same scene and
 //!    returns a [`PartialRender`]: its film's exact sums and its counters, also as bytes.
 //! 3. [`merge`] adds the partial results of all N jobs, in any order, and writes the image.
+//!    Between the two, [`combine`] may add any disjoint set of partial results into one, so
+//!    a cluster can merge in a tree (each node adds a few) instead of one node adding all N.
 //!
 //! Why the merge is exact: a render's work is cut into units fixed by its settings alone
 //! (for the camera-sample algorithms, each pass over each band of rows), job k does the units
@@ -127,11 +129,13 @@ impl RenderPlan {
     }
 }
 
-/// What one job rendered: its film's exact sums and its counters.
+/// What one job rendered (or, after [`combine`], several): its film's exact sums and its
+/// counters.
 #[derive(Clone)]
 pub struct PartialRender {
     plan: u64,
-    job: u32,
+    /// The jobs whose work it holds, ascending: one for [`render_job`]'s result.
+    held: Vec<u32>,
     jobs: u32,
     film: Film,
     stats: RenderStats,
@@ -140,9 +144,22 @@ pub struct PartialRender {
 }
 
 impl PartialRender {
-    /// This is job `job()` of `jobs()`.
+    /// This is job `job()` of `jobs()`; for a combination of jobs, the first it holds.
     pub fn job(&self) -> u32 {
-        self.job
+        self.held[0]
+    }
+
+    /// The jobs whose work it holds, ascending: `[job()]` for one job's result.
+    pub fn held_jobs(&self) -> &[u32] {
+        &self.held
+    }
+
+    /// "job 3 of 8", or "jobs [2, 5] of 8" for a combination: for messages.
+    pub fn name(&self) -> String {
+        match self.held.as_slice() {
+            [job] => format!("job {job} of {}", self.jobs),
+            held => format!("jobs {held:?} of {}", self.jobs),
+        }
     }
 
     pub fn jobs(&self) -> u32 {
@@ -162,8 +179,11 @@ impl PartialRender {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut w = Writer::default();
         w.u64(self.plan);
-        w.u32(self.job);
         w.u32(self.jobs);
+        w.len(self.held.len());
+        for &job in &self.held {
+            w.u32(job);
+        }
         write_stats(&mut w, &self.stats);
         write_film(&self.film, &mut w);
         write_tally(&mut w, self.tally.as_ref());
@@ -173,21 +193,29 @@ impl PartialRender {
     pub fn from_bytes(bytes: &[u8]) -> Result<PartialRender> {
         let mut r = Reader::open(bytes, PARTIAL_MAGIC, "partial render")?;
         let plan = r.u64()?;
-        let job = r.u32()?;
         let jobs = r.u32()?;
+        let held = (0..r.len(4)?)
+            .map(|_| r.u32())
+            .collect::<Result<Vec<u32>>>()?;
         let stats = read_stats(&mut r)?;
         let film = read_film(&mut r)?;
         let tally = read_tally(&mut r)?;
         r.end()?;
-        if jobs == 0 || jobs > MLT_MAX_JOBS || job >= jobs {
+        let ascending = held.windows(2).all(|pair| pair[0] < pair[1]);
+        if jobs == 0
+            || jobs > MLT_MAX_JOBS
+            || held.is_empty()
+            || !ascending
+            || held.last().is_some_and(|&last| last >= jobs)
+        {
             return Err(Error::new(
                 MLT_STATUS_INVALID_ARGUMENT,
-                format!("the partial render claims to be job {job} of {jobs}"),
+                format!("the partial render claims to hold jobs {held:?} of {jobs}"),
             ));
         }
         Ok(PartialRender {
             plan,
-            job,
+            held,
             jobs,
             film,
             stats,
@@ -242,7 +270,7 @@ pub fn render_job(
     )?;
     Ok(PartialRender {
         plan: plan.id,
-        job,
+        held: vec![job],
         jobs,
         film,
         stats,
@@ -250,10 +278,11 @@ pub fn render_job(
     })
 }
 
-/// Merges the partial results of every job of `plan`, given in any order, and writes the
-/// image into `rgb_out` (width × height × 3 floats) as `render` would. The stats add the
-/// jobs' counts; `seconds` is the sum of the jobs' times, `threads` the most any job used,
-/// `stop` the first of Cancelled, TimeLimitReached, Completed that some job reports.
+/// Merges the partial results of every job of `plan`, given in any order (each one job's or
+/// a [`combine`]d set), and writes the image into `rgb_out` (width × height × 3 floats) as
+/// `render` would. The stats add the jobs' counts; `seconds` is the sum of the jobs' times,
+/// `threads` the most any job used, `stop` the first of Cancelled, TimeLimitReached,
+/// Completed that some job reports.
 pub fn merge(
     plan: &RenderPlan,
     partials: impl IntoIterator<Item = PartialRender>,
@@ -268,70 +297,17 @@ pub fn merge(
             plan.settings.height
         )));
     }
-    let mut merged: Option<(Film, RenderStats, Option<ChainTally>)> = None;
-    let mut seen: Vec<bool> = Vec::new();
-    for partial in partials {
-        if partial.plan != plan.id {
-            return Err(Error::invalid(format!(
-                "job {} of {} belongs to another plan (id {:016x}, not {:016x})",
-                partial.job, partial.jobs, partial.plan, plan.id
-            )));
-        }
-        if (partial.film.width, partial.film.height) != (plan.settings.width, plan.settings.height)
-        {
-            return Err(Error::invalid(format!(
-                "job {}'s image is {} x {}, the plan's {} x {}",
-                partial.job,
-                partial.film.width,
-                partial.film.height,
-                plan.settings.width,
-                plan.settings.height
-            )));
-        }
-        if seen.is_empty() {
-            seen = vec![false; partial.jobs as usize];
-        }
-        if partial.jobs as usize != seen.len() {
-            return Err(Error::invalid(format!(
-                "job {} was one of {} jobs, another one of {}: a render is split one way",
-                partial.job,
-                partial.jobs,
-                seen.len()
-            )));
-        }
-        if std::mem::replace(&mut seen[partial.job as usize], true) {
-            return Err(Error::invalid(format!(
-                "job {} of {} is given twice",
-                partial.job, partial.jobs
-            )));
-        }
-        match &mut merged {
-            None => merged = Some((partial.film, partial.stats, partial.tally)),
-            Some((film, stats, tally)) => {
-                let misfit = |why: String| {
-                    Error::invalid(format!(
-                        "job {} does not fit the others: {why}",
-                        partial.job
-                    ))
-                };
-                film.merge(&partial.film).map_err(misfit)?;
-                match (tally.as_mut(), partial.tally) {
-                    (None, None) => {}
-                    (Some(tally), Some(other)) => tally.merge(other).map_err(misfit)?,
-                    _ => return Err(misfit("one has Metropolis chains, the other not".into())),
-                }
-                add_stats(stats, &partial.stats);
-            }
-        }
-    }
-    let missing: Vec<usize> = (0..seen.len()).filter(|&j| !seen[j]).collect();
-    let Some((mut film, mut stats, tally)) = merged else {
-        return Err(Error::invalid("no partial render to merge"));
-    };
+    let Folded {
+        mut film,
+        mut stats,
+        tally,
+        jobs,
+        held,
+    } = fold(plan, partials)?;
+    let missing: Vec<usize> = (0..held.len()).filter(|&j| !held[j]).collect();
     if !missing.is_empty() {
         return Err(Error::invalid(format!(
-            "jobs {missing:?} of {} are missing: the image needs every job",
-            seen.len()
+            "jobs {missing:?} of {jobs} are missing: the image needs every job"
         )));
     }
     if let Some(tally) = tally {
@@ -349,6 +325,107 @@ pub fn merge(
     stats.rays += plan.chain_start.as_ref().map_or(0, |start| start.rays);
     stats.filter = film.write_rgb(&mut rgb_out[..needed], None);
     Ok(stats)
+}
+
+/// Adds partial results of `plan` that hold disjoint sets of jobs (any number, in any order)
+/// into one partial result holding all their jobs, for [`merge`] or a further `combine`.
+/// Merging the combination gives the bits merging its parts would: a cluster can add its N
+/// results in a tree, each node reading a few, instead of one node reading all N.
+pub fn combine(
+    plan: &RenderPlan,
+    partials: impl IntoIterator<Item = PartialRender>,
+) -> Result<PartialRender> {
+    let Folded {
+        film,
+        stats,
+        tally,
+        jobs,
+        held,
+    } = fold(plan, partials)?;
+    Ok(PartialRender {
+        plan: plan.id,
+        held: (0..jobs).filter(|&j| held[j as usize]).collect(),
+        jobs,
+        film,
+        stats,
+        tally,
+    })
+}
+
+/// The sum of some partial results of one plan, and which jobs it holds.
+struct Folded {
+    film: Film,
+    stats: RenderStats,
+    tally: Option<ChainTally>,
+    jobs: u32,
+    held: Vec<bool>,
+}
+
+/// Adds partial results of `plan`, checking that each belongs to it, fits the others, and
+/// holds no job another holds.
+fn fold(plan: &RenderPlan, partials: impl IntoIterator<Item = PartialRender>) -> Result<Folded> {
+    let mut folded: Option<Folded> = None;
+    for partial in partials {
+        if partial.plan != plan.id {
+            return Err(Error::invalid(format!(
+                "{} belongs to another plan (id {:016x}, not {:016x})",
+                partial.name(),
+                partial.plan,
+                plan.id
+            )));
+        }
+        if (partial.film.width, partial.film.height) != (plan.settings.width, plan.settings.height)
+        {
+            return Err(Error::invalid(format!(
+                "{}: the image is {} x {}, the plan's {} x {}",
+                partial.name(),
+                partial.film.width,
+                partial.film.height,
+                plan.settings.width,
+                plan.settings.height
+            )));
+        }
+        let Some(sum) = folded.as_mut() else {
+            let mut held = vec![false; partial.jobs as usize];
+            for &job in &partial.held {
+                held[job as usize] = true;
+            }
+            folded = Some(Folded {
+                film: partial.film,
+                stats: partial.stats,
+                tally: partial.tally,
+                jobs: partial.jobs,
+                held,
+            });
+            continue;
+        };
+        if partial.jobs != sum.jobs {
+            return Err(Error::invalid(format!(
+                "{} was split from {} jobs, another from {}: a render is split one way",
+                partial.name(),
+                partial.jobs,
+                sum.jobs
+            )));
+        }
+        for &job in &partial.held {
+            if std::mem::replace(&mut sum.held[job as usize], true) {
+                return Err(Error::invalid(format!(
+                    "job {job} of {} is given twice",
+                    partial.jobs
+                )));
+            }
+        }
+        let name = partial.name();
+        let misfit = |why: String| Error::invalid(format!("{name} does not fit the others: {why}"));
+        sum.film.merge(&partial.film).map_err(misfit)?;
+        match (sum.tally.as_mut(), partial.tally) {
+            (None, None) => {}
+            (Some(tally), Some(other)) => tally.merge(other).map_err(misfit)?,
+            _ => return Err(misfit("one has Metropolis chains, the other not".into())),
+        }
+        add_stats(&mut sum.stats, &partial.stats);
+    }
+    folded.ok_or_else(|| Error::invalid("no partial render to merge"))
 }
 
 fn add_stats(total: &mut RenderStats, job: &RenderStats) {
