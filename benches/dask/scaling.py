@@ -7,7 +7,7 @@ combine, the merge) measured one by one; then an estimate, from those per-pixel 
 costs, of a 4K frame on 64 machines, merged by one machine or through a tree.
 
     pip install ./python "dask[distributed]"
-    python3 benches/dask/scaling.py            # about 3 minutes on 2 cores
+    python3 benches/dask/scaling.py            # about 2½ minutes on 2 cores
 
 Environment: MLT_SCALING_SIZE (default 384: the frame is SIZE x SIZE), MLT_SCALING_REPEATS
 (default 3; medians are printed), MLT_SCALING_ALGORITHMS (default "path,mmlt").
@@ -158,7 +158,7 @@ def main() -> None:
                 f" {work / CORES:.0f} s on one machine; per job {job:.1f} s, each partial result"
                 f" {bytes_per_pixel * k4 / 1e6:.0f} MB ({transfer_bytes / 1e9:.1f} GB to the merging machine),"
                 f" to/from bytes {codec:.1f} s, merge {merge:.1f} s: about {total:.0f} s,"
-                f" {work / CORES / total:.0f}x one machine"
+                f" {work / CORES / total:.1f}x one machine"
             )
             # Through a tree of fan-in 8: 8 combines of 8 in parallel, then one merge of 8.
             fan_in = 8
@@ -167,7 +167,7 @@ def main() -> None:
             print(
                 f"merged through a tree of fan-in {fan_in} (8 combines of 8 partial results on 8 machines at once,"
                 f" then one merge of 8): merge {tree_merge:.1f} s, {fan_in * bytes_per_pixel * k4 / 1e9:.1f} GB"
-                f" into each merging machine: about {tree_total:.0f} s, {work / CORES / tree_total:.0f}x one machine\n"
+                f" into each merging machine: about {tree_total:.0f} s, {work / CORES / tree_total:.1f}x one machine\n"
             )
 
 
