@@ -169,6 +169,20 @@ fn settings(algorithm: i32) -> MltRenderSettings {
     }
 }
 
+/// A 12 × 10 render of `algorithm` with few samples, mutations and chains: every algorithm
+/// splits in well under a second.
+fn small_settings(algorithm: i32) -> MltRenderSettings {
+    MltRenderSettings {
+        width: 12,
+        height: 10,
+        samples_per_pixel: 2,
+        mutations_per_pixel: 2,
+        bootstrap_samples: 4096,
+        chains: 16,
+        ..settings(algorithm)
+    }
+}
+
 fn image_len(settings: &MltRenderSettings) -> usize {
     settings.width as usize * settings.height as usize * 3
 }
@@ -454,15 +468,7 @@ fn every_algorithm_splits_exactly() {
         MLT_ALGORITHM_PATH_SPACE_MLT,
         MLT_ALGORITHM_ERPT,
     ] {
-        let settings = MltRenderSettings {
-            width: 12,
-            height: 10,
-            samples_per_pixel: 2,
-            mutations_per_pixel: 2,
-            bootstrap_samples: 4096,
-            chains: 16,
-            ..settings(algorithm)
-        };
+        let settings = small_settings(algorithm);
         let plan = plan(&scene, &camera, &settings);
         let ((status, message), partial, _) = job(&scene, &plan, 0, 2, 1);
         assert_outcome((status, message), MLT_STATUS_OK, &[]);
@@ -486,15 +492,7 @@ fn every_algorithm_splits_exactly() {
 fn combined_partial_results_merge_exactly() {
     let (scene, camera) = cornell();
     for algorithm in [MLT_ALGORITHM_PATH, MLT_ALGORITHM_MMLT] {
-        let settings = MltRenderSettings {
-            width: 12,
-            height: 10,
-            samples_per_pixel: 2,
-            mutations_per_pixel: 2,
-            bootstrap_samples: 4096,
-            chains: 16,
-            ..settings(algorithm)
-        };
+        let settings = small_settings(algorithm);
         let plan = plan(&scene, &camera, &settings);
         let five: Vec<Vec<u8>> = (0..5).map(|k| job_ok(&scene, &plan, k, 5)).collect();
         let pair = combine_ok(&plan, &[&five[3], &five[0]]);
