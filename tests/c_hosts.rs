@@ -806,6 +806,10 @@ fn hosts_are_clean_under_valgrind_memcheck() {
                 "--show-leak-kinds=definite,indirect,possible",
                 "--errors-for-leak-kinds=definite,indirect,possible",
                 "--error-exitcode=99",
+                // Valgrind runs one thread at a time; with its default unfair lock the
+                // render's workers can starve the host thread that polls progress (a cancel
+                // after 3 progress calls took over 30 s on a 2-core machine).
+                "--fair-sched=yes",
             ])
             .arg(format!("--suppressions={}", suppressions.display()))
             .arg(&exe)
