@@ -118,14 +118,15 @@ fn cornell_glass_in_sample_space_agrees_with_the_path_tracer() {
 }
 
 /// The door-ajar scene (tests/common/door_ajar.rs), lit only through the crack of a door,
-/// against BDPT (`tests/bdpt.rs` checks BDPT against the path tracer there).
+/// against BDPT's cached estimate (tests/common/door_ajar_reference.rs; `tests/bdpt.rs`
+/// checks BDPT against the path tracer there).
 #[test]
 fn door_ajar_agrees_with_bdpt() {
     let (scene, camera) = load_canonical("door-ajar");
-    let reference = bdpt_reference("door-ajar", 64);
+    let reference = &door_ajar_reference::BDPT;
     let test = erpt_estimate(&scene, &camera, DOOR_AJAR_SAMPLES, false);
     let (tm, tv) = test.mean();
-    let (rm, rv) = reference.mean();
+    let (rm, rv) = reference.image_mean();
     for c in 0..3 {
         let se = (tv[c] + rv[c]).sqrt();
         eprintln!(

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod door_ajar;
+pub mod door_ajar_reference;
 pub mod generate;
 pub mod lamp_behind_glass;
 pub mod obj_text;
@@ -318,6 +319,82 @@ impl Estimate {
     }
 }
 
+/// An image estimate as `assert_estimates_agree` compares it: the image mean and the means
+/// of the cells of a grid, each with its variance.
+pub trait RegionEstimate {
+    /// Pixels, for estimates made of them (`None`: resolution-free, a cached reference).
+    fn pixels(&self) -> Option<(usize, usize)>;
+    fn image_mean(&self) -> ([f64; 3], [f64; 3]);
+    /// Cell (gx, gy) of a `grid` × `grid` partition.
+    fn cell(&self, grid: usize, gx: usize, gy: usize) -> ([f64; 3], [f64; 3]);
+}
+
+impl RegionEstimate for Estimate {
+    fn pixels(&self) -> Option<(usize, usize)> {
+        Some((self.width, self.height))
+    }
+
+    fn image_mean(&self) -> ([f64; 3], [f64; 3]) {
+        self.mean()
+    }
+
+    fn cell(&self, grid: usize, gx: usize, gy: usize) -> ([f64; 3], [f64; 3]) {
+        let (w, h) = (self.width, self.height);
+        self.region(
+            gx * w / grid,
+            gy * h / grid,
+            (gx + 1) * w / grid,
+            (gy + 1) * h / grid,
+        )
+    }
+}
+
+/// A converged reference kept as numbers (committed constants, made by a test that
+/// regenerates them): the image mean and the cells of a `GRID` × `GRID` partition, each with
+/// the variance of its estimate. With a box filter each is an integral over the film, the
+/// same at any resolution whose size the grid divides.
+pub struct CachedEstimate<const GRID: usize> {
+    pub mean: [f64; 3],
+    pub mean_variance: [f64; 3],
+    /// Row by row.
+    pub cells: [[[f64; 3]; GRID]; GRID],
+    pub cell_variances: [[[f64; 3]; GRID]; GRID],
+}
+
+impl<const GRID: usize> CachedEstimate<GRID> {
+    /// The numbers of `estimate` (whose size `GRID` must divide).
+    pub fn of(estimate: &Estimate) -> Self {
+        assert!(estimate.width % GRID == 0 && estimate.height % GRID == 0);
+        let cells: [[([f64; 3], [f64; 3]); GRID]; GRID] =
+            std::array::from_fn(|gy| std::array::from_fn(|gx| estimate.cell(GRID, gx, gy)));
+        let (mean, mean_variance) = estimate.mean();
+        CachedEstimate {
+            mean,
+            mean_variance,
+            cells: cells.map(|row| row.map(|cell| cell.0)),
+            cell_variances: cells.map(|row| row.map(|cell| cell.1)),
+        }
+    }
+}
+
+impl<const GRID: usize> RegionEstimate for CachedEstimate<GRID> {
+    fn pixels(&self) -> Option<(usize, usize)> {
+        None
+    }
+
+    fn image_mean(&self) -> ([f64; 3], [f64; 3]) {
+        (self.mean, self.mean_variance)
+    }
+
+    fn cell(&self, grid: usize, gx: usize, gy: usize) -> ([f64; 3], [f64; 3]) {
+        assert_eq!(
+            grid, GRID,
+            "the cached reference has a {GRID} × {GRID} grid"
+        );
+        (self.cells[gy][gx], self.cell_variances[gy][gx])
+    }
+}
+
 /// A `size` × `size` path-traced image (max depth 5) with `spp` samples per pixel.
 pub fn path_traced_image(
     scene: &Scene,
@@ -411,14 +488,6 @@ pub fn bdpt_estimate(scene: &Scene, camera: &Camera, samples_per_pixel: u32) -> 
     Estimate::from_correlated_renders(64, 64, &renders)
 }
 
-/// [`bdpt_estimate`] of a canonical scene, once per test binary.
-pub fn bdpt_reference(scene_name: &str, samples_per_pixel: u32) -> &'static Estimate {
-    cached_estimate(&format!("bdpt {scene_name} {samples_per_pixel}"), || {
-        let (scene, camera) = load_canonical(scene_name);
-        bdpt_estimate(&scene, &camera, samples_per_pixel)
-    })
-}
-
 /// Asserts that two independent estimates of the same image agree: the image mean within
 /// `sigmas` combined standard errors and the mean of every cell of a `grid` × `grid`
 /// partition within `region_sigmas`. Also asserts the comparison is sharp: a 2% brightness
@@ -431,18 +500,17 @@ pub fn bdpt_reference(scene_name: &str, samples_per_pixel: u32) -> &'static Esti
 /// and Student's t tails; with 16 renders, |t| > 6 has probability 2·10⁻⁵ per comparison.
 pub fn assert_estimates_agree(
     label: &str,
-    test: &Estimate,
-    reference: &Estimate,
+    test: &dyn RegionEstimate,
+    reference: &dyn RegionEstimate,
     grid: usize,
     sigmas: f64,
     region_sigmas: f64,
 ) {
-    assert_eq!(
-        (test.width, test.height),
-        (reference.width, reference.height)
-    );
-    let (tm, tv) = test.mean();
-    let (rm, rv) = reference.mean();
+    if let (Some(a), Some(b)) = (test.pixels(), reference.pixels()) {
+        assert_eq!(a, b);
+    }
+    let (tm, tv) = test.image_mean();
+    let (rm, rv) = reference.image_mean();
     for c in 0..3 {
         let sigma = (tv[c] + rv[c]).sqrt();
         // For tuning a test's cost (shown with --nocapture): a 2% error fails only while
@@ -467,13 +535,22 @@ pub fn assert_estimates_agree(
             sigmas,
         );
     }
-    let (w, h) = (test.width, test.height);
+    assert_regions_agree(label, test, reference, grid, region_sigmas);
+}
+
+/// The region part of `assert_estimates_agree`: every cell of a `grid` × `grid` partition
+/// within `region_sigmas` combined standard errors.
+pub fn assert_regions_agree(
+    label: &str,
+    test: &dyn RegionEstimate,
+    reference: &dyn RegionEstimate,
+    grid: usize,
+    region_sigmas: f64,
+) {
     for gy in 0..grid {
         for gx in 0..grid {
-            let (x0, x1) = (gx * w / grid, (gx + 1) * w / grid);
-            let (y0, y1) = (gy * h / grid, (gy + 1) * h / grid);
-            let (tm, tv) = test.region(x0, y0, x1, y1);
-            let (rm, rv) = reference.region(x0, y0, x1, y1);
+            let (tm, tv) = test.cell(grid, gx, gy);
+            let (rm, rv) = reference.cell(grid, gx, gy);
             for c in 0..3 {
                 let tolerance = region_sigmas * (tv[c] + rv[c]).sqrt();
                 assert!(
