@@ -364,7 +364,7 @@ pub struct CachedEstimate<const GRID: usize> {
 impl<const GRID: usize> CachedEstimate<GRID> {
     /// The numbers of `estimate` (whose size `GRID` must divide).
     pub fn of(estimate: &Estimate) -> Self {
-        assert!(estimate.width % GRID == 0 && estimate.height % GRID == 0);
+        assert!(estimate.width.is_multiple_of(GRID) && estimate.height.is_multiple_of(GRID));
         let cells: [[([f64; 3], [f64; 3]); GRID]; GRID] =
             std::array::from_fn(|gy| std::array::from_fn(|gx| estimate.cell(GRID, gx, gy)));
         let (mean, mean_variance) = estimate.mean();
