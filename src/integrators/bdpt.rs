@@ -25,7 +25,7 @@ use super::{PathVertex, PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
-use crate::sampling::{Rng, Sampler};
+use crate::sampling::{PixelSampler, Sampler};
 use crate::scene::lights::{Emitter, LightSample};
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
@@ -1005,7 +1005,7 @@ impl PixelEstimator for Bdpt<'_> {
         camera_model: &CameraModel,
         x: f32,
         y: f32,
-        rng: &mut Rng,
+        sampler: &mut PixelSampler,
         counters: &mut SampleCounters,
         scratch: &mut BdptScratch,
         splats: &mut Vec<Splat>,
@@ -1015,7 +1015,7 @@ impl PixelEstimator for Bdpt<'_> {
             camera_model,
             x,
             y,
-            rng,
+            sampler,
             scratch,
             counters,
             |_, _, c| match c.splat_pixel {
@@ -1032,6 +1032,7 @@ mod tests {
     use super::*;
     use crate::accel::Backend;
     use crate::integrators::path::PathTracer;
+    use crate::sampling::Rng;
     use crate::scene::{Camera, Material, SceneDesc};
 
     /// A floor whose shading normals tilt 30–45° towards the camera, a

@@ -6,7 +6,7 @@
 //! on how the work is cut into bands and passes.
 
 use crate::control::Control;
-use crate::sampling::{Rng, shifted_sobol_2d};
+use crate::sampling::PixelSampler;
 use std::ops::Range;
 
 /// Passes of camera samples: the first takes one sample per pixel and always runs to its
@@ -60,26 +60,24 @@ impl PassSchedule {
     }
 }
 
-/// Where a pixel's camera samples go: spread over the pixel as a (0, 2)-sequence shifted
-/// per pixel, each with its own random stream.
+/// Where a pixel's camera samples go and the numbers they read: a low-discrepancy sampler
+/// per sample (`PixelSampler`), its film position from a slot of its own.
 #[derive(Clone, Copy)]
 pub(crate) struct PixelSamples {
+    /// The render's seed with a salt of the caller's (apart from other uses of the seed).
     pub seed: u64,
-    /// Stream offset of the per-pixel shifts (apart from the per-sample streams, which
-    /// hash the sample index into the seed).
-    pub shift_stream: u64,
     /// Image width, for pixel indices.
     pub width: u32,
 }
 
 /// One camera sample: its index within its pixel, the pixel's index, the film position in
-/// pixels, and its random numbers.
+/// pixels, and its numbers.
 pub(crate) struct CameraSample {
     pub index: u32,
     pub pixel: u64,
     pub x: f32,
     pub y: f32,
-    pub rng: Rng,
+    pub sampler: PixelSampler,
 }
 
 impl PixelSamples {
@@ -92,17 +90,16 @@ impl PixelSamples {
         indices: Range<u32>,
     ) -> impl Iterator<Item = CameraSample> + use<> {
         let pixel = y as u64 * self.width as u64 + x as u64;
-        let mut shift = Rng::new(self.seed, self.shift_stream + pixel);
-        let shift = [shift.next_u32(), shift.next_u32()];
         let seed = self.seed;
         indices.map(move |index| {
-            let [jx, jy] = shifted_sobol_2d(index, shift);
+            let sampler = PixelSampler::new(seed, pixel, index);
+            let [jx, jy] = sampler.film_position();
             CameraSample {
                 index,
                 pixel,
                 x: x as f32 + jx,
                 y: y as f32 + jy,
-                rng: Rng::for_pixel_sample(seed, pixel, index as u64),
+                sampler,
             }
         })
     }

@@ -8,7 +8,7 @@ pub mod path;
 use crate::accel::Ray;
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
-use crate::sampling::Rng;
+use crate::sampling::PixelSampler;
 use crate::scene::lights::Emitter;
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
@@ -130,7 +130,7 @@ pub trait PixelEstimator: Sync {
         camera: &CameraModel,
         x: f32,
         y: f32,
-        rng: &mut Rng,
+        sampler: &mut PixelSampler,
         counters: &mut SampleCounters,
         scratch: &mut Self::Scratch,
         splats: &mut Vec<Splat>,

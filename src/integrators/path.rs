@@ -7,7 +7,7 @@ use super::{PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
-use crate::sampling::{Rng, Sampler, power_heuristic};
+use crate::sampling::{PixelSampler, Sampler, power_heuristic};
 use crate::scene::lights::LightSample;
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
@@ -99,7 +99,10 @@ impl PathTracer<'_> {
             // Every vertex reads the same coordinates (light sample, BSDF sample, roulette)
             // whether or not it uses them, so a Metropolis chain's small step that changes a
             // vertex from specular to diffuse leaves the later vertices' numbers in place.
-            let u_light = [rng.uniform(), rng.uniform(), rng.uniform()];
+            // The light's choice one number, its point a pair (a 2D low-discrepancy slot).
+            let u_select = rng.uniform();
+            let [u_point_x, u_point_y] = rng.uniform2();
+            let u_light = [u_select, u_point_x, u_point_y];
             let u_bsdf = rng.uniform2();
             let u_lobe = rng.uniform();
             let u_roulette = rng.uniform();
@@ -250,13 +253,13 @@ impl PixelEstimator for PathTracer<'_> {
         camera: &CameraModel,
         x: f32,
         y: f32,
-        rng: &mut Rng,
+        sampler: &mut PixelSampler,
         counters: &mut SampleCounters,
         _scratch: &mut (),
         _splats: &mut Vec<Splat>,
     ) -> Spectrum {
-        let lens = rng.uniform2();
+        let lens = sampler.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
-        self.radiance(origin, direction, rng, &mut counters.rays)
+        self.radiance(origin, direction, sampler, &mut counters.rays)
     }
 }

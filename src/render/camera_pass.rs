@@ -13,8 +13,8 @@ use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 
-/// Stream offset of the per-pixel shifts of the camera samples' positions.
-const PIXEL_SHIFT_STREAM: u64 = 0x5eed_0f15_0000_0000;
+/// Salts the seed of the camera samples' numbers, apart from other uses of the seed.
+const CAMERA_SAMPLE_SALT: u64 = 0x5eed_0f15_0000_0000;
 
 /// Rows per unit of parallel work.
 const BAND_ROWS: u32 = 4;
@@ -84,8 +84,7 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
             estimator,
             camera: *camera,
             samples: PixelSamples {
-                seed,
-                shift_stream: PIXEL_SHIFT_STREAM,
+                seed: seed ^ CAMERA_SAMPLE_SALT,
                 width,
             },
             schedule,
@@ -139,7 +138,7 @@ impl<'a, E: PixelEstimator> CameraSampleJob<'a, E> {
                                 &self.camera,
                                 sample.x,
                                 sample.y,
-                                &mut sample.rng,
+                                &mut sample.sampler,
                                 &mut counters,
                                 &mut state.scratch,
                                 &mut state.splats,

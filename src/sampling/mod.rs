@@ -13,7 +13,7 @@ pub use distribution::{Distribution1D, Distribution2D};
 pub use normal::standard_normal;
 pub use rng::Rng;
 pub use sampler::Sampler;
-pub use sobol::shifted_sobol_2d;
+pub use sobol::PixelSampler;
 pub use warp::{
     OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf, power_heuristic, uniform_disk,
     uniform_triangle,

@@ -12,7 +12,7 @@ const PCG_MULTIPLIER: u64 = 6_364_136_223_846_793_005;
 
 /// SplitMix64 finalizer: a bijective 64-bit mix with good avalanche.
 #[inline]
-fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)

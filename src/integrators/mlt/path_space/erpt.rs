@@ -52,21 +52,20 @@ use super::perturbation::{self, PerturbationSizes, RandomKernel};
 use super::{PathSpace, PathVertex};
 use crate::control::Control;
 use crate::film::Film;
-use crate::integrators::bdpt::{Bdpt, BdptScratch};
+use crate::integrators::bdpt::{Bdpt, BdptScratch, CONNECTION_STREAM};
 use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
 use crate::integrators::mlt::primary_space::PathSample;
 use crate::integrators::{PixelEstimator, SampleCounters};
-use crate::sampling::Rng;
+use crate::sampling::{PixelSampler, Rng, Sampler};
 use crate::scene::CameraModel;
 use crate::spectrum::Spectrum;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicI64, Ordering};
 
-/// Stream offsets: the per-pixel shifts of the camera samples, and the pre-pass.
-const PIXEL_SHIFT_STREAM: u64 = 0x5eed_e397_0000_0000;
+/// Stream offset of the pre-pass.
 const PREPASS_STREAM: u64 = 0x5eed_e398_0000_0000;
 /// Mixed into the seed of the (pixel, sample) streams, so an ERPT render's camera samples
 /// are not BDPT's with the same seed.
@@ -291,14 +290,16 @@ impl Redistributor<'_> {
     }
 
     /// One camera sample through film position (x, y) and the chains of its strategies,
-    /// whose deposits also go to partial image `buffer`. Returns (mutations, accepted,
-    /// whether the sample was valid).
+    /// whose deposits also go to partial image `buffer`. The camera sample reads `sampler`,
+    /// the chains `rng` (a Markov chain's steps need independent numbers). Returns
+    /// (mutations, accepted, whether the sample was valid).
     #[allow(clippy::too_many_arguments)]
     fn sample(
         &self,
         x: f32,
         y: f32,
         buffer: usize,
+        sampler: &mut PixelSampler,
         rng: &mut Rng,
         scratch: &mut UnitScratch,
         counters: &mut SampleCounters,
@@ -313,7 +314,7 @@ impl Redistributor<'_> {
             y,
             max_depth + 2,
             max_depth + 1,
-            rng,
+            sampler,
             &mut scratch.bdpt,
             counters,
         );
@@ -329,7 +330,9 @@ impl Redistributor<'_> {
                 {
                     continue;
                 }
-                let Some(c) = bdpt.connect(camera, &mut scratch.bdpt, s, t, rng, counters) else {
+                sampler.start_stream(CONNECTION_STREAM);
+                let Some(c) = bdpt.connect(camera, &mut scratch.bdpt, s, t, sampler, counters)
+                else {
                     continue;
                 };
                 let Some(colour) = unit_colour(c.value) else {
@@ -478,11 +481,7 @@ pub(crate) fn run(
     // takes the BDPT samples and leaves their energy where it is (chains of length 0),
     // which bounds how long a stop takes by one pass of camera samples.
     let mut schedule = PassSchedule::new(settings.samples_per_pixel, pixels as u64, PASS_SAMPLES);
-    let samples = PixelSamples {
-        seed,
-        shift_stream: PIXEL_SHIFT_STREAM,
-        width,
-    };
+    let samples = PixelSamples { seed, width };
     let mut samples_taken = 0u64;
     while let Some(indices) = schedule.next_pass(u32::MAX, control) {
         units.par_iter_mut().enumerate().for_each(|(band, unit)| {
@@ -508,11 +507,14 @@ pub(crate) fn run(
                         } else {
                             0
                         };
+                        let mut chain_rng =
+                            Rng::for_pixel_sample(seed, sample.pixel, sample.index as u64);
                         let (m, a, valid) = redistributor.sample(
                             sample.x,
                             sample.y,
                             buffer,
-                            &mut sample.rng,
+                            &mut sample.sampler,
+                            &mut chain_rng,
                             unit,
                             &mut counters,
                             control,
