@@ -289,7 +289,8 @@ fn mean_and_error(values: &[f64]) -> (f64, f64) {
 
 /// Renders the prism with `algorithm` at `budget` samples or mutations per pixel, `renders`
 /// times (seeds differ), and checks every channel's total and centroid row against Snell's
-/// law within 6 standard errors (6 renders: 5 degrees of freedom; P(|t| > 6) ≈ 2·10⁻³). The blue centroid, which
+/// law within 6 standard errors (6 renders: 5 degrees of freedom, P(|t| > 6) ≈ 2·10⁻³; 12
+/// renders: P ≈ 10⁻⁴). The blue centroid, which
 /// moves most with the dispersion, must tell the prism from one of Abbe number 10% higher.
 /// With `sharp_brightness`, the luminance of the totals must also resolve a 2% error.
 fn check_algorithm(algorithm: Algorithm, budget: u32, renders: u64, sharp_brightness: bool) {
@@ -377,9 +378,12 @@ fn snell_spreads_the_spectrum_in_order() {
     );
 }
 
+// 12 renders, not 6: the path tracer's low-discrepancy samples make its centroid so
+// precise that the spread of 6 renders alone (5 degrees of freedom) too often understates its
+// standard error (seeds 40-45 put it at a quarter of the 24-render value).
 #[test]
 fn path_tracing_disperses_by_snells_law() {
-    check_algorithm(Algorithm::Path, 1024, 6, true);
+    check_algorithm(Algorithm::Path, 1024, 12, true);
 }
 
 #[test]

@@ -127,8 +127,8 @@ fn error_falls_at_least_like_one_over_square_root_of_samples() {
     let fine = rmse(&render_furnace(5, 64, 200, 32), &reference);
     // 16× the samples: independent samples' error would shrink by √16 = 4 (the spread of an
     // RMSE over 3072 values is a few percent, so 3.4 is generous); the camera samples'
-    // stratified (0, 2) points shrink it faster (6.5 here), at most by 16^1.5 = 64, the
-    // rate of Owen-scrambled points on a smooth integrand. A biased estimator, whose
+    // stratified (0, 2) points shrink it faster, at most by 16^1.5 = 64, the
+    // best rate of randomized QMC on a smooth integrand. A biased estimator, whose
     // error stops shrinking, fails the lower bound.
     let ratio = coarse / fine;
     assert!(

@@ -50,7 +50,7 @@ fn grey_furnace_is_exact_in_spectral_mode() {
     for algorithm in SPECTRAL_ALGORITHMS {
         // Independent renders: a Metropolis image's pixels are correlated, so the standard
         // error comes from the spread between renders.
-        let renders: Vec<Vec<f32>> = (0..6)
+        let renders: Vec<Vec<f32>> = (0..8)
             .map(|seed| {
                 render_image(
                     &scene,
@@ -67,7 +67,8 @@ fn grey_furnace_is_exact_in_spectral_mode() {
             0.02 / 9.0
         );
         for c in 0..3 {
-            // 6 renders: 5 degrees of freedom; P(|t| > 7) < 10⁻³.
+            // 8 renders: 7 degrees of freedom; P(|t| > 7) ≈ 2·10⁻⁴. (With 6, ERPT's blue
+            // channel sat at the power check's limit.)
             assert_within_and_sharp(
                 &format!("{algorithm:?} channel {c}"),
                 mean[c],

@@ -3,8 +3,8 @@
 the Cornell scenes at a few sample counts, each image's RMSE against a converged reference,
 and the time it took on one thread.
 
-mlt renders with its low-discrepancy camera samples (a padded, shuffled, Owen-scrambled
-(0, 2)-sequence per pixel: src/sampling/sobol.rs); Mitsuba 3 (`scalar_rgb`, its `path`
+mlt renders with its low-discrepancy camera samples (a padded, shuffled, digitally
+shifted (0, 2)-sequence per pixel: src/sampling/sobol.rs); Mitsuba 3 (`scalar_rgb`, its `path`
 integrator, the same triangles, camera, max depth and size, as spectral_compare.py builds
 them) with its `independent` sampler and with its low-discrepancy `ldsampler`. The
 reference is mlt's path tracer at REFERENCE_SPP samples per pixel (unbiased, so any

@@ -75,6 +75,7 @@ pub(super) fn sample(
             weight: color,
             pdf: fresnel,
             specular: true,
+            radiance_scale: 1.0,
         });
     }
     let eta = eta_i / eta_t;
@@ -126,6 +127,7 @@ fn refraction(
         weight: color * scale,
         pdf: 1.0 - fresnel,
         specular: true,
+        radiance_scale: scale,
     }
 }
 
@@ -152,6 +154,7 @@ pub(super) fn scatter(
             weight: color,
             pdf: fresnel,
             specular: true,
+            radiance_scale: 1.0,
         });
     }
     if fresnel >= 1.0 {

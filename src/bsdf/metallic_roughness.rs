@@ -628,11 +628,18 @@ impl MetallicRoughness {
             return None;
         }
         let f = self.eval_local(view, local, mode);
+        // `eval_local`'s radiance scaling on refraction, η_o² over the η_t² the microfacet
+        // term's denominator brings.
+        let radiance_scale = match mode {
+            TransportMode::Radiance if local.z < 0.0 => view.eta() * view.eta(),
+            _ => 1.0,
+        };
         Some(ScatterSample {
             wi,
             weight: f * (local.z.abs() / pdf),
             pdf,
             specular: false,
+            radiance_scale,
         })
     }
 
@@ -650,6 +657,7 @@ impl MetallicRoughness {
             weight: self.diffuse_f(view.wo.z, local.z) * (local.z / pdf),
             pdf,
             specular: false,
+            radiance_scale: 1.0,
         })
     }
 
@@ -660,6 +668,7 @@ impl MetallicRoughness {
             weight: self.reflectance(view.wo.z, view.eta()) / choice.reflection,
             pdf: choice.reflection,
             specular: true,
+            radiance_scale: 1.0,
         }
     }
 
@@ -682,6 +691,7 @@ impl MetallicRoughness {
             weight: self.transmission_tint() * (transmitted * scale / choice.transmission),
             pdf: choice.transmission,
             specular: true,
+            radiance_scale: scale,
         }
     }
 }

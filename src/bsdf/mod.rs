@@ -318,6 +318,7 @@ fn sample(
                 weight: albedo,
                 pdf: cosine_hemisphere_pdf(local.z),
                 specular: false,
+                radiance_scale: 1.0,
             })
         }
         BsdfModel::Mirror(reflectance) => Some(ScatterSample {
@@ -325,6 +326,7 @@ fn sample(
             weight: reflectance,
             pdf: 1.0,
             specular: true,
+            radiance_scale: 1.0,
         }),
         BsdfModel::Dielectric { ior, tint } => {
             dielectric::sample(ior, tint, normal, wo, u_lobe, mode)
@@ -388,12 +390,14 @@ fn scatter(
             weight: albedo,
             pdf: cosine_hemisphere_pdf(cos_i.abs()),
             specular: false,
+            radiance_scale: 1.0,
         }),
         BsdfModel::Mirror(reflectance) => same_side.then_some(ScatterSample {
             wi,
             weight: reflectance,
             pdf: 1.0,
             specular: true,
+            radiance_scale: 1.0,
         }),
         BsdfModel::Dielectric { ior, tint } => dielectric::scatter(ior, tint, normal, wo, wi, mode),
         BsdfModel::MetallicRoughness(m) => m.scatter(normal, wo, wi, mode),

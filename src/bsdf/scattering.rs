@@ -21,6 +21,10 @@ pub struct ScatterSample {
     pub pdf: f32,
     /// A Dirac lobe: no other strategy can generate this direction.
     pub specular: bool,
+    /// The factor `weight` holds for radiance crossing into another medium, (η_i/η_t)² at
+    /// a refraction in radiance mode, else 1. Russian roulette divides it out: a path in
+    /// glass carries less throughput without being any less important.
+    pub radiance_scale: f32,
 }
 
 /// Mirror reflection of `wo` about `normal` (either orientation).

@@ -49,6 +49,10 @@ impl PathTracer<'_> {
         // The previous vertex's scattering density, for MIS against light sampling.
         let mut previous_pdf = 0.0f32;
         let mut previous_specular = true;
+        // The product of the refractions' radiance scalings so far, which Russian roulette
+        // divides out of the throughput (as pbrt-v4 and Mitsuba do): a path inside glass
+        // carries (1/η)² the throughput with no less to contribute.
+        let mut radiance_scale = 1.0f32;
 
         // `depth` = scattering vertices before the surface this iteration hits.
         let mut depth = 0;
@@ -118,10 +122,12 @@ impl PathTracer<'_> {
             throughput *= sample.weight;
             previous_pdf = sample.pdf;
             previous_specular = sample.specular;
+            radiance_scale *= sample.radiance_scale;
             depth += 1;
 
             if depth >= ROULETTE_START_DEPTH {
-                let survival = throughput.max_component().min(ROULETTE_MAX_SURVIVAL);
+                let survival =
+                    (throughput.max_component() / radiance_scale).min(ROULETTE_MAX_SURVIVAL);
                 if u_roulette >= survival {
                     break;
                 }
