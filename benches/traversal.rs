@@ -47,6 +47,10 @@
 //!   `target/mlt-bench/traversal-SCENE.png`.
 //! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `mlt bvh4`, `raw obvhs`, `mlt embree`,
 //!   `raw embree` (default all that the build and CPU have), e.g. to profile one.
+//! - `MLT_BENCH_QUALITIES`: comma-separated build qualities besides the default `high`, of
+//!   `medium`, `fast` (default none): each adds the tracers `mlt bvh QUALITY` and `mlt
+//!   embree QUALITY` (built at that `BuildQuality`), their build rows and a `QUALITY
+//!   bvh/embree` ratio, e.g. `MLT_BENCH_QUALITIES=medium,fast` for the table of qualities.
 //! - `MLT_BENCH_OBVHS_BUILD`: the obvhs build preset of `raw obvhs` (`fastest`, `very_fast`,
 //!   `fast`, `medium`, `slow`, `very_slow`; default `medium`, mlt's), to see what a preset
 //!   would change; `slow` and `very_slow` split triangles, which mlt's BVH does not support.
@@ -68,7 +72,7 @@ use generate::{bounce_ray, bounds, random_ray};
 use glam::Vec3A;
 use mlt::accel::{Accel, BvhWidth, Filtering, Ray, with_bvh_width};
 use mlt::sampling::Rng;
-use mlt::{Backend, Camera};
+use mlt::{Backend, BuildQuality, Camera};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use rayon::prelude::*;
@@ -463,16 +467,46 @@ fn time_trace(
 // ---------------------------------------------------------------------------------------
 // Measurement and report
 
+/// The build qualities measured besides the default: `MLT_BENCH_QUALITIES`.
+fn extra_qualities() -> Vec<BuildQuality> {
+    env_names("MLT_BENCH_QUALITIES", &[])
+        .iter()
+        .map(|name| match name.as_str() {
+            "medium" => BuildQuality::Medium,
+            "fast" => BuildQuality::Fast,
+            other => panic!("MLT_BENCH_QUALITIES: unknown {other:?}; one of medium, fast"),
+        })
+        .collect()
+}
+
+/// The tracer name of `backend` built at `quality`.
+fn mlt_tracer_name(backend: Backend, quality: BuildQuality) -> &'static str {
+    match (backend, quality) {
+        (Backend::Bvh, BuildQuality::High) => "mlt bvh",
+        (Backend::Bvh, BuildQuality::Medium) => "mlt bvh medium",
+        (Backend::Bvh, BuildQuality::Fast) => "mlt bvh fast",
+        (Backend::Embree, BuildQuality::High) => "mlt embree",
+        (Backend::Embree, BuildQuality::Medium) => "mlt embree medium",
+        (Backend::Embree, BuildQuality::Fast) => "mlt embree fast",
+    }
+}
+
 /// The tracers' names, in table and chart order; those without Embree only in builds with it.
 /// `MLT_BENCH_TRACERS` picks some.
 fn tracer_names() -> Vec<&'static str> {
     let mut all = vec!["mlt bvh"];
+    for &quality in &extra_qualities() {
+        all.push(mlt_tracer_name(Backend::Bvh, quality));
+    }
     if BvhWidth::best() != BvhWidth::Four {
         all.push("mlt bvh4");
     }
     all.push("raw obvhs");
     if cfg!(feature = "embree") {
         all.extend(["mlt embree", "raw embree"]);
+        for &quality in &extra_qualities() {
+            all.push(mlt_tracer_name(Backend::Embree, quality));
+        }
     }
     let wanted = env_names("MLT_BENCH_TRACERS", &all);
     for name in &wanted {
@@ -491,6 +525,8 @@ const RATIOS: &[(&str, &str, &str)] = &[
     ("embree/raw", "mlt embree", "raw embree"),
     ("bvh/embree", "mlt bvh", "mlt embree"),
     ("bvh4/embree", "mlt bvh4", "mlt embree"),
+    ("medium bvh/embree", "mlt bvh medium", "mlt embree medium"),
+    ("fast bvh/embree", "mlt bvh fast", "mlt embree fast"),
 ];
 
 struct RateRow {
@@ -625,29 +661,40 @@ struct BuildRow {
     bytes: usize,
 }
 
-/// Builds `backend` `builds` times over the scene; returns the last build and its row.
+/// Builds `backend` `builds` times over the scene at the default quality; returns the last
+/// build and its row.
 fn measure_build(scene: &BenchScene, backend: Backend, builds: usize) -> (Accel, BuildRow) {
-    measure_build_named(
-        scene,
-        backend,
-        builds,
-        match backend {
-            Backend::Bvh => "mlt bvh",
-            Backend::Embree => "mlt embree",
-        },
-    )
+    measure_build_at(scene, backend, BuildQuality::default(), builds)
+}
+
+/// `measure_build` at `quality`.
+fn measure_build_at(
+    scene: &BenchScene,
+    backend: Backend,
+    quality: BuildQuality,
+    builds: usize,
+) -> (Accel, BuildRow) {
+    let name = mlt_tracer_name(backend, quality);
+    measure_build_named(scene, backend, quality, builds, name)
 }
 
 /// `measure_build` with the 4-wide BVH.
 fn measure_build_bvh4(scene: &BenchScene, builds: usize) -> (Accel, BuildRow) {
     with_bvh_width(BvhWidth::Four, || {
-        measure_build_named(scene, Backend::Bvh, builds, "mlt bvh4")
+        measure_build_named(
+            scene,
+            Backend::Bvh,
+            BuildQuality::default(),
+            builds,
+            "mlt bvh4",
+        )
     })
 }
 
 fn measure_build_named(
     scene: &BenchScene,
     backend: Backend,
+    quality: BuildQuality,
     builds: usize,
     name: &'static str,
 ) -> (Accel, BuildRow) {
@@ -658,7 +705,7 @@ fn measure_build_named(
         drop(accel.take());
         let start = Instant::now();
         accel = Some(
-            Accel::build(backend, &scene.triangles, Filtering::Unfiltered)
+            Accel::build(backend, quality, &scene.triangles, Filtering::Unfiltered)
                 .expect("the backend builds"),
         );
         seconds.push(start.elapsed().as_secs_f64());
@@ -676,12 +723,12 @@ fn measure_build_named(
 
 fn print_build_rows(rows: &[BuildRow]) {
     println!(
-        "{:<8} {:>10} {:<11} {:>9} {:>10} {:>9}",
+        "{:<8} {:>10} {:<17} {:>9} {:>10} {:>9}",
         "scene", "triangles", "backend", "build s", "memory MB", "B/tri"
     );
     for r in rows {
         println!(
-            "{:<8} {:>10} {:<11} {:>9.3} {:>10.1} {:>9.1}",
+            "{:<8} {:>10} {:<17} {:>9.3} {:>10.1} {:>9.1}",
             r.scene,
             r.triangles,
             r.backend,
@@ -863,6 +910,16 @@ fn main() {
         let (embree, row) = measure_build(&scene, Backend::Embree, builds);
         #[cfg(feature = "embree")]
         build_rows.push(row);
+        // The other qualities' structures, named as their tracers.
+        let mut at_qualities = Vec::new();
+        for &quality in &extra_qualities() {
+            let backends = [Backend::Bvh, Backend::Embree];
+            for backend in backends.into_iter().filter(|b| b.is_available()) {
+                let (accel, row) = measure_build_at(&scene, backend, quality, builds);
+                build_rows.push(row);
+                at_qualities.push((mlt_tracer_name(backend, quality), accel));
+            }
+        }
         let mut tracers: Vec<Box<dyn Tracer + '_>> = vec![
             Box::new(MltTracer {
                 name: "mlt bvh",
@@ -890,11 +947,19 @@ fn main() {
             }));
             tracers.push(Box::new(raw_embree::EmbreeTracer::new(&embree, &rays)));
         }
+        for (name, accel) in &at_qualities {
+            tracers.push(Box::new(MltTracer {
+                name,
+                accel,
+                rays: &rays,
+            }));
+        }
         let names = tracer_names();
-        let tracer_refs: Vec<&dyn Tracer> = tracers
+        // In `tracer_names` order, the table's and the chart's.
+        let tracer_refs: Vec<&dyn Tracer> = names
             .iter()
+            .filter_map(|name| tracers.iter().find(|t| t.name() == *name))
             .map(|t| t.as_ref())
-            .filter(|t| names.contains(&t.name()))
             .collect();
         print_rate_header();
         for &threads in &thread_counts {

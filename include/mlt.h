@@ -173,6 +173,25 @@
 #define MLT_BACKEND_EMBREE 1
 
 /**
+ * `MltSceneDesc.build_quality` (0, the default): the acceleration structure that renders
+ * fastest, for scenes built once and rendered long (Embree: `RTC_BUILD_QUALITY_HIGH`).
+ */
+#define MLT_BUILD_QUALITY_HIGH 0
+
+/**
+ * `MltSceneDesc.build_quality`: a quicker build, slower rays (Embree:
+ * `RTC_BUILD_QUALITY_MEDIUM`).
+ */
+#define MLT_BUILD_QUALITY_MEDIUM 1
+
+/**
+ * `MltSceneDesc.build_quality`: the quickest build, for scenes rebuilt often (an editor's
+ * preview, a baking tool's iterations); rays are slower still (Embree:
+ * `RTC_BUILD_QUALITY_LOW`). Every quality gives the same images up to rounding.
+ */
+#define MLT_BUILD_QUALITY_FAST 2
+
+/**
  * `MltRenderSettings.algorithm`: path tracing with next-event estimation and MIS.
  */
 #define MLT_ALGORITHM_PATH 0
@@ -809,6 +828,11 @@ typedef struct MltSceneDesc {
    * Number of entries in `textures`.
    */
   size_t textures_len;
+  /**
+   * One of `MLT_BUILD_QUALITY_*` (the default, 0, is `MLT_BUILD_QUALITY_HIGH`): how much
+   * work the acceleration structure's build spends for faster rays.
+   */
+  int32_t build_quality;
 } MltSceneDesc;
 
 /**
@@ -1094,6 +1118,19 @@ typedef struct MltSceneInfo {
    * The `MLT_BACKEND_*` the scene was built with.
    */
   int32_t backend;
+  /**
+   * The `MLT_BUILD_QUALITY_*` it was built at …
+   */
+  int32_t build_quality;
+  /**
+   * … the bytes its acceleration structure holds (for Embree, what Embree allocated plus
+   * mlt's own arrays) …
+   */
+  uint64_t accel_memory_bytes;
+  /**
+   * … and the seconds the acceleration structure's build took.
+   */
+  double accel_build_seconds;
 } MltSceneInfo;
 
 /**
@@ -1327,7 +1364,8 @@ MLT_API enum MltStatus mlt_scene_retain(struct MltScene *scene);
 MLT_API void mlt_scene_release(struct MltScene *scene);
 
 /**
- * Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
+ * Facts about a scene: triangle, degenerate and emitter counts, bounds, backend, and its
+ * acceleration structure's build quality, memory and build time.
  *
  * # Safety
  * `out` must be writable. (`scene` is looked up among the live scenes: any other pointer

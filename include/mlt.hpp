@@ -119,6 +119,14 @@ enum class Backend : std::int32_t {
     Embree = MLT_BACKEND_EMBREE,
 };
 
+/// How much work the acceleration structure's build spends for faster rays
+/// (`MLT_BUILD_QUALITY_*`).
+enum class BuildQuality : std::int32_t {
+    High = MLT_BUILD_QUALITY_HIGH,
+    Medium = MLT_BUILD_QUALITY_MEDIUM,
+    Fast = MLT_BUILD_QUALITY_FAST,
+};
+
 /// `MLT_MATERIAL_*`.
 enum class MaterialKind : std::int32_t {
     Diffuse = MLT_MATERIAL_DIFFUSE,
@@ -217,6 +225,10 @@ static_assert(detail::c_value(Algorithm::Path) == MLT_ALGORITHM_PATH &&
 static_assert(detail::c_value(Backend::Bvh) == MLT_BACKEND_BVH &&
                   detail::c_value(Backend::Embree) == MLT_BACKEND_EMBREE,
               "mlt::Backend mirrors MLT_BACKEND_*");
+static_assert(detail::c_value(BuildQuality::High) == MLT_BUILD_QUALITY_HIGH &&
+                  detail::c_value(BuildQuality::Medium) == MLT_BUILD_QUALITY_MEDIUM &&
+                  detail::c_value(BuildQuality::Fast) == MLT_BUILD_QUALITY_FAST,
+              "mlt::BuildQuality mirrors MLT_BUILD_QUALITY_*");
 static_assert(detail::c_value(MaterialKind::Diffuse) == MLT_MATERIAL_DIFFUSE &&
                   detail::c_value(MaterialKind::Mirror) == MLT_MATERIAL_MIRROR &&
                   detail::c_value(MaterialKind::Dielectric) == MLT_MATERIAL_DIELECTRIC &&
@@ -787,6 +799,7 @@ struct SceneDesc {
     Span<const std::uint32_t> material_ids;
     Span<const Material> materials;
     Backend backend = Backend::Bvh;
+    BuildQuality build_quality = BuildQuality::High;
     std::optional<Environment> environment;
     std::optional<Sun> sun;
     Span<const PunctualLight> punctual_lights;
@@ -995,6 +1008,10 @@ struct SceneInfo {
     Vec3 bounds_min{};
     Vec3 bounds_max{};
     Backend backend = Backend::Bvh;
+    BuildQuality build_quality = BuildQuality::High;
+    /// Bytes the acceleration structure holds, and the seconds its build took.
+    std::uint64_t accel_memory_bytes = 0;
+    double accel_build_seconds = 0.0;
 
     static SceneInfo from_c(const MltSceneInfo &c) noexcept {
         SceneInfo i;
@@ -1004,6 +1021,9 @@ struct SceneInfo {
         i.bounds_min = detail::to_array(c.bounds_min);
         i.bounds_max = detail::to_array(c.bounds_max);
         i.backend = detail::from_c<Backend>(c.backend);
+        i.build_quality = detail::from_c<BuildQuality>(c.build_quality);
+        i.accel_memory_bytes = c.accel_memory_bytes;
+        i.accel_build_seconds = c.accel_build_seconds;
         return i;
     }
 };
@@ -1078,6 +1098,7 @@ public:
         c.materials = materials.data();
         c.materials_len = materials.size();
         c.backend = detail::c_value(desc.backend);
+        c.build_quality = detail::c_value(desc.build_quality);
         c.environment = environment ? &*environment : nullptr;
         c.sun = sun ? &*sun : nullptr;
         c.punctual_lights = lights.data();

@@ -47,7 +47,7 @@ mod wire;
 #[cfg(feature = "cli")]
 pub mod io;
 
-pub use accel::Backend;
+pub use accel::{Backend, BuildQuality};
 pub use error::{Error, MltStatus, Result};
 pub use filter::FilterStats;
 pub use integrators::mlt::driver::{Mutation, MutationCounts, MutationWeights};

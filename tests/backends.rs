@@ -1,5 +1,5 @@
 //! The BVH and Embree backends answer the same queries the same way; the BVH at each width
-//! this CPU supports (the 8-wide AVX2 tree and the 4-wide fallback).
+//! this CPU supports (the 8-wide AVX2 tree and the 4-wide fallback) and at each build quality.
 //!
 //! Scenes: cornell-box, cornell-glass and a generated mesh of ~130k triangles (a displaced
 //! sphere and two wavy sheets that cut through it and each other, in a box). Rays, 100k of
@@ -27,7 +27,7 @@ use common::*;
 use glam::{DVec3, Vec3A};
 use mlt::accel::{BvhWidth, Hit, Ray, with_bvh_width};
 use mlt::sampling::Rng;
-use mlt::{Backend, Camera, Material, Scene};
+use mlt::{Backend, BuildQuality, Camera, Material, Scene};
 
 const RAYS_PER_KIND: usize = 100_000;
 /// Relative agreement of t between backends, and the closeness of two t that makes a tie.
@@ -43,10 +43,11 @@ const GRAZING_COS: f64 = 1e-4;
 /// A triangle scene built with both backends, plus the host's triangles in f64.
 struct Pair {
     name: &'static str,
-    /// The default BVH: as wide as the CPU supports.
+    /// The default BVH: as wide as the CPU supports, at the default build quality.
     bvh: Scene,
-    /// The 4-wide fallback, when the default is wider.
-    bvh4: Option<Scene>,
+    /// The other BVHs, named: the 4-wide fallback (when the default is wider) and the
+    /// faster build qualities.
+    variants: Vec<(&'static str, Scene)>,
     embree: Scene,
     camera: Camera,
     triangles: Vec<[DVec3; 3]>,
@@ -58,11 +59,32 @@ struct Pair {
 impl Pair {
     fn new(name: &'static str, mesh: &Mesh, camera: Camera) -> Pair {
         let bvh = mesh.scene_with(Backend::Bvh);
-        let bvh4 = (BvhWidth::best() != BvhWidth::Four)
-            .then(|| with_bvh_width(BvhWidth::Four, || mesh.scene_with(Backend::Bvh)));
+        let mut variants = Vec::new();
+        if BvhWidth::best() != BvhWidth::Four {
+            let bvh4 = with_bvh_width(BvhWidth::Four, || mesh.scene_with(Backend::Bvh));
+            variants.push(("4-wide", bvh4));
+        }
+        for (name, quality) in [
+            ("medium build", BuildQuality::Medium),
+            ("fast build", BuildQuality::Fast),
+        ] {
+            variants.push((name, mesh.scene_built(Backend::Bvh, quality)));
+        }
         let embree = mesh.scene_with(Backend::Embree);
         let info = bvh.info();
-        assert_eq!(info, embree.info());
+        let embree_info = embree.info();
+        assert_eq!(
+            (info.triangle_count, info.degenerate_triangle_count),
+            (
+                embree_info.triangle_count,
+                embree_info.degenerate_triangle_count
+            )
+        );
+        assert_eq!(info.emitter_count, embree_info.emitter_count);
+        assert_eq!(
+            (info.bounds_min, info.bounds_max),
+            (embree_info.bounds_min, embree_info.bounds_max)
+        );
         let vertex = |i: u32| {
             let p = &mesh.positions[3 * i as usize..][..3];
             DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
@@ -77,7 +99,7 @@ impl Pair {
         Pair {
             name,
             bvh,
-            bvh4,
+            variants,
             embree,
             camera,
             triangles,
@@ -411,14 +433,14 @@ fn compare(pair: &Pair, bvh: &Scene, kind: Kind) -> Tally {
 
 fn check_pair(pair: &Pair) {
     check_bvh(pair, "default", &pair.bvh);
-    if let Some(bvh4) = &pair.bvh4 {
-        check_bvh(pair, "4-wide", bvh4);
+    for (name, bvh) in &pair.variants {
+        check_bvh(pair, name, bvh);
     }
 }
 
 /// Every query of every kind through `bvh` against Embree.
-fn check_bvh(pair: &Pair, width: &str, bvh: &Scene) {
-    let name = format!("{} ({width} bvh)", pair.name);
+fn check_bvh(pair: &Pair, variant: &str, bvh: &Scene) {
+    let name = format!("{} ({variant} bvh)", pair.name);
     let mut queries = 0;
     let mut disagreements = 0;
     let mut unexplained = Vec::new();

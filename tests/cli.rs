@@ -379,6 +379,54 @@ fn embree_backend_renders_or_names_the_missing_feature() {
     }
 }
 
+/// `--build-quality` reaches the scene (the summary names it, with the build's time and
+/// memory), the default is `high`, and an unknown value is a one-line error.
+#[test]
+fn build_quality_is_applied_and_reported() {
+    for (flag, expected) in [(None, "high build"), (Some("fast"), "fast build")] {
+        let out = temp_path(&format!("quality-{expected}.pfm"));
+        let mut args: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![
+            &"--algorithm",
+            &"path",
+            &"--spp",
+            &"1",
+            &"--width",
+            &"8",
+            &"--height",
+            &"8",
+            &"--out",
+            &out,
+        ];
+        let scene_path = scene("cornell-box.obj");
+        args.insert(0, &scene_path);
+        if let Some(value) = &flag {
+            args.push(&"--build-quality");
+            args.push(value);
+        }
+        let output = mlt_render(&args);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(output.status.success(), "{output:?}");
+        let line = stdout
+            .lines()
+            .find(|l| l.contains("acceleration"))
+            .unwrap_or_else(|| panic!("no acceleration row: {stdout}"));
+        assert!(
+            line.contains(expected) && line.contains(" s, ") && line.contains("MB"),
+            "{line}"
+        );
+        let _ = std::fs::remove_file(&out);
+    }
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--build-quality",
+        &"best",
+        &"--out",
+        &temp_path("x.pfm"),
+    ]);
+    assert!(!output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("build-quality"));
+}
+
 #[test]
 fn missing_scene_file_is_a_one_line_error() {
     let missing = temp_path("missing.obj");

@@ -39,6 +39,7 @@ _Image = np.ndarray[Tuple[int, int, int], np.dtype[np.float32]]
 _Progress = Callable[[float], Optional[bool]]
 _Vec3 = Tuple[float, float, float]
 _Backend = Literal["bvh", "embree"]
+_BuildQuality = Literal["fast", "medium", "high"]
 
 @final
 class SceneInfo:
@@ -52,6 +53,12 @@ class SceneInfo:
     def bounds_min(self) -> _Vec3: ...
     @property
     def bounds_max(self) -> _Vec3: ...
+    @property
+    def build_quality(self) -> _BuildQuality: ...
+    @property
+    def accel_memory_bytes(self) -> int: ...
+    @property
+    def accel_build_seconds(self) -> float: ...
 
 @final
 class Scene:
@@ -71,6 +78,7 @@ class Scene:
         sun: Optional[Sun] = None,
         lights: Optional[Iterable[PunctualLight]] = None,
         backend: _Backend = "bvh",
+        build_quality: _BuildQuality = "high",
     ) -> Scene: ...
     @staticmethod
     def load(
@@ -82,6 +90,7 @@ class Scene:
         energy_compensation: bool = False,
         abbe_number: Optional[float] = None,
         backend: _Backend = "bvh",
+        build_quality: _BuildQuality = "high",
     ) -> Tuple[Scene, Optional[Camera]]: ...
     @property
     def info(self) -> SceneInfo: ...

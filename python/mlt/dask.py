@@ -62,6 +62,7 @@ class SceneFile:
     energy_compensation: bool = False
     abbe_number: Optional[float] = None
     backend: str = "bvh"
+    build_quality: str = "high"
 
     def __call__(self) -> _mlt.Scene:
         scene, _camera = _mlt.Scene.load(
@@ -72,6 +73,7 @@ class SceneFile:
             energy_compensation=self.energy_compensation,
             abbe_number=self.abbe_number,
             backend=self.backend,  # type: ignore[arg-type]
+            build_quality=self.build_quality,  # type: ignore[arg-type]
         )
         return scene
 
@@ -86,7 +88,7 @@ class SceneArrays:
     materials: Optional[Sequence[Any]] = None
     material_ids: Optional[npt.ArrayLike] = None
     #: The keyword arguments of :meth:`Scene.from_arrays` (normals, texcoords, tangents,
-    #: colors, textures, environment, sun, lights, backend).
+    #: colors, textures, environment, sun, lights, backend, build_quality).
     options: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
     def __init__(

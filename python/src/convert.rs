@@ -4,9 +4,9 @@
 use crate::arrays::{self, Array};
 use crate::errors::{invalid, with_context};
 use mlt::{
-    Algorithm, AlphaMode, Backend, Camera, Material, MaterialKind, MutationWeights, PunctualLight,
-    PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc, TextureEncoding,
-    TextureFilter, TextureRef, WrapMode,
+    Algorithm, AlphaMode, Backend, BuildQuality, Camera, Material, MaterialKind, MutationWeights,
+    PunctualLight, PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc,
+    TextureEncoding, TextureFilter, TextureRef, WrapMode,
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -97,6 +97,16 @@ const BACKENDS: [(&str, Backend); 2] = [("bvh", Backend::Bvh), ("embree", Backen
 
 pub fn backend(py: Python<'_>, name: &str) -> PyResult<Backend> {
     choose(py, "Scene", "backend", name, &BACKENDS)
+}
+
+pub const BUILD_QUALITIES: [(&str, BuildQuality); 3] = [
+    ("fast", BuildQuality::Fast),
+    ("medium", BuildQuality::Medium),
+    ("high", BuildQuality::High),
+];
+
+pub fn build_quality(py: Python<'_>, name: &str) -> PyResult<BuildQuality> {
+    choose(py, "Scene", "build_quality", name, &BUILD_QUALITIES)
 }
 
 pub fn camera(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {

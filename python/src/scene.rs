@@ -29,18 +29,27 @@ pub struct SceneInfo {
     emitter_count: usize,
     bounds_min: (f32, f32, f32),
     bounds_max: (f32, f32, f32),
+    /// The build quality: "fast", "medium" or "high".
+    build_quality: &'static str,
+    /// Bytes the acceleration structure holds.
+    accel_memory_bytes: usize,
+    /// Seconds its build took.
+    accel_build_seconds: f64,
 }
 
 #[pymethods]
 impl SceneInfo {
     fn __repr__(&self) -> String {
         format!(
-            "SceneInfo(triangle_count={}, degenerate_triangle_count={}, emitter_count={}, bounds_min={:?}, bounds_max={:?})",
+            "SceneInfo(triangle_count={}, degenerate_triangle_count={}, emitter_count={}, bounds_min={:?}, bounds_max={:?}, build_quality={:?}, accel_memory_bytes={}, accel_build_seconds={})",
             self.triangle_count,
             self.degenerate_triangle_count,
             self.emitter_count,
             self.bounds_min,
-            self.bounds_max
+            self.bounds_max,
+            self.build_quality,
+            self.accel_memory_bytes,
+            self.accel_build_seconds
         )
     }
 }
@@ -61,7 +70,12 @@ struct OwnedDesc {
 }
 
 impl OwnedDesc {
-    fn desc<'a>(&'a self, lights: &'a OwnedLights, backend: mlt::Backend) -> mlt::SceneDesc<'a> {
+    fn desc<'a>(
+        &'a self,
+        lights: &'a OwnedLights,
+        backend: mlt::Backend,
+        build_quality: mlt::BuildQuality,
+    ) -> mlt::SceneDesc<'a> {
         mlt::SceneDesc {
             positions: &self.positions,
             indices: &self.indices,
@@ -69,6 +83,7 @@ impl OwnedDesc {
             materials: &self.materials,
             lights: lights.desc(),
             backend,
+            build_quality,
             normals: &self.normals,
             texcoords: &self.texcoords,
             tangents: &self.tangents,
@@ -98,11 +113,13 @@ impl Scene {
     /// textures: `Texture`s the materials refer to.
     /// environment, sun, lights: an `Environment`, a `Sun`, and `PunctualLight`s.
     /// backend: "bvh" (default) or "embree" (only in builds with the feature).
+    /// build_quality: "high" (default: the acceleration structure that renders fastest),
+    /// "medium" or "fast" (the quickest build, for scenes rebuilt often; slower rays).
     ///
     /// Raises `InvalidArgumentError` (a `ValueError`) naming the array and element at fault:
     /// a wrong shape or dtype, a non-finite coordinate, an index out of range.
     #[staticmethod]
-    #[pyo3(signature = (positions, indices, materials=None, material_ids=None, *, normals=None, texcoords=None, tangents=None, colors=None, textures=None, environment=None, sun=None, lights=None, backend="bvh"))]
+    #[pyo3(signature = (positions, indices, materials=None, material_ids=None, *, normals=None, texcoords=None, tangents=None, colors=None, textures=None, environment=None, sun=None, lights=None, backend="bvh", build_quality="high"))]
     #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         py: Python<'_>,
@@ -119,8 +136,10 @@ impl Scene {
         sun: Option<&Bound<'_, PyAny>>,
         lights: Option<&Bound<'_, PyAny>>,
         backend: &str,
+        build_quality: &str,
     ) -> PyResult<Scene> {
         let backend = convert::backend(py, backend)?;
+        let build_quality = convert::build_quality(py, build_quality)?;
         let materials = match materials {
             Some(materials) => materials
                 .try_iter()?
@@ -155,8 +174,8 @@ impl Scene {
             textures,
         };
         let lights = OwnedLights::extract(environment, sun, lights)?;
-        let scene =
-            build(py, &owned.desc(&lights, backend)).map_err(|e| errors::from_mlt(py, &e))?;
+        let scene = build(py, &owned.desc(&lights, backend, build_quality))
+            .map_err(|e| errors::from_mlt(py, &e))?;
         Ok(Scene { scene })
     }
 
@@ -173,7 +192,7 @@ impl Scene {
     /// Raises FileNotFoundError for a missing file and `LoadError` for one that cannot be
     /// read.
     #[staticmethod]
-    #[pyo3(signature = (path, *, environment=None, sun=None, lights=None, energy_compensation=false, abbe_number=None, backend="bvh"))]
+    #[pyo3(signature = (path, *, environment=None, sun=None, lights=None, energy_compensation=false, abbe_number=None, backend="bvh", build_quality="high"))]
     #[allow(clippy::too_many_arguments)]
     fn load<'py>(
         py: Python<'py>,
@@ -184,8 +203,10 @@ impl Scene {
         energy_compensation: bool,
         abbe_number: Option<f32>,
         backend: &str,
+        build_quality: &str,
     ) -> PyResult<(Scene, Option<Bound<'py, PyAny>>)> {
         let backend = convert::backend(py, backend)?;
+        let build_quality = convert::build_quality(py, build_quality)?;
         if !path.exists() {
             return Err(PyFileNotFoundError::new_err((
                 2,
@@ -214,6 +235,7 @@ impl Scene {
         punctual.append(&mut lights.punctual);
         lights.punctual = punctual;
         let mut desc = data.desc(backend);
+        desc.build_quality = build_quality;
         desc.lights = lights.desc();
         let scene = build(py, &desc).map_err(|e| {
             let message = describe_scene_error(&e, &data);
@@ -227,7 +249,8 @@ impl Scene {
         Ok((Scene { scene }, camera))
     }
 
-    /// Triangle and emitter counts and the bounding box.
+    /// Triangle and emitter counts, the bounding box, and the acceleration structure's build
+    /// quality, memory and build time.
     #[getter]
     fn info(&self) -> SceneInfo {
         let info = self.scene.info();
@@ -238,6 +261,12 @@ impl Scene {
             emitter_count: info.emitter_count,
             bounds_min: tuple(info.bounds_min),
             bounds_max: tuple(info.bounds_max),
+            build_quality: convert::BUILD_QUALITIES
+                .iter()
+                .find(|(_, q)| *q == info.build_quality)
+                .map_or("high", |(name, _)| name),
+            accel_memory_bytes: info.accel_memory_bytes,
+            accel_build_seconds: info.accel_build_seconds,
         }
     }
 

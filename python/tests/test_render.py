@@ -149,6 +149,30 @@ def test_cornell_box_renders(cornell_box: tuple[mlt.Scene, mlt.Camera | None], a
     assert stats.stop == "completed"
 
 
+@pytest.mark.parametrize("quality", ["fast", "medium", "high"])
+def test_every_build_quality_renders_the_same_image(
+    cornell_box: tuple[mlt.Scene, mlt.Camera | None], quality: str
+) -> None:
+    # The qualities build different trees over the same triangles: the same hits up to
+    # rounding, so the same samples give the same image but for a rare ray.
+    default, camera = cornell_box
+    assert camera is not None
+    scene, _ = mlt.Scene.load(SCENES / "cornell-box.obj", build_quality=quality)
+    info = scene.info
+    assert (info.build_quality, default.info.build_quality) == (quality, "high")
+    assert info.accel_memory_bytes > 0 and info.accel_build_seconds >= 0.0
+    settings = small("path", width=24, height=24, samples_per_pixel=8)
+    image, _ = mlt.render(scene, camera, settings)
+    reference, _ = mlt.render(default, camera, settings)
+    assert np.mean(np.abs(image - reference)) <= 1e-3 * reference.mean()
+
+
+def test_an_unknown_build_quality_is_refused() -> None:
+    positions, indices = quad()
+    with pytest.raises(ValueError, match="build_quality"):
+        mlt.Scene.from_arrays(positions, indices, build_quality="best")
+
+
 def test_framing_camera_sees_the_whole_scene() -> None:
     positions, indices = quad(half_size=1.0)
     scene = mlt.Scene.from_arrays(positions, indices)

@@ -49,6 +49,23 @@ impl Backend {
     }
 }
 
+/// How much work the build spends for faster rays, as Embree's build qualities. Every quality
+/// answers the same queries (the agreement of [`Accel`]'s contract); only the speeds and the
+/// memory differ. The traversal bench (`benches/traversal.rs`) reports build time, memory and
+/// ray rates per quality; README "Benchmarks" has the figures.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BuildQuality {
+    /// The quickest build, for scenes rebuilt often (an editor's preview, a baking tool's
+    /// iterations); rays are slower. Embree: `RTC_BUILD_QUALITY_LOW`.
+    Fast,
+    /// Between the two. Embree: `RTC_BUILD_QUALITY_MEDIUM`.
+    Medium,
+    /// The tree that renders fastest, for scenes built once and rendered long (the
+    /// default). Embree: `RTC_BUILD_QUALITY_HIGH`.
+    #[default]
+    High,
+}
+
 /// Whether a structure will also answer filtered queries ([`Accel::intersect_filtered`],
 /// [`Accel::occluded_filtered`]). The BVH answers them either way; Embree only runs filters
 /// in scenes built for them, which makes its unfiltered queries slower too (see
@@ -70,13 +87,14 @@ pub enum Accel {
 }
 
 impl Accel {
-    /// Builds `backend`'s structure over triangles given as vertex triples, none degenerate;
+    /// Builds `backend`'s structure at `quality` over triangles given as vertex triples, none degenerate;
     /// `filtering` says whether it will answer filtered queries (a filtered query on an
     /// Embree structure built `Unfiltered` panics). Fails with `MLT_STATUS_UNSUPPORTED` for
     /// a backend this build lacks (see [`Backend::is_available`]), and with Embree's error if
     /// Embree fails.
     pub fn build(
         backend: Backend,
+        quality: BuildQuality,
         triangles: &[[Vec3A; 3]],
         filtering: Filtering,
     ) -> Result<Accel> {
@@ -84,10 +102,12 @@ impl Accel {
             Backend::Bvh => {
                 // The BVH answers filtered queries whatever it was built for.
                 let _ = filtering;
-                Ok(Accel::Bvh(BvhAccel::build(triangles)?))
+                Ok(Accel::Bvh(BvhAccel::build(triangles, quality)?))
             }
             #[cfg(feature = "embree")]
-            Backend::Embree => Ok(Accel::Embree(EmbreeAccel::build(triangles, filtering)?)),
+            Backend::Embree => Ok(Accel::Embree(EmbreeAccel::build(
+                triangles, quality, filtering,
+            )?)),
             #[cfg(not(feature = "embree"))]
             Backend::Embree => Err(crate::error::Error::new(
                 crate::error::MLT_STATUS_UNSUPPORTED,
@@ -187,6 +207,7 @@ mod tests {
         for backend in available_backends() {
             let accel = Accel::build(
                 backend,
+                BuildQuality::default(),
                 &[[
                     Vec3A::new(-1.0, -1.0, 1.0),
                     Vec3A::new(1.0, -1.0, 1.0),
@@ -250,13 +271,25 @@ mod tests {
                 for width in [BvhWidth::Four, BvhWidth::Eight] {
                     if width.is_supported() {
                         let accel = with_bvh_width(width, || {
-                            Accel::build(backend, triangles, Filtering::Filtered).unwrap()
+                            Accel::build(
+                                backend,
+                                BuildQuality::default(),
+                                triangles,
+                                Filtering::Filtered,
+                            )
+                            .unwrap()
                         });
                         accels.push((format!("{backend:?} {width:?}"), accel));
                     }
                 }
             } else {
-                let accel = Accel::build(backend, triangles, Filtering::Filtered).unwrap();
+                let accel = Accel::build(
+                    backend,
+                    BuildQuality::default(),
+                    triangles,
+                    Filtering::Filtered,
+                )
+                .unwrap();
                 accels.push((format!("{backend:?}"), accel));
             }
         }
@@ -508,7 +541,7 @@ mod tests {
     #[test]
     fn unavailable_backend_is_unsupported() {
         for backend in [Backend::Bvh, Backend::Embree] {
-            match Accel::build(backend, &[], Filtering::Unfiltered) {
+            match Accel::build(backend, BuildQuality::default(), &[], Filtering::Unfiltered) {
                 Ok(_) => assert!(backend.is_available()),
                 Err(e) => {
                     assert!(!backend.is_available());

@@ -176,6 +176,16 @@ enum BackendArg {
     Embree,
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum BuildQualityArg {
+    /// The quickest build, slower rays: for scenes rebuilt often.
+    Fast,
+    /// Between the two.
+    Medium,
+    /// The acceleration structure that renders fastest.
+    High,
+}
+
 /// Render a scene with mlt.
 ///
 /// SCENE is a Wavefront OBJ (with its MTL; the camera from NAME.camera.json beside it) or a
@@ -288,6 +298,9 @@ struct Args {
     /// Ray-intersection backend.
     #[arg(long, value_enum, default_value = "bvh")]
     backend: BackendArg,
+    /// How much work the acceleration structure's build spends for faster rays.
+    #[arg(long, value_enum, default_value = "high")]
+    build_quality: BuildQualityArg,
     /// Environment map lighting the scene from infinitely far away: an equirectangular
     /// (latitude-longitude) .hdr or .exr of linear radiance, +Y up, its centre looking
     /// along +Z.
@@ -398,6 +411,11 @@ fn run(args: &Args) -> Result<(), String> {
         (None, None) => None,
     };
     let mut desc = data.desc(backend);
+    desc.build_quality = match args.build_quality {
+        BuildQualityArg::Fast => mlt::BuildQuality::Fast,
+        BuildQualityArg::Medium => mlt::BuildQuality::Medium,
+        BuildQualityArg::High => mlt::BuildQuality::High,
+    };
     desc.lights.sun = sun;
     desc.lights.environment = environment
         .as_ref()
@@ -615,6 +633,15 @@ fn print_summary(
             info.emitter_count,
             format!("{:?}", args.backend).to_lowercase(),
             load_seconds
+        ),
+    );
+    row(
+        "acceleration",
+        format!(
+            "{} build in {:.3} s, {:.1} MB",
+            format!("{:?}", info.build_quality).to_lowercase(),
+            info.accel_build_seconds,
+            info.accel_memory_bytes as f64 / 1e6
         ),
     );
     if !lights.is_empty() {

@@ -2,7 +2,7 @@
 //! range-checked with a message naming the field.
 
 use super::types::*;
-use crate::accel::Backend;
+use crate::accel::{Backend, BuildQuality};
 use crate::error::*;
 use crate::integrators::mlt::driver::MutationWeights;
 use crate::render::{Algorithm, RenderSettings, RenderStats};
@@ -190,6 +190,26 @@ pub(super) fn backend(value: i32) -> Result<Backend> {
         other => Err(Error::invalid(format!(
             "desc.backend is {other}; use MLT_BACKEND_BVH (0) or MLT_BACKEND_EMBREE (1)"
         ))),
+    }
+}
+
+pub(super) fn build_quality(value: i32) -> Result<BuildQuality> {
+    match value {
+        MLT_BUILD_QUALITY_HIGH => Ok(BuildQuality::High),
+        MLT_BUILD_QUALITY_MEDIUM => Ok(BuildQuality::Medium),
+        MLT_BUILD_QUALITY_FAST => Ok(BuildQuality::Fast),
+        other => Err(Error::invalid(format!(
+            "desc.build_quality is {other}; use MLT_BUILD_QUALITY_HIGH (0), MLT_BUILD_QUALITY_MEDIUM (1) or MLT_BUILD_QUALITY_FAST (2)"
+        ))),
+    }
+}
+
+/// The `MLT_BUILD_QUALITY_*` of `quality`.
+pub(super) fn build_quality_code(quality: BuildQuality) -> i32 {
+    match quality {
+        BuildQuality::High => MLT_BUILD_QUALITY_HIGH,
+        BuildQuality::Medium => MLT_BUILD_QUALITY_MEDIUM,
+        BuildQuality::Fast => MLT_BUILD_QUALITY_FAST,
     }
 }
 

@@ -257,10 +257,11 @@ impl Extensible for MltSceneDesc {
     const INITIALIZER: &'static str = "mlt_scene_desc_default";
     /// Before the lights besides emissive triangles (mlt 0.2's header, 80 bytes): no
     /// lights; before the surface attributes and textures (112 bytes): flat triangles, no
-    /// textures.
+    /// textures; before the build quality (208 bytes): the default quality.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltSceneDesc, environment),
         offset_of!(MltSceneDesc, normals),
+        offset_of!(MltSceneDesc, build_quality),
     ];
     fn defaults() -> Self {
         MltSceneDesc {
@@ -288,6 +289,7 @@ impl Extensible for MltSceneDesc {
             colors_len: 0,
             textures: std::ptr::null(),
             textures_len: 0,
+            build_quality: MLT_BUILD_QUALITY_HIGH,
         }
     }
 }
@@ -417,7 +419,8 @@ impl Extensible for MltRenderStats {
 impl Extensible for MltSceneInfo {
     const TYPE_NAME: &'static str = "MltSceneInfo";
     const INITIALIZER: &'static str = "mlt_scene_info_default";
-    const EARLIER_LAYOUTS: &'static [usize] = &[];
+    /// Before the acceleration structure's facts (64 bytes).
+    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltSceneInfo, build_quality)];
     fn defaults() -> Self {
         MltSceneInfo {
             struct_size: size_of::<Self>() as u32,
@@ -476,12 +479,15 @@ mod tests {
     }
 
     /// The layouts older headers have: mlt 0.2's material ends at `ior`, its scene
-    /// description at `backend`; the one with lights but no surface attributes is 112 bytes.
+    /// description at `backend`; the one with lights but no surface attributes is 112 bytes,
+    /// the one without the build quality 192; the scene info without the acceleration
+    /// structure's facts 64.
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
         assert_eq!(sizes::<MltMaterial>(), [36, 168]);
-        assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192]);
+        assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
+        assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);
     }

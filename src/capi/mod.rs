@@ -291,6 +291,7 @@ pub unsafe extern "C" fn mlt_scene_create(
                     punctual: &punctual,
                 },
                 backend: backend(desc.backend)?,
+                build_quality: build_quality(desc.build_quality)?,
                 normals,
                 texcoords,
                 tangents,
@@ -410,7 +411,8 @@ pub unsafe extern "C" fn mlt_scene_release(scene: *mut MltScene) {
     let _ = guard(|| handles::release(scene).map(|()| MLT_STATUS_OK));
 }
 
-/// Facts about a scene: triangle, degenerate and emitter counts, bounds, backend.
+/// Facts about a scene: triangle, degenerate and emitter counts, bounds, backend, and its
+/// acceleration structure's build quality, memory and build time.
 ///
 /// # Safety
 /// `out` must be writable. (`scene` is looked up among the live scenes: any other pointer
@@ -433,6 +435,9 @@ pub unsafe extern "C" fn mlt_scene_get_info(
             bounds_min: info.bounds_min,
             bounds_max: info.bounds_max,
             backend: handle.backend,
+            build_quality: build_quality_code(info.build_quality),
+            accel_memory_bytes: info.accel_memory_bytes as u64,
+            accel_build_seconds: info.accel_build_seconds,
         };
         // SAFETY: checked by host_fields; writable by the contract.
         unsafe { write_host(out, fields, &value) };

@@ -79,6 +79,17 @@ pub const MLT_BACKEND_BVH: i32 = 0;
 /// `MltSceneDesc.backend`: Intel Embree 3, only when mlt was built with the `embree` feature.
 pub const MLT_BACKEND_EMBREE: i32 = 1;
 
+/// `MltSceneDesc.build_quality` (0, the default): the acceleration structure that renders
+/// fastest, for scenes built once and rendered long (Embree: `RTC_BUILD_QUALITY_HIGH`).
+pub const MLT_BUILD_QUALITY_HIGH: i32 = 0;
+/// `MltSceneDesc.build_quality`: a quicker build, slower rays (Embree:
+/// `RTC_BUILD_QUALITY_MEDIUM`).
+pub const MLT_BUILD_QUALITY_MEDIUM: i32 = 1;
+/// `MltSceneDesc.build_quality`: the quickest build, for scenes rebuilt often (an editor's
+/// preview, a baking tool's iterations); rays are slower still (Embree:
+/// `RTC_BUILD_QUALITY_LOW`). Every quality gives the same images up to rounding.
+pub const MLT_BUILD_QUALITY_FAST: i32 = 2;
+
 /// `MltRenderSettings.algorithm`: path tracing with next-event estimation and MIS.
 pub const MLT_ALGORITHM_PATH: i32 = 0;
 /// `MltRenderSettings.algorithm`: bidirectional path tracing, all strategies combined by MIS
@@ -408,6 +419,11 @@ pub struct MltSceneDesc {
     pub textures: *const MltTexture,
     /// Number of entries in `textures`.
     pub textures_len: usize,
+    // A header before the build quality ends the struct here: such a host's scenes are
+    // built at the default quality.
+    /// One of `MLT_BUILD_QUALITY_*` (the default, 0, is `MLT_BUILD_QUALITY_HIGH`): how much
+    /// work the acceleration structure's build spends for faster rays.
+    pub build_quality: i32,
 }
 
 /// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with
@@ -591,6 +607,13 @@ pub struct MltSceneInfo {
     pub bounds_max: [f32; 3],
     /// The `MLT_BACKEND_*` the scene was built with.
     pub backend: i32,
+    /// The `MLT_BUILD_QUALITY_*` it was built at …
+    pub build_quality: i32,
+    /// … the bytes its acceleration structure holds (for Embree, what Embree allocated plus
+    /// mlt's own arrays) …
+    pub accel_memory_bytes: u64,
+    /// … and the seconds the acceleration structure's build took.
+    pub accel_build_seconds: f64,
 }
 
 /// A ray for the batch queries: points origin + t·direction with t in [tmin, tmax] (with

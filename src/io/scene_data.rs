@@ -70,7 +70,8 @@ pub struct SceneData {
 }
 
 impl SceneData {
-    /// Borrows the arrays as a scene description for [`crate::Scene::new`].
+    /// Borrows the arrays as a scene description for [`crate::Scene::new`], at the default
+    /// build quality.
     pub fn desc(&self, backend: Backend) -> SceneDesc<'_> {
         SceneDesc {
             positions: &self.positions,
@@ -82,6 +83,7 @@ impl SceneData {
                 ..Default::default()
             },
             backend,
+            build_quality: Default::default(),
             normals: &self.normals,
             texcoords: &self.texcoords,
             tangents: &self.tangents,

@@ -15,7 +15,7 @@ pub use light_desc::{
 pub use lights::AreaLight;
 pub use material::{AlphaMode, Material, MaterialKind, TextureRef};
 
-use crate::accel::{Accel, Backend, Filtering, Hit, Ray};
+use crate::accel::{Accel, Backend, BuildQuality, Filtering, Hit, Ray};
 use crate::error::{Error, Result};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
@@ -35,6 +35,8 @@ pub struct SceneDesc<'a> {
     /// Lights besides the emissive triangles: environment, sun, punctual lights.
     pub lights: LightsDesc<'a>,
     pub backend: Backend,
+    /// How much work the acceleration structure's build spends for faster rays.
+    pub build_quality: BuildQuality,
     /// Per-vertex shading normals, x, y, z per vertex (any nonzero length; normalized on
     /// use), or empty for flat triangles. Interpolated across each triangle; a normal on the
     /// back side of its triangle is turned to the front.
@@ -64,6 +66,7 @@ impl Default for SceneDesc<'_> {
             materials: &[],
             lights: LightsDesc::default(),
             backend: Backend::default(),
+            build_quality: BuildQuality::default(),
             normals: &[],
             texcoords: &[],
             tangents: &[],
@@ -85,7 +88,7 @@ impl<'a> SceneDesc<'a> {
 }
 
 /// Facts about a built scene.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct SceneInfo {
     pub triangle_count: usize,
     /// Triangles with zero area (or a non-finite normal): kept in the id space, never hit,
@@ -95,6 +98,11 @@ pub struct SceneInfo {
     pub emitter_count: usize,
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
+    /// The acceleration structure's build quality, the bytes it holds
+    /// ([`Accel::memory_bytes`]) and the seconds its build took.
+    pub build_quality: BuildQuality,
+    pub accel_memory_bytes: usize,
+    pub accel_build_seconds: f64,
 }
 
 /// Per-triangle data the integrators read after a hit, in the backend's internal order.
@@ -164,12 +172,13 @@ fn fingerprint(desc: &SceneDesc) -> u64 {
         floats(&mut h, environment.pixels);
     }
     let small = format!(
-        "{:?} {:?} {:?} {:?} {:?}",
+        "{:?} {:?} {:?} {:?} {:?} {:?}",
         desc.materials,
         environment.map(|e| (e.width, e.height, e.rotation_degrees, e.scale)),
         sun,
         punctual,
         desc.backend,
+        desc.build_quality,
     );
     h.update(small.as_bytes());
     for texture in desc.textures {
@@ -249,7 +258,9 @@ impl Scene {
         } else {
             Filtering::Unfiltered
         };
-        let accel = Accel::build(desc.backend, &kept_vertices, filtering)?;
+        let build_start = std::time::Instant::now();
+        let accel = Accel::build(desc.backend, desc.build_quality, &kept_vertices, filtering)?;
+        let accel_build_seconds = build_start.elapsed().as_secs_f64();
         let order = accel.internal_to_build_order();
 
         let material_of = |id: u32| {
@@ -344,6 +355,9 @@ impl Scene {
             emitter_count,
             bounds_min: bounds_min.to_array(),
             bounds_max: bounds_max.to_array(),
+            build_quality: desc.build_quality,
+            accel_memory_bytes: accel.memory_bytes(),
+            accel_build_seconds,
         };
         Ok(Scene {
             accel,

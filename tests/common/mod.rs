@@ -634,8 +634,22 @@ impl Mesh {
         self.scene_lit(backend, Default::default())
     }
 
+    /// The scene built with `backend` at `quality`.
+    pub fn scene_built(&self, backend: Backend, quality: mlt::BuildQuality) -> Scene {
+        self.build(backend, quality, Default::default())
+    }
+
     /// The scene with lights besides its emissive triangles.
     pub fn scene_lit(&self, backend: Backend, lights: mlt::LightsDesc) -> Scene {
+        self.build(backend, Default::default(), lights)
+    }
+
+    fn build(
+        &self,
+        backend: Backend,
+        build_quality: mlt::BuildQuality,
+        lights: mlt::LightsDesc,
+    ) -> Scene {
         Scene::new(&SceneDesc {
             positions: &self.positions,
             indices: &self.indices,
@@ -643,6 +657,7 @@ impl Mesh {
             materials: &self.materials,
             lights,
             backend,
+            build_quality,
             ..Default::default()
         })
         .expect("a valid scene")

@@ -33,6 +33,7 @@ pub(super) trait WideNode<const W: usize> {
     fn set_child(&mut self, slot: usize, aabb: &Aabb, reference: u32);
     /// The slots' references: nodes, leaves or `EMPTY`.
     fn children(&self) -> &[u32; W];
+    fn children_mut(&mut self) -> &mut [u32; W];
 }
 
 /// Four child boxes: `bounds[2 * axis]` their minima along the axis, `bounds[2 * axis + 1]`
@@ -65,6 +66,10 @@ impl WideNode<WIDTH> for Node4 {
     #[inline(always)]
     fn children(&self) -> &[u32; WIDTH] {
         &self.children
+    }
+
+    fn children_mut(&mut self) -> &mut [u32; WIDTH] {
+        &mut self.children
     }
 }
 
@@ -101,6 +106,10 @@ impl WideNode<8> for Node8 {
     #[inline(always)]
     fn children(&self) -> &[u32; 8] {
         &self.children
+    }
+
+    fn children_mut(&mut self) -> &mut [u32; 8] {
+        &mut self.children
     }
 }
 

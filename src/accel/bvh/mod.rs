@@ -34,6 +34,7 @@ mod simd4;
 mod stack;
 mod traversal;
 
+use super::BuildQuality;
 use super::ray::{Hit, Ray};
 use crate::error::Result;
 use glam::Vec3A;
@@ -107,15 +108,19 @@ pub struct BvhAccel {
 }
 
 impl BvhAccel {
-    /// Builds over triangles given as vertex triples, none of them degenerate, as wide as the
-    /// CPU supports (or as [`with_bvh_width`] asks).
-    pub fn build(vertices: &[[Vec3A; 3]]) -> Result<Self> {
+    /// Builds at `quality` over triangles given as vertex triples, none of them degenerate, as
+    /// wide as the CPU supports (or as [`with_bvh_width`] asks).
+    pub fn build(vertices: &[[Vec3A; 3]], quality: BuildQuality) -> Result<Self> {
         let width = FORCED_WIDTH.get().unwrap_or_else(BvhWidth::best);
-        Self::build_with_width(vertices, width)
+        Self::build_with_width(vertices, width, quality)
     }
 
     /// Builds `width` wide, or 4-wide if the CPU does not support `width`.
-    pub(crate) fn build_with_width(vertices: &[[Vec3A; 3]], width: BvhWidth) -> Result<Self> {
+    pub(crate) fn build_with_width(
+        vertices: &[[Vec3A; 3]],
+        width: BvhWidth,
+        quality: BuildQuality,
+    ) -> Result<Self> {
         let width = if width.is_supported() {
             width
         } else {
@@ -134,12 +139,12 @@ impl BvhAccel {
         }
         let (tree, build_order) = match width {
             BvhWidth::Four => {
-                let (tree, build_order) = build::build(vertices)?;
+                let (tree, build_order) = build::build(vertices, quality)?;
                 (Tree::Four(tree), build_order)
             }
             #[cfg(target_arch = "x86_64")]
             BvhWidth::Eight => {
-                let (tree, build_order) = build::build(vertices)?;
+                let (tree, build_order) = build::build(vertices, quality)?;
                 (Tree::Eight(tree), build_order)
             }
             #[cfg(not(target_arch = "x86_64"))]
@@ -285,7 +290,9 @@ mod tests {
                     .num_threads(threads)
                     .build()
                     .unwrap();
-                pool.install(|| BvhAccel::build_with_width(&triangles, width).unwrap())
+                pool.install(|| {
+                    BvhAccel::build_with_width(&triangles, width, BuildQuality::default()).unwrap()
+                })
             };
             let one = build_on(1);
             for threads in [2, 3, 8] {
@@ -303,10 +310,22 @@ mod tests {
     #[test]
     fn builds_the_widest_supported_unless_forced() {
         let tris = [[Vec3A::ZERO, Vec3A::X, Vec3A::Y]; 40];
-        assert_eq!(BvhAccel::build(&tris).unwrap().width(), BvhWidth::best());
-        let forced = with_bvh_width(BvhWidth::Four, || BvhAccel::build(&tris).unwrap());
+        assert_eq!(
+            BvhAccel::build(&tris, BuildQuality::default())
+                .unwrap()
+                .width(),
+            BvhWidth::best()
+        );
+        let forced = with_bvh_width(BvhWidth::Four, || {
+            BvhAccel::build(&tris, BuildQuality::default()).unwrap()
+        });
         assert_eq!(forced.width(), BvhWidth::Four);
-        assert_eq!(BvhAccel::build(&tris).unwrap().width(), BvhWidth::best());
+        assert_eq!(
+            BvhAccel::build(&tris, BuildQuality::default())
+                .unwrap()
+                .width(),
+            BvhWidth::best()
+        );
         #[cfg(target_arch = "x86_64")]
         if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
             assert_eq!(BvhWidth::best(), BvhWidth::Eight);
@@ -335,7 +354,7 @@ mod tests {
                     ]
                 })
                 .collect();
-            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            let accel = BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
             assert_eq!(accel.width(), width);
             let mut sorted = accel.build_order.clone();
             sorted.sort_unstable();
@@ -400,7 +419,7 @@ mod tests {
             })
             .collect();
         for width in widths() {
-            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            let accel = BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
             for origin in [Vec3A::splat(3e38), Vec3A::new(-3e38, 3e38, -3e38)] {
                 for direction in [Vec3A::ONE, -Vec3A::ONE, Vec3A::new(1.0, -1.0, 1.0)] {
                     let ray = Ray::new(origin, direction.normalize(), 0.0, f32::INFINITY);
@@ -433,7 +452,8 @@ mod tests {
             let direction = Vec3A::new(tiny, 3.0, 1.0).normalize();
             let expected = (1e8 + 1.0) / direction.y;
             for width in widths() {
-                let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+                let accel =
+                    BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
                 let ray = Ray::new(origin, direction, 0.0, f32::INFINITY);
                 let hit = accel.intersect(&ray);
                 let what = format!("{width:?}, direction {direction}: {hit:?}");
@@ -460,7 +480,7 @@ mod tests {
             })
             .collect();
         for width in widths() {
-            let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+            let accel = BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
             for (i, [a, ..]) in tris.iter().enumerate() {
                 let origin = *a + Vec3A::new(-1.0, 1e14, 1e14);
                 let ray = Ray::new(origin, Vec3A::X, 0.0, 2.0);
@@ -495,7 +515,8 @@ mod tests {
         for squares in [8, 40] {
             let tris: Vec<[Vec3A; 3]> = (0..squares).flat_map(|i| square(i as f32)).collect();
             for width in widths() {
-                let accel = BvhAccel::build_with_width(&tris, width).unwrap();
+                let accel =
+                    BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
                 // From x = 0 and y = 0 (the boxes' own planes), straight along +z.
                 let ray = Ray::new(Vec3A::new(0.0, 0.25, -1.0), Vec3A::Z, 0.0, f32::INFINITY);
                 let hit = accel.intersect(&ray).expect("the first square");

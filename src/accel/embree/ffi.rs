@@ -40,6 +40,7 @@ pub const RTC_ERROR_CANCELLED: RTCError = 6;
 
 /// `enum RTCBuildQuality`.
 pub type RTCBuildQuality = c_int;
+pub const RTC_BUILD_QUALITY_LOW: RTCBuildQuality = 0;
 pub const RTC_BUILD_QUALITY_MEDIUM: RTCBuildQuality = 1;
 pub const RTC_BUILD_QUALITY_HIGH: RTCBuildQuality = 2;
 

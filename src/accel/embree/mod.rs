@@ -25,8 +25,8 @@
 #[doc(hidden)]
 pub mod ffi;
 
-use super::Filtering;
 use super::ray::{Hit, Ray};
+use super::{BuildQuality, Filtering};
 use crate::error::{
     Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, MLT_STATUS_UNSUPPORTED, MltStatus,
     Result,
@@ -40,9 +40,15 @@ use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::sync::atomic::{AtomicIsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
-/// The build quality of the (static) scenes: high (spatial splits) traces camera rays about
-/// 20% faster than medium on a 130k-triangle mesh, for twice the build time.
-const BUILD_QUALITY: RTCBuildQuality = RTC_BUILD_QUALITY_HIGH;
+/// Embree's build quality for ours. High (spatial splits) traces camera rays about 20% faster
+/// than medium on a 130k-triangle mesh, for twice the build time.
+fn embree_build_quality(quality: BuildQuality) -> RTCBuildQuality {
+    match quality {
+        BuildQuality::Fast => RTC_BUILD_QUALITY_LOW,
+        BuildQuality::Medium => RTC_BUILD_QUALITY_MEDIUM,
+        BuildQuality::High => RTC_BUILD_QUALITY_HIGH,
+    }
+}
 /// No `RTC_SCENE_FLAG_ROBUST`: it would make edges watertight and tnear inclusive (exactly
 /// the BVH's interval), but costs 15-30% of the ray rate on a 130k-triangle mesh (where the
 /// high build quality then gains nothing over medium). Neither backend is watertight without it: a ray through the
@@ -250,10 +256,14 @@ unsafe impl Send for EmbreeAccel {}
 unsafe impl Sync for EmbreeAccel {}
 
 impl EmbreeAccel {
-    /// Builds over triangles given as vertex triples (a triangle soup: three vertices per
-    /// triangle, 32-bit indices). None of them may be degenerate. Filtered queries need
-    /// `Filtering::Filtered`.
-    pub fn build(triangles: &[[Vec3A; 3]], filtering: Filtering) -> Result<Self> {
+    /// Builds at `quality` over triangles given as vertex triples (a triangle soup: three
+    /// vertices per triangle, 32-bit indices). None of them may be degenerate. Filtered
+    /// queries need `Filtering::Filtered`.
+    pub fn build(
+        triangles: &[[Vec3A; 3]],
+        quality: BuildQuality,
+        filtering: Filtering,
+    ) -> Result<Self> {
         let count = triangles.len();
         let vertex_count = count.checked_mul(3).filter(|&n| n <= 1 << 32);
         let Some(vertex_count) = vertex_count else {
@@ -282,7 +292,7 @@ impl EmbreeAccel {
         device.check_handle("rtcNewScene", scene)?;
         // SAFETY: a live, uncommitted scene; valid enum values.
         unsafe {
-            rtcSetSceneBuildQuality(scene, BUILD_QUALITY);
+            rtcSetSceneBuildQuality(scene, embree_build_quality(quality));
             rtcSetSceneFlags(scene, flags);
         }
         device.check("rtcSetSceneBuildQuality")?;
@@ -555,7 +565,8 @@ mod tests {
 
     #[test]
     fn empty_scene_misses() {
-        let accel = EmbreeAccel::build(&[], Filtering::Unfiltered).unwrap();
+        let accel =
+            EmbreeAccel::build(&[], BuildQuality::default(), Filtering::Unfiltered).unwrap();
         let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
         assert_eq!(accel.intersect(&ray), None);
         assert!(!accel.occluded(&ray));
@@ -574,7 +585,12 @@ mod tests {
     /// callback and resumed once the query has returned, and the scene still works after.
     #[test]
     fn filter_panics_reach_the_caller() {
-        let accel = EmbreeAccel::build(&[facing_triangle()], Filtering::Filtered).unwrap();
+        let accel = EmbreeAccel::build(
+            &[facing_triangle()],
+            BuildQuality::default(),
+            Filtering::Filtered,
+        )
+        .unwrap();
         let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
         let panicking = |_, _, _| -> bool { panic!("the filter panicked") };
         for occlusion in [false, true] {
@@ -601,7 +617,12 @@ mod tests {
     #[test]
     #[should_panic(expected = "built without Filtering::Filtered")]
     fn filtered_query_needs_a_filterable_scene() {
-        let accel = EmbreeAccel::build(&[facing_triangle()], Filtering::Unfiltered).unwrap();
+        let accel = EmbreeAccel::build(
+            &[facing_triangle()],
+            BuildQuality::default(),
+            Filtering::Unfiltered,
+        )
+        .unwrap();
         let ray = Ray::new(Vec3A::ZERO, Vec3A::Z, 0.0, f32::INFINITY);
         accel.intersect_filtered(&ray, &|_, _, _| false);
     }
@@ -620,7 +641,8 @@ mod tests {
                 ]
             })
             .collect();
-        let accel = EmbreeAccel::build(&triangles, Filtering::Unfiltered).unwrap();
+        let accel =
+            EmbreeAccel::build(&triangles, BuildQuality::default(), Filtering::Unfiltered).unwrap();
         let bytes = accel.memory_bytes();
         assert!(bytes >= 1000 * 48, "{bytes}");
         assert!(bytes < 100 << 20, "{bytes}");
