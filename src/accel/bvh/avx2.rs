@@ -21,6 +21,37 @@ impl Lanes<8> for __m256 {
         // SAFETY: both are 32 bytes of eight f32, and every bit pattern is a valid f32.
         unsafe { std::mem::transmute::<__m256, [f32; 8]>(self) }
     }
+
+    #[inline(always)]
+    fn places(self, mask: u32) -> [u32; 8] {
+        // SAFETY: eight-lane distances only come from the 8-wide traversal, which runs only
+        // on CPUs with AVX2 (`BvhWidth::Eight`).
+        unsafe { places8(self, mask) }
+    }
+}
+
+/// `Lanes::places` with AVX2: the keys (`distance_key`) of lanes outside `mask` are made
+/// the least, so that they count for no lane, then each lane's key is compared with all.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn places8(t: __m256, mask: u32) -> [u32; 8] {
+    let lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let keys = _mm256_or_si256(
+        _mm256_and_si256(_mm256_castps_si256(t), _mm256_set1_epi32(!7)),
+        lanes,
+    );
+    let bits = _mm256_sllv_epi32(_mm256_set1_epi32(1), lanes);
+    let in_mask = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), bits), bits);
+    let keys = _mm256_blendv_epi8(_mm256_set1_epi32(i32::MIN), keys, in_mask);
+    let mut farther = _mm256_setzero_si256();
+    for other in 0..8 {
+        let key = _mm256_permutevar8x32_epi32(keys, _mm256_set1_epi32(other));
+        // Lanes where `other`'s key is larger get -1.
+        farther = _mm256_sub_epi32(farther, _mm256_cmpgt_epi32(key, keys));
+    }
+    let places = _mm256_blendv_epi8(_mm256_set1_epi32(7), farther, in_mask);
+    // SAFETY: both are 32 bytes of eight 32-bit integers.
+    unsafe { std::mem::transmute::<__m256i, [u32; 8]>(places) }
 }
 
 /// `BoxRay4` for eight boxes, with each slab computed as one fused bound · inv − origin · inv.

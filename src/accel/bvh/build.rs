@@ -373,14 +373,15 @@ pub(super) fn build<const W: usize, N: WideNode<W> + Copy + Send>(
         out.blocks.len() < TWO_BLOCKS_BIT as usize && out.nodes.len() < LEAF_BIT as usize,
         "too many nodes or leaf blocks"
     );
-    // Occlusion queries push the root too.
-    if stack_need + 1 > STACK_SIZE {
+    // Occlusion queries push the root too, and a closest-hit query's `descend` writes a
+    // whole node's children above the entries it keeps.
+    if stack_need + W > STACK_SIZE {
         return Err(Error::new(
             MLT_STATUS_INTERNAL_ERROR,
             format!(
                 "the BVH over these {} triangles needs a traversal stack of {} entries; at most {STACK_SIZE} are supported",
                 vertices.len(),
-                stack_need + 1
+                stack_need + W
             ),
         ));
     }

@@ -541,3 +541,60 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod ordering_tests {
+    use super::stack::Lanes;
+    use crate::sampling::Rng;
+
+    /// `places` against a sort: the entered lanes, farthest first (ties by lane, the lower
+    /// lane taken as farther only if its key says so), then the last place for the others.
+    fn check_places<const N: usize>(distances: [f32; N], mask: u32, places: [u32; N]) {
+        let mut entered: Vec<usize> = (0..N).filter(|lane| mask >> lane & 1 != 0).collect();
+        let key = |lane: usize| super::stack::distance_key(distances[lane], lane as u32);
+        entered.sort_by_key(|&lane| std::cmp::Reverse(key(lane)));
+        for (place, &lane) in entered.iter().enumerate() {
+            assert_eq!(
+                places[lane] as usize, place,
+                "{distances:?} {mask:#b} {places:?}"
+            );
+        }
+        for lane in (0..N).filter(|lane| mask >> lane & 1 == 0) {
+            assert_eq!(
+                places[lane] as usize,
+                N - 1,
+                "{distances:?} {mask:#b} {places:?}"
+            );
+        }
+    }
+
+    /// Distances with ties and zeros, as entry distances are (at least tmin = 0).
+    fn distances<const N: usize>(rng: &mut Rng) -> [f32; N] {
+        std::array::from_fn(|_| match (rng.uniform() * 4.0) as u32 {
+            0 => 0.0,
+            1 => 1.5,
+            _ => rng.uniform() * 100.0,
+        })
+    }
+
+    #[test]
+    fn places_order_entered_children_farthest_first() {
+        let mut rng = Rng::new(11, 0);
+        for _ in 0..2000 {
+            let mask = (rng.uniform() * 16.0) as u32;
+            let t = distances::<4>(&mut rng);
+            check_places(t, mask, glam::Vec4::from_array(t).places(mask));
+        }
+        #[cfg(target_arch = "x86_64")]
+        if super::BvhWidth::Eight.is_supported() {
+            for _ in 0..2000 {
+                let mask = (rng.uniform() * 256.0) as u32;
+                let t = distances::<8>(&mut rng);
+                // SAFETY: both are 32 bytes of eight f32.
+                let lanes =
+                    unsafe { std::mem::transmute::<[f32; 8], std::arch::x86_64::__m256>(t) };
+                check_places(t, mask, lanes.places(mask));
+            }
+        }
+    }
+}

@@ -2,7 +2,7 @@
 //! of the four children's boxes in one vector operation.
 
 use super::layout::{Node4, near_and_far_bounds};
-use super::stack::Lanes;
+use super::stack::{Lanes, distance_key};
 use crate::accel::ray::Ray;
 use glam::{Vec3A, Vec4};
 
@@ -52,6 +52,24 @@ impl Lanes<4> for Vec4 {
     #[inline(always)]
     fn lanes(self) -> [f32; 4] {
         self.to_array()
+    }
+
+    #[inline(always)]
+    fn places(self, mask: u32) -> [u32; 4] {
+        let t = self.to_array();
+        let keys: [i32; 4] = std::array::from_fn(|lane| distance_key(t[lane], lane as u32));
+        let mut farther = [0; 4];
+        for (other, &key) in keys.iter().enumerate() {
+            let entered = (mask >> other) & 1;
+            for (count, &lane_key) in farther.iter_mut().zip(&keys) {
+                *count += entered & (key > lane_key) as u32;
+            }
+        }
+        // Arithmetic rather than a branch on each lane.
+        std::array::from_fn(|lane| {
+            let outside = ((mask >> lane) & 1).wrapping_sub(1);
+            (farther[lane] & !outside) | (3 & outside)
+        })
     }
 }
 
