@@ -22,6 +22,16 @@ use crate::spectrum::Spectrum;
 use crate::texture::{Texture, TextureDesc};
 use glam::Vec3A;
 
+/// A ray query a render made, with the answer it got (see `Scene::record_queries`).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug)]
+pub enum RecordedQuery {
+    /// A closest-hit query (`Accel::intersect`).
+    ClosestHit { ray: Ray, hit: Option<Hit> },
+    /// An occlusion query (`Accel::occluded`).
+    Occluded { ray: Ray, occluded: bool },
+}
+
 /// Host-side description of a scene: plain arrays, as the C ABI passes them.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneDesc<'a> {
@@ -131,6 +141,12 @@ pub struct Scene {
     /// Whether some triangle's material is an alpha cut-out (`AlphaMode::Mask`): then ray
     /// queries test candidate hits against its alpha.
     has_cutouts: bool,
+    /// Whether ray queries leave the plain structure query for `closest_hit_slow` and
+    /// `blocked_slow`: `has_cutouts`, or a ray recording is on. One flag, so a normal query
+    /// tests exactly what it tested before recordings existed.
+    slow_queries: bool,
+    /// The ray recording `record_queries` started, if any (the overhead bench's).
+    recording: Option<Box<std::sync::Mutex<Vec<RecordedQuery>>>>,
     /// Internal triangle index → the host's triangle id.
     internal_to_input: Vec<u32>,
     /// Offset that moves ray origins off surfaces, scaled to the scene's coordinates.
@@ -363,6 +379,8 @@ impl Scene {
             accel,
             shading,
             has_cutouts,
+            slow_queries: has_cutouts,
+            recording: None,
             attributes,
             textures,
             materials: desc.materials.to_vec(),
@@ -445,23 +463,100 @@ impl Scene {
     /// The closest surface `ray` hits (internal triangle ids), through alpha cut-outs.
     #[inline]
     pub(crate) fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        if self.has_cutouts {
-            self.accel
-                .intersect_filtered(ray, &|triangle, u, v| self.is_solid(triangle, u, v))
+        if self.slow_queries {
+            self.closest_hit_slow(ray)
         } else {
             self.accel.intersect(ray)
         }
     }
 
+    /// `closest_hit` in a scene with alpha cut-outs or a ray recording.
+    #[inline(never)]
+    fn closest_hit_slow(&self, ray: &Ray) -> Option<Hit> {
+        let hit = if self.has_cutouts {
+            self.accel
+                .intersect_filtered(ray, &|triangle, u, v| self.is_solid(triangle, u, v))
+        } else {
+            self.accel.intersect(ray)
+        };
+        self.record(RecordedQuery::ClosestHit { ray: *ray, hit });
+        hit
+    }
+
     /// Whether a surface blocks `ray` within its interval, through alpha cut-outs.
     #[inline]
     pub(crate) fn blocked(&self, ray: &Ray) -> bool {
-        if self.has_cutouts {
+        if self.slow_queries {
+            self.blocked_slow(ray)
+        } else {
+            self.accel.occluded(ray)
+        }
+    }
+
+    /// `blocked` in a scene with alpha cut-outs or a ray recording.
+    #[inline(never)]
+    fn blocked_slow(&self, ray: &Ray) -> bool {
+        let occluded = if self.has_cutouts {
             self.accel
                 .occluded_filtered(ray, &|triangle, u, v| self.is_solid(triangle, u, v))
         } else {
             self.accel.occluded(ray)
+        };
+        self.record(RecordedQuery::Occluded {
+            ray: *ray,
+            occluded,
+        });
+        occluded
+    }
+
+    /// Appends `query` to the recording, if one is on.
+    fn record(&self, query: RecordedQuery) {
+        if let Some(recording) = &self.recording {
+            recording
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .push(query);
         }
+    }
+
+    /// Starts recording every ray query renders make of this scene (dropping an earlier
+    /// recording), for `take_recorded_queries`. Slows every query down (a lock and a push
+    /// each); renders without a recording pay nothing. Queries from several threads are
+    /// recorded in the order they take the lock. For the overhead bench
+    /// (`benches/overhead.rs`), which replays a render's rays through `accel`.
+    #[doc(hidden)]
+    pub fn record_queries(&mut self) {
+        self.recording = Some(Box::default());
+        self.slow_queries = true;
+    }
+
+    /// Stops the recording `record_queries` started and returns its queries in order (empty
+    /// when none was on).
+    #[doc(hidden)]
+    pub fn take_recorded_queries(&mut self) -> Vec<RecordedQuery> {
+        self.slow_queries = self.has_cutouts;
+        self.recording
+            .take()
+            .map(|recording| {
+                recording
+                    .into_inner()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+            })
+            .unwrap_or_default()
+    }
+
+    /// The acceleration structure renders query (`Accel::intersect` and `Accel::occluded`
+    /// directly, in a scene without alpha cut-outs), in internal triangle ids.
+    #[doc(hidden)]
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    /// Whether some material is an alpha cut-out: then queries are filtered, and a replay
+    /// through `accel`'s unfiltered queries would not answer as renders did.
+    #[doc(hidden)]
+    pub fn has_cutouts(&self) -> bool {
+        self.has_cutouts
     }
 
     /// The surface at barycentrics `barycentrics` of internal triangle `triangle`.
