@@ -9,8 +9,9 @@
 //! per node, whose boxes are tested with one AVX instruction per slab; elsewhere four, tested
 //! with SSE (or NEON) through glam's `Vec4`. Leaf blocks are tested with `Vec4` in both. Tests
 //! and benches can force the 4-wide tree with [`with_bvh_width`]. On the traversal bench
-//! (1 thread, closest hit) the 8-wide tree traces 1.3-1.6x the 4-wide's rays, 0.78-0.99x
-//! Embree 3's; its build takes the same time.
+//! (closest hit, 1 and 2 threads) the 8-wide tree traces 1.25-1.4x the 4-wide's rays,
+//! 0.99-1.07x Embree 3's on the room and 0.82-0.92x on the terrain; its build takes the same
+//! time.
 //!
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
