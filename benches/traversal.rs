@@ -46,7 +46,10 @@
 //! - `MLT_BENCH_PREVIEW=1`: also writes a shaded view of each scene through its camera to
 //!   `target/mlt-bench/traversal-SCENE.png`.
 //! - `MLT_BENCH_TRACERS`: comma-separated, of `mlt bvh`, `mlt bvh4`, `raw obvhs`, `mlt embree`,
-//!   `raw embree` (default all that the build and CPU have), e.g. to profile one.
+//!   `raw embree`, `mlt bvh embree-tree` (default all that the build and CPU have), e.g. to
+//!   profile one. `mlt bvh embree-tree` is mlt's traversal over a wide tree collapsed from
+//!   Embree's own binary SAH tree (`rtcBuildBVH`) instead of obvhs's: beside `mlt bvh` and
+//!   `mlt embree` it separates what the tree costs from what the traversal does.
 //! - `MLT_BENCH_QUALITIES`: comma-separated build qualities besides the default `high`, of
 //!   `medium`, `fast` (default none): each adds the tracers `mlt bvh QUALITY` and `mlt
 //!   embree QUALITY` (built at that `BuildQuality`), their build rows and a `QUALITY
@@ -503,7 +506,7 @@ fn tracer_names() -> Vec<&'static str> {
     }
     all.push("raw obvhs");
     if cfg!(feature = "embree") {
-        all.extend(["mlt embree", "raw embree"]);
+        all.extend(["mlt embree", "raw embree", EMBREE_TREE]);
         for &quality in &extra_qualities() {
             all.push(mlt_tracer_name(Backend::Embree, quality));
         }
@@ -519,8 +522,14 @@ fn tracer_names() -> Vec<&'static str> {
     all
 }
 
+/// The BVH's traversal over a wide tree collapsed from Embree's binary SAH tree instead of
+/// obvhs's (`BvhAccel::build_over_embree_tree`): with the same traversal as `mlt bvh`, the
+/// difference between the two is the tree's.
+const EMBREE_TREE: &str = "mlt bvh embree-tree";
+
 /// The ratios the table reports: (label, numerator tracer, denominator tracer).
 const RATIOS: &[(&str, &str, &str)] = &[
+    ("embree-tree/embree", EMBREE_TREE, "mlt embree"),
     ("bvh/obvhs", "mlt bvh", "raw obvhs"),
     ("embree/raw", "mlt embree", "raw embree"),
     ("bvh/embree", "mlt bvh", "mlt embree"),
@@ -920,6 +929,22 @@ fn main() {
                 at_qualities.push((mlt_tracer_name(backend, quality), accel));
             }
         }
+        #[cfg(feature = "embree")]
+        let embree_tree = tracer_names().contains(&EMBREE_TREE).then(|| {
+            let start = Instant::now();
+            let accel = Accel::Bvh(
+                mlt::accel::BvhAccel::build_over_embree_tree(&scene.triangles)
+                    .expect("the BVH builds over Embree's tree"),
+            );
+            build_rows.push(BuildRow {
+                scene: scene.name,
+                triangles: scene.triangles.len(),
+                backend: EMBREE_TREE,
+                seconds: start.elapsed().as_secs_f64(),
+                bytes: accel.memory_bytes(),
+            });
+            accel
+        });
         let mut tracers: Vec<Box<dyn Tracer + '_>> = vec![
             Box::new(MltTracer {
                 name: "mlt bvh",
@@ -940,6 +965,13 @@ fn main() {
         }
         #[cfg(feature = "embree")]
         {
+            if let Some(accel) = &embree_tree {
+                tracers.push(Box::new(MltTracer {
+                    name: EMBREE_TREE,
+                    accel,
+                    rays: &rays,
+                }));
+            }
             tracers.push(Box::new(MltTracer {
                 name: "mlt embree",
                 accel: &embree,

@@ -35,6 +35,14 @@ fn expectations() -> Vec<(String, i64)> {
         RTCRayHit { ray, hit }
         RTCIntersectContext { flags, filter, instID }
         RTCFilterFunctionNArguments { valid, geometryUserPtr, context, ray, hit, N }
+        RTCBuildPrimitive { lower_x, lower_y, lower_z, geomID, upper_x, upper_y, upper_z, primID }
+        RTCBounds { lower_x, lower_y, lower_z, align0, upper_x, upper_y, upper_z, align1 }
+        RTCBuildArguments {
+            byteSize, buildQuality, buildFlags, maxBranchingFactor, maxDepth, sahBlockSize,
+            minLeafSize, maxLeafSize, traversalCost, intersectionCost, bvh, primitives,
+            primitiveCount, primitiveArrayCapacity, createNode, setNodeChildren, setNodeBounds,
+            createLeaf, splitPrimitive, buildProgress, userPtr,
+        }
     }
     macro_rules! constants {
         ($($name:ident),* $(,)?) => {$(

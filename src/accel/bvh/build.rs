@@ -339,11 +339,24 @@ pub(super) fn build<const W: usize, N: WideNode<W> + Copy + Send>(
     // The 8-wide tree takes leaves of up to two blocks: on the terrain, 30% fewer nodes
     // (they average only ~4.3 children: the bottom nodes hold few leaves) and ~7% more
     // random rays per second; the room is unchanged.
-    let leaf_blocks = if W == 8 { 2 } else { 1 };
-    let params = build_params(quality, (leaf_blocks * WIDTH) as u32);
+    let params = build_params(quality, max_leaf::<W>());
     let bvh2 = build_bvh2_from_tris(&tris, params, &mut Duration::default());
+    build_over(&bvh2, vertices)
+}
+
+/// Triangles per leaf of the `W`-wide tree.
+pub(super) const fn max_leaf<const W: usize>() -> u32 {
+    let leaf_blocks = if W == 8 { 2 } else { 1 };
+    (leaf_blocks * WIDTH) as u32
+}
+
+/// The `W`-wide tree over the binary tree `bvh2` of `vertices`, as `build`.
+pub(super) fn build_over<const W: usize, N: WideNode<W> + Copy + Send>(
+    bvh2: &Bvh2,
+    vertices: &[[Vec3A; 3]],
+) -> Result<(WideTree<N>, Vec<u32>)> {
     let mut builder = Builder {
-        bvh2: &bvh2,
+        bvh2,
         plans: vec![[SlotPlan::default(); 8]; bvh2.nodes.len()],
         vertices,
     };

@@ -154,6 +154,30 @@ impl BvhAccel {
         Ok(BvhAccel { tree, build_order })
     }
 
+    /// Built 8-wide (or as wide as the CPU supports) over Embree's own binary SAH tree
+    /// instead of obvhs's: the traversal bench's diagnostic of tree against traversal.
+    #[cfg(feature = "embree")]
+    #[doc(hidden)]
+    pub fn build_over_embree_tree(vertices: &[[Vec3A; 3]]) -> Result<Self> {
+        let width = BvhWidth::best();
+        let (tree, build_order) = match width {
+            BvhWidth::Four => {
+                let bvh2 = super::embree::tree::binary_tree(vertices, build::max_leaf::<4>())?;
+                let (tree, order) = build::build_over(&bvh2, vertices)?;
+                (Tree::Four(tree), order)
+            }
+            #[cfg(target_arch = "x86_64")]
+            BvhWidth::Eight => {
+                let bvh2 = super::embree::tree::binary_tree(vertices, build::max_leaf::<8>())?;
+                let (tree, order) = build::build_over(&bvh2, vertices)?;
+                (Tree::Eight(tree), order)
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            BvhWidth::Eight => unreachable!("8-wide needs x86-64"),
+        };
+        Ok(BvhAccel { tree, build_order })
+    }
+
     /// Children per node.
     #[doc(hidden)]
     pub fn width(&self) -> BvhWidth {

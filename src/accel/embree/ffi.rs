@@ -212,3 +212,103 @@ unsafe extern "C" {
     );
     pub fn rtcOccluded1(scene: RTCScene, context: *mut RTCIntersectContext, ray: *mut RTCRay);
 }
+
+/// `struct RTCBuildPrimitive` (`rtcore_builder.h`).
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCBuildPrimitive {
+    pub lower_x: f32,
+    pub lower_y: f32,
+    pub lower_z: f32,
+    pub geomID: c_uint,
+    pub upper_x: f32,
+    pub upper_y: f32,
+    pub upper_z: f32,
+    pub primID: c_uint,
+}
+
+/// `struct RTCBounds` (`rtcore_common.h`).
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RTCBounds {
+    pub lower_x: f32,
+    pub lower_y: f32,
+    pub lower_z: f32,
+    pub align0: f32,
+    pub upper_x: f32,
+    pub upper_y: f32,
+    pub upper_z: f32,
+    pub align1: f32,
+}
+
+pub type RTCThreadLocalAllocator = *mut c_void;
+pub type RTCCreateNodeFunction = Option<
+    unsafe extern "C" fn(
+        allocator: RTCThreadLocalAllocator,
+        child_count: c_uint,
+        user_ptr: *mut c_void,
+    ) -> *mut c_void,
+>;
+pub type RTCSetNodeChildrenFunction = Option<
+    unsafe extern "C" fn(
+        node: *mut c_void,
+        children: *mut *mut c_void,
+        child_count: c_uint,
+        user_ptr: *mut c_void,
+    ),
+>;
+pub type RTCSetNodeBoundsFunction = Option<
+    unsafe extern "C" fn(
+        node: *mut c_void,
+        bounds: *mut *const RTCBounds,
+        child_count: c_uint,
+        user_ptr: *mut c_void,
+    ),
+>;
+pub type RTCCreateLeafFunction = Option<
+    unsafe extern "C" fn(
+        allocator: RTCThreadLocalAllocator,
+        primitives: *const RTCBuildPrimitive,
+        primitive_count: usize,
+        user_ptr: *mut c_void,
+    ) -> *mut c_void,
+>;
+
+/// `struct RTCBuildArguments` (`rtcore_builder.h`); the split and progress callbacks are
+/// never set.
+#[repr(C)]
+pub struct RTCBuildArguments {
+    pub byteSize: usize,
+    pub buildQuality: RTCBuildQuality,
+    pub buildFlags: c_int,
+    pub maxBranchingFactor: c_uint,
+    pub maxDepth: c_uint,
+    pub sahBlockSize: c_uint,
+    pub minLeafSize: c_uint,
+    pub maxLeafSize: c_uint,
+    pub traversalCost: f32,
+    pub intersectionCost: f32,
+    pub bvh: *mut c_void,
+    pub primitives: *mut RTCBuildPrimitive,
+    pub primitiveCount: usize,
+    pub primitiveArrayCapacity: usize,
+    pub createNode: RTCCreateNodeFunction,
+    pub setNodeChildren: RTCSetNodeChildrenFunction,
+    pub setNodeBounds: RTCSetNodeBoundsFunction,
+    pub createLeaf: RTCCreateLeafFunction,
+    pub splitPrimitive: Option<unsafe extern "C" fn()>,
+    pub buildProgress: Option<unsafe extern "C" fn()>,
+    pub userPtr: *mut c_void,
+}
+
+// The builder API, for the traversal bench's "mlt bvh over embree's tree" diagnostic.
+unsafe extern "C" {
+    pub fn rtcNewBVH(device: RTCDevice) -> *mut c_void;
+    pub fn rtcBuildBVH(args: *const RTCBuildArguments) -> *mut c_void;
+    pub fn rtcThreadLocalAlloc(
+        allocator: RTCThreadLocalAllocator,
+        bytes: usize,
+        align: usize,
+    ) -> *mut c_void;
+    pub fn rtcReleaseBVH(bvh: *mut c_void);
+}

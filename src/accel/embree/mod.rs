@@ -24,6 +24,7 @@
 
 #[doc(hidden)]
 pub mod ffi;
+pub(crate) mod tree;
 
 use super::ray::{Hit, Ray};
 use super::{BuildQuality, Filtering};
