@@ -9,7 +9,7 @@
 //!
 //! A body gets the box test as a closure rather than through a trait: a trait method cannot be
 //! `#[target_feature]` unless it is `unsafe` to call, whereas a closure written in `intersect8`
-//! or `occluded8` inherits their AVX2 and FMA. The bodies are `#[inline(always)]`, so each
+//! or `occluded8` inherits their target features. The bodies are `#[inline(always)]`, so each
 //! entry point gets its own copy, compiled with its features.
 
 #[cfg(target_arch = "x86_64")]
@@ -62,9 +62,10 @@ pub(super) fn occluded4(
     )
 }
 
-/// The closest hit in an 8-wide tree that `accept` keeps; for CPUs with AVX2 and FMA.
+/// The closest hit in an 8-wide tree that `accept` keeps; for CPUs with AVX2, FMA and the bit
+/// instructions (`BvhWidth::is_supported`).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 pub(super) fn intersect8(
     tree: &WideTree<Node8>,
     ray: &Ray,
@@ -83,10 +84,10 @@ pub(super) fn intersect8(
     )
 }
 
-/// Whether a hit `accept` keeps in an 8-wide tree blocks the ray; for CPUs with AVX2 and
-/// FMA.
+/// Whether a hit `accept` keeps in an 8-wide tree blocks the ray; for CPUs with AVX2, FMA and
+/// the bit instructions (`BvhWidth::is_supported`).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 pub(super) fn occluded8(
     tree: &WideTree<Node8>,
     ray: &Ray,
