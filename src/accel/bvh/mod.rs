@@ -12,8 +12,8 @@
 //! with SSE (or NEON) through glam's `Vec4`. Leaf blocks are tested with `Vec4` in both. Tests
 //! and benches can force the 4-wide tree with [`with_bvh_width`]. On the traversal bench
 //! (closest hit, 1 and 2 threads) the 8-wide tree traces 1.25-1.4x the 4-wide's rays,
-//! 0.99-1.07x Embree 3's on the room and 0.82-0.92x on the terrain; its build takes the same
-//! time.
+//! 0.95-1.11x Embree 3's on the room and 0.77-0.93x on the terrain (README, "Benchmarks");
+//! its build takes the same time.
 //!
 //! Triangles are numbered in leaf order, so a hit needs no indirection; the unused lanes of a
 //! block hold a zero triangle, whose test yields NaN and fails every comparison.
@@ -168,19 +168,19 @@ impl BvhAccel {
     #[cfg(feature = "embree")]
     #[doc(hidden)]
     pub fn build_over_embree_tree(vertices: &[[Vec3A; 3]]) -> Result<Self> {
-        let width = BvhWidth::best();
-        let (tree, build_order) = match width {
-            BvhWidth::Four => {
-                let bvh2 = super::embree::tree::binary_tree(vertices, build::max_leaf::<4>())?;
-                let (tree, order) = build::build_over(&bvh2, vertices)?;
-                (Tree::Four(tree), order)
-            }
+        fn over<const W: usize, N: layout::WideNode<W> + Copy + Send>(
+            vertices: &[[Vec3A; 3]],
+        ) -> Result<(WideTree<N>, Vec<u32>)> {
+            let bvh2 = super::embree::tree::binary_tree(vertices, build::max_leaf::<W>())?;
+            build::build_over(&bvh2, vertices)
+        }
+        if vertices.is_empty() {
+            return Self::build_with_width(vertices, BvhWidth::best(), BuildQuality::default());
+        }
+        let (tree, build_order) = match BvhWidth::best() {
+            BvhWidth::Four => over(vertices).map(|(tree, order)| (Tree::Four(tree), order))?,
             #[cfg(target_arch = "x86_64")]
-            BvhWidth::Eight => {
-                let bvh2 = super::embree::tree::binary_tree(vertices, build::max_leaf::<8>())?;
-                let (tree, order) = build::build_over(&bvh2, vertices)?;
-                (Tree::Eight(tree), order)
-            }
+            BvhWidth::Eight => over(vertices).map(|(tree, order)| (Tree::Eight(tree), order))?,
             #[cfg(not(target_arch = "x86_64"))]
             BvhWidth::Eight => unreachable!("8-wide needs x86-64"),
         };
@@ -378,6 +378,30 @@ mod tests {
     }
 
     fn matches_brute_force_at(width: BvhWidth) {
+        matches_brute_force_of(&format!("{width:?}"), |tris| {
+            let accel = BvhAccel::build_with_width(tris, width, BuildQuality::default()).unwrap();
+            assert_eq!(accel.width(), width);
+            accel
+        });
+    }
+
+    /// The traversal bench's diagnostic build over Embree's own binary tree answers as
+    /// testing every triangle does, as the default build does.
+    #[cfg(feature = "embree")]
+    #[test]
+    fn over_embrees_tree_matches_brute_force() {
+        matches_brute_force_of("over Embree's tree", |tris| {
+            BvhAccel::build_over_embree_tree(tris).unwrap()
+        });
+        let empty = BvhAccel::build_over_embree_tree(&[]).unwrap();
+        assert_eq!(
+            empty.intersect(&Ray::new(Vec3A::ZERO, Vec3A::X, 0.0, 1.0)),
+            None
+        );
+    }
+
+    /// `build` (over triangles) answers every query as testing every triangle does.
+    fn matches_brute_force_of(label: &str, build: impl Fn(&[[Vec3A; 3]]) -> BvhAccel) {
         let mut rng = Rng::new(5, 5);
         for count in [1, 3, 5, 9, 17, 40, 500, 5000] {
             let tris: Vec<[Vec3A; 3]> = (0..count)
@@ -390,8 +414,7 @@ mod tests {
                     ]
                 })
                 .collect();
-            let accel = BvhAccel::build_with_width(&tris, width, BuildQuality::default()).unwrap();
-            assert_eq!(accel.width(), width);
+            let accel = build(&tris);
             let mut sorted = accel.build_order.clone();
             sorted.sort_unstable();
             assert_eq!(sorted, (0..count as u32).collect::<Vec<_>>());
@@ -419,7 +442,7 @@ mod tests {
                         let p = a * (1.0 - h.u - h.v) + b * h.u + c * h.v;
                         assert!((p - (o + d * h.t)).length() < 1e-3);
                     }
-                    other => panic!("{width:?}, {count} triangles: mismatch {other:?}"),
+                    other => panic!("{label}, {count} triangles: mismatch {other:?}"),
                 }
                 assert_eq!(accel.occluded(&ray), best.is_some());
                 // A segment that ends before the closest hit is not blocked by it.
@@ -433,9 +456,9 @@ mod tests {
                 }
             }
             if count >= 500 {
-                assert!(hits > 1000, "{width:?}, {count} triangles: {hits} hits");
+                assert!(hits > 1000, "{label}, {count} triangles: {hits} hits");
             }
-            if width == BvhWidth::Eight && count == 5000 {
+            if accel.width() == BvhWidth::Eight && count == 5000 {
                 assert!(two_block_leaves(&accel) > 0, "two-block leaves are tested");
             }
         }

@@ -11,12 +11,15 @@ use obvhs::aabb::Aabb;
 use obvhs::bvh2::{Bvh2, node::Bvh2Node};
 use std::ffi::{c_uint, c_void};
 
+/// The most triangles a leaf may hold (the 8-wide tree's two blocks).
+const MAX_LEAF: usize = 8;
+
 /// A node or leaf as the callbacks build it in Embree's thread-local memory.
 #[repr(C)]
 struct Built {
     /// 0 for a node, else the number of primitives of a leaf.
     count: u32,
-    ids: [u32; 32],
+    ids: [u32; MAX_LEAF],
     children: [*mut Built; 2],
     bounds: [Aabb; 2],
 }
@@ -31,7 +34,7 @@ unsafe extern "C" fn create_node(
         let node = rtcThreadLocalAlloc(allocator, size_of::<Built>(), 32).cast::<Built>();
         node.write(Built {
             count: 0,
-            ids: [0; 32],
+            ids: [0; MAX_LEAF],
             children: [std::ptr::null_mut(); 2],
             bounds: [Aabb::empty(); 2],
         });
@@ -90,9 +93,13 @@ unsafe extern "C" fn create_leaf(
     }
 }
 
-/// Embree's high-quality binary SAH tree over `vertices`, with leaves of at most `max_leaf`
-/// triangles and the SAH counting them in blocks of four, as obvhs's `Bvh2`.
+/// Embree's high-quality binary SAH tree over `vertices` (at least one), with leaves of at most `max_leaf`
+/// (at most 8) triangles and the SAH counting them in blocks of four, as obvhs's `Bvh2`.
 pub fn binary_tree(vertices: &[[Vec3A; 3]], max_leaf: u32) -> Result<Bvh2> {
+    assert!(
+        (1..=MAX_LEAF as u32).contains(&max_leaf),
+        "leaves of 1 to {MAX_LEAF}"
+    );
     let device = Device::new()?;
     let mut primitives: Vec<RTCBuildPrimitive> = vertices
         .iter()
@@ -116,6 +123,7 @@ pub fn binary_tree(vertices: &[[Vec3A; 3]], max_leaf: u32) -> Result<Bvh2> {
     // tree has been copied out.
     unsafe {
         let bvh = rtcNewBVH(device.raw);
+        device.check_handle("rtcNewBVH", bvh)?;
         let args = RTCBuildArguments {
             byteSize: size_of::<RTCBuildArguments>(),
             buildQuality: RTC_BUILD_QUALITY_HIGH,
@@ -140,7 +148,10 @@ pub fn binary_tree(vertices: &[[Vec3A; 3]], max_leaf: u32) -> Result<Bvh2> {
             userPtr: std::ptr::null_mut(),
         };
         let root = rtcBuildBVH(&args).cast::<Built>();
-        device.check("rtcBuildBVH")?;
+        if let Err(error) = device.check_handle("rtcBuildBVH", root) {
+            rtcReleaseBVH(bvh);
+            return Err(error);
+        }
         let mut bvh2 = Bvh2::default();
         let root_box = vertices.iter().fold(Aabb::empty(), |mut b, [a, c, d]| {
             b.extend(*a);
