@@ -1,6 +1,7 @@
 //! The README and the pages of docs/ link to files and headings that exist: every relative
 //! link names a file of the repository, and every `#anchor` one of the target page's
-//! headings (as GitHub makes anchors of them). Reads files only; takes milliseconds.
+//! headings (as GitHub makes anchors of them). docs/layout.md's tree of `src/` names every
+//! source file there is, and no other. Reads files only; takes milliseconds.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -113,4 +114,58 @@ fn anchors_follow_github() {
         "the-embree-backend-optional"
     );
     assert_eq!(anchor("Jobs and Dask"), "jobs-and-dask");
+}
+
+/// The `.rs` files docs/layout.md's first code block names: a tree whose lines are a name
+/// (a folder ends in `/`; several files are separated by `, `), then its description after
+/// two spaces or more, each line indented under the folder it is in.
+fn layout_files() -> BTreeSet<String> {
+    let text = std::fs::read_to_string(crate_dir().join("docs/layout.md")).unwrap();
+    let block = text
+        .split("```text\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("docs/layout.md has a text block");
+    let mut folders: Vec<(usize, String)> = Vec::new();
+    let mut files = BTreeSet::new();
+    for line in block.lines() {
+        let indent = line.len() - line.trim_start().len();
+        let names = line.trim_start().split("  ").next().unwrap_or("");
+        folders.retain(|(folder_indent, _)| *folder_indent < indent);
+        let folder: String = folders.iter().map(|(_, name)| name.as_str()).collect();
+        for name in names.split(", ") {
+            let path = format!("{folder}{name}");
+            if name.ends_with('/') {
+                folders.push((indent, name.to_string()));
+            } else if name.ends_with(".rs") {
+                files.insert(path);
+            }
+        }
+    }
+    files
+}
+
+fn source_files(dir: &Path, files: &mut BTreeSet<String>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            source_files(&path, files);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let relative = path.strip_prefix(crate_dir()).unwrap();
+            files.insert(relative.to_string_lossy().replace('\\', "/"));
+        }
+    }
+}
+
+#[test]
+fn the_layout_names_every_source_file() {
+    let listed = layout_files();
+    let mut present = BTreeSet::new();
+    source_files(&crate_dir().join("src"), &mut present);
+    let unlisted: Vec<_> = present.difference(&listed).collect();
+    let gone: Vec<_> = listed.difference(&present).collect();
+    assert!(
+        unlisted.is_empty() && gone.is_empty(),
+        "docs/layout.md does not list {unlisted:?} and lists {gone:?}, which do not exist"
+    );
 }
