@@ -636,6 +636,29 @@ mod tests {
         );
     }
 
+    /// The committed header is what hosts compile against: its version macros must name this
+    /// crate's version, which is bumped whenever the C ABI grows.
+    #[test]
+    fn header_version_macros_match_the_crate() {
+        let header = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/include/mlt.h"))
+            .expect("include/mlt.h is readable");
+        let define = |name: &str| -> String {
+            let prefix = format!("#define {name} ");
+            let line = header
+                .lines()
+                .find(|line| line.starts_with(&prefix))
+                .unwrap_or_else(|| panic!("include/mlt.h defines {name}"));
+            line[prefix.len()..].trim().to_string()
+        };
+        let version = [
+            define("MLT_VERSION_MAJOR"),
+            define("MLT_VERSION_MINOR"),
+            define("MLT_VERSION_PATCH"),
+        ]
+        .join(".");
+        assert_eq!(version, env!("CARGO_PKG_VERSION"));
+    }
+
     #[test]
     fn status_strings_match_descriptions() {
         for status in [
