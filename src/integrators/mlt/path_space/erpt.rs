@@ -53,7 +53,7 @@ use super::{PathSpace, PathVertex};
 use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::{Bdpt, BdptScratch, CONNECTION_STREAM};
-use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
+use crate::integrators::camera_samples::{PassSchedule, PixelSamples};
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
