@@ -79,3 +79,38 @@ impl PartialEq for RenderRequest {
         self.settings == other.settings && self.camera == other.camera
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::MLT_MAX_THREADS;
+
+    #[test]
+    fn only_checked_values_make_a_request() {
+        let settings = RenderSettings::default();
+        let camera = Camera::default();
+        let request = ValidSettings::new(&settings)
+            .unwrap()
+            .with_camera(&camera)
+            .unwrap();
+        assert_eq!(*request.settings(), ValidSettings::new(&settings).unwrap());
+        let zero_width = RenderSettings {
+            width: 0,
+            ..settings
+        };
+        assert!(ValidSettings::new(&zero_width).is_err());
+        let no_view = Camera {
+            target: camera.eye,
+            ..camera
+        };
+        let valid = ValidSettings::new(&settings).unwrap();
+        assert!(valid.with_camera(&no_view).is_err());
+        // A job's own thread count is checked like any setting.
+        assert_eq!(request.with_threads(3).unwrap().settings().threads, 3);
+        let error = request.with_threads(MLT_MAX_THREADS + 1).unwrap_err();
+        assert!(
+            error.message.starts_with("settings.threads is"),
+            "{error:?}"
+        );
+    }
+}
