@@ -29,7 +29,7 @@ pub use types::*;
 
 use crate::accel::Backend;
 use crate::error::*;
-use crate::render::{self, StopReason};
+use crate::render::{self, StopReason, ValidSettings};
 use crate::scene::{
     Camera, EnvironmentDesc, LightsDesc, MLT_MAX_PUNCTUAL_LIGHTS, Scene, SceneDesc, SunDesc,
 };
@@ -512,8 +512,8 @@ pub unsafe extern "C" fn mlt_render_ex(
         } else {
             Some(unsafe { host_fields(stats_out, "stats_out") }?)
         };
-        settings.validate()?;
-        camera.validate()?;
+        let request = ValidSettings::new(&settings)?.with_camera(&camera)?;
+        let settings = request.settings();
         let needed = settings.output_len()?;
         if out_len < needed {
             return Err(Error::invalid(format!(
@@ -527,7 +527,8 @@ pub unsafe extern "C" fn mlt_render_ex(
             Some(callback) => unsafe { callback(fraction, user_data) },
             None => true,
         };
-        let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
+        let stats =
+            render::render_request(&handle.scene, &request, image, None, Some(&mut forward))?;
         if let Some(fields) = stats_fields {
             // SAFETY: checked by host_fields above; writable by the contract.
             unsafe { write_host(stats_out, fields, &stats_to_c(&stats)) };
