@@ -2,9 +2,12 @@
 //! allocations, up to the scheduling noise of rayon's internals (see below). A counting global
 //! allocator sees every thread's allocations.
 
-mod common;
+mod common {
+    pub mod scenes;
+}
 
-use common::*;
+use common::scenes::{furnace_camera, furnace_scene};
+
 use mlt::{Algorithm, RenderSettings, render};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};

@@ -3,9 +3,12 @@
 //! This checks light sampling (selection and area pdfs), BSDF sampling and their MIS weights
 //! against ground truth that does not depend on the renderer.
 
-mod common;
+mod common {
+    pub mod stats;
+}
 
-use common::*;
+use common::stats::{assert_within_and_sharp, mean_and_standard_error};
+
 use mlt::{Algorithm, Backend, Camera, Material, RenderSettings, Scene, SceneDesc, render};
 use std::f64::consts::PI;
 

@@ -20,10 +20,18 @@
 //! must agree within its statistical error.
 #![cfg(feature = "embree")]
 
-mod common;
+mod common {
+    pub mod generate;
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
 use common::generate::{MeshBuilder, bounce_ray, point_in_bounds, random_ray};
-use common::*;
+use common::references::{path_traced_estimate, render_image};
+use common::scenes::{Mesh, canonical_camera, canonical_mesh, cornell_box, cornell_camera};
+use common::stats::{Estimate, assert_estimates_agree};
+
 use glam::{DVec3, Vec3A};
 use mlt::accel::{BvhWidth, Hit, Ray, with_bvh_width};
 use mlt::sampling::Rng;

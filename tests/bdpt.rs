@@ -4,9 +4,16 @@
 //! resolvable). Light tracing splats land on arbitrary pixels; the image must still be
 //! identical for any thread count.
 
-mod common;
+mod common {
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::scenes::{furnace_camera, furnace_scene, furnace_truth, load_canonical};
+use common::stats::{
+    Estimate, assert_estimates_agree, assert_within_and_sharp, mean_and_standard_error,
+};
+
 use mlt::{Algorithm, Camera, RenderSettings, Scene, render};
 
 #[allow(clippy::too_many_arguments)]

@@ -5,7 +5,9 @@
 //! message naming it and leaves the outputs untouched; byte buffers are freed once, and a
 //! buffer mlt did not give is never freed.
 
-mod common;
+mod common {
+    pub mod scenes;
+}
 
 use mlt::capi::*;
 use mlt::error::*;
@@ -118,7 +120,7 @@ impl Drop for Scene {
 }
 
 /// A scene through `mlt_scene_create` from a mesh's arrays.
-fn create(mesh: &common::Mesh) -> Scene {
+fn create(mesh: &common::scenes::Mesh) -> Scene {
     let materials = mesh.c_materials();
     let mut desc = std::mem::MaybeUninit::<MltSceneDesc>::uninit();
     // SAFETY: writable memory for an MltSceneDesc.
@@ -143,7 +145,7 @@ fn create(mesh: &common::Mesh) -> Scene {
 
 /// tests/scenes/cornell-box.obj through the C ABI, and its camera.
 fn cornell() -> (Scene, MltCamera) {
-    let camera = common::cornell_camera();
+    let camera = common::scenes::cornell_camera();
     let c = MltCamera {
         eye: camera.eye,
         target: camera.target,
@@ -153,7 +155,7 @@ fn cornell() -> (Scene, MltCamera) {
         focus_distance: camera.focus_distance,
         ..default_camera()
     };
-    (create(&common::cornell_box()), c)
+    (create(&common::scenes::cornell_box()), c)
 }
 
 fn settings(algorithm: i32) -> MltRenderSettings {
@@ -1022,7 +1024,7 @@ fn job_bad_input() {
     assert!(is_sentinel(&out) && stats.samples == 77);
 
     // A scene built from other arrays (one vertex moved) is not the plan's.
-    let mut moved = common::cornell_box();
+    let mut moved = common::scenes::cornell_box();
     moved.positions[0] += 1e-3;
     let other = create(&moved);
     refuse(

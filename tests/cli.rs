@@ -619,7 +619,7 @@ fn write_hdr(path: &Path, width: u32, height: u32, rgb: [f32; 3]) {
 /// which changes nothing for a uniform sky); under a delta sun straight above of
 /// irradiance π it is 0.5 again (no noise but the pixel positions'), and under a sun disc
 /// given by its radiance too. The checks are loose (each image is one render of 8192
-/// samples); `tests/capi_bad_input.rs` checks the same scene to its standard error.
+/// samples); `tests/capi_images.rs` checks the same scene to its standard error.
 #[test]
 fn environment_and_sun_flags_light_the_scene() {
     let obj = ground_scene();

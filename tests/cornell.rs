@@ -4,9 +4,15 @@
 //! different estimator, on both Cornell scenes (the box and the glass one, whose caustics
 //! are reached only through specular chains) in `tests/bdpt.rs`.
 
-mod common;
+mod common {
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::references::{path_traced_estimate, path_traced_image};
+use common::scenes::load_canonical;
+use common::stats::rmse;
 
 const SIZE: u32 = 64;
 

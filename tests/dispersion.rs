@@ -13,9 +13,15 @@
 //! tracing and BDPT a 2% error in the luminance of the totals would leave them (both
 //! asserted).
 
-mod common;
+mod common {
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::references::render_image;
+use common::stats::{assert_within_and_sharp, luminance};
+
 use glam::DVec3;
 use mlt::{Algorithm, Backend, Camera, Material, RenderSettings, Scene, SceneDesc};
 

@@ -4,7 +4,9 @@
 //! `rtcInitIntersectContext` writes; each must equal its Rust counterpart.
 #![cfg(feature = "embree")]
 
-mod common;
+mod common {
+    pub mod compiler;
+}
 
 use mlt::accel::embree::ffi::*;
 use std::mem::{align_of, offset_of, size_of};
@@ -136,7 +138,7 @@ fn values_from_c(expressions: &[&str]) -> Vec<i64> {
     let source = dir.join("layout.c");
     let exe = dir.join("layout");
     std::fs::write(&source, c_program(expressions)).unwrap();
-    let mut cmd = common::compiler(false);
+    let mut cmd = common::compiler::compiler(false);
     cmd.args(["-std=c11", "-Wall", "-Werror"])
         .arg(&source)
         .arg("-o")

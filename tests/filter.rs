@@ -5,9 +5,16 @@
 //! mean by more than a stated bound (its bias: the mean over seeds of filtered − unfiltered,
 //! which needs no reference, since the unfiltered image is unbiased).
 
-mod common;
+mod common {
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::references::path_traced_image;
+use common::scenes::load_canonical;
+use common::stats::{luminance, mean, region_means, rmse};
+
 use mlt::{Algorithm, Camera, RenderSettings, Scene, render, render_with_unfiltered};
 
 fn both(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> (Vec<f32>, Vec<f32>) {

@@ -1,9 +1,16 @@
 //! Scene loaders and image writers of `mlt::io`.
 #![cfg(feature = "cli")]
 
-mod common;
+mod common {
+    pub mod door_ajar;
+    pub mod lamp_behind_glass;
+    pub mod obj_text;
+    pub mod sky_spheres;
+    pub mod window_room;
+}
 
 use common::{door_ajar, lamp_behind_glass, sky_spheres, window_room};
+
 use mlt::io::{self, IoError, SceneData};
 use mlt::{Material, MaterialKind, Scene};
 use std::path::{Path, PathBuf};

@@ -3,9 +3,12 @@
 //! exactly the image a render alone gets: four host threads rendering the same scene with
 //! four algorithms at once, each in its own order, match the serial renders bit for bit.
 
-mod common;
+mod common {
+    pub mod scenes;
+}
 
-use common::*;
+use common::scenes::load_canonical;
+
 use mlt::{Algorithm, RenderSettings, render};
 
 fn settings(algorithm: Algorithm) -> RenderSettings {
