@@ -19,37 +19,66 @@ use std::ptr::{null, null_mut};
 fn ray_queries_null_pointers() {
     let scene = HostScene::floor_and_light().create();
     let rays = [ray([0.0, 1.0, 0.0], [0.0, -1.0, 0.0])];
-    let mut hits = [SENTINEL_HIT];
-    let mut flags = [0xABu8];
-    // SAFETY: each call passes one NULL that must be rejected.
-    unsafe {
-        assert_invalid(
-            mlt_intersect(null(), rays.as_ptr(), 1, hits.as_mut_ptr()),
-            &["scene", "NULL"],
-        );
-        assert_invalid(
-            mlt_intersect(scene.0, null(), 1, hits.as_mut_ptr()),
-            &["rays", "NULL"],
-        );
-        assert_invalid(
-            mlt_intersect(scene.0, rays.as_ptr(), 1, null_mut()),
-            &["hits_out", "NULL"],
-        );
-        assert_invalid(
-            mlt_occluded(null(), rays.as_ptr(), 1, flags.as_mut_ptr()),
-            &["scene", "NULL"],
-        );
-        assert_invalid(
-            mlt_occluded(scene.0, null(), 1, flags.as_mut_ptr()),
-            &["rays", "NULL"],
-        );
-        assert_invalid(
-            mlt_occluded(scene.0, rays.as_ptr(), 1, null_mut()),
-            &["occluded_out", "NULL"],
-        );
-    }
-    assert_eq!(hits[0].triangle_id, SENTINEL_HIT.triangle_id);
-    assert_eq!(flags[0], 0xAB);
+    // A query with one ray, its output NULL or a sentinel: the status, and whether the
+    // sentinel is untouched.
+    let intersect = |scene: *const MltScene, rays: *const MltRay, output: bool| {
+        let mut hits = [SENTINEL_HIT];
+        let out = if output {
+            hits.as_mut_ptr()
+        } else {
+            null_mut()
+        };
+        // SAFETY: each pointer is valid for one element, or NULL, which mlt must refuse.
+        let status = unsafe { mlt_intersect(scene, rays, 1, out) };
+        (status, hits[0].triangle_id == SENTINEL_HIT.triangle_id)
+    };
+    let occluded = |scene: *const MltScene, rays: *const MltRay, output: bool| {
+        let mut flags = [0xABu8];
+        let out = if output {
+            flags.as_mut_ptr()
+        } else {
+            null_mut()
+        };
+        // SAFETY: as above.
+        let status = unsafe { mlt_occluded(scene, rays, 1, out) };
+        (status, flags[0] == 0xAB)
+    };
+    let (live, valid) = (scene.0.cast_const(), rays.as_ptr());
+    assert_calls_refused(
+        "NULL pointers of the ray queries",
+        vec![
+            (
+                "mlt_intersect scene",
+                Box::new(|| intersect(null(), valid, true)),
+                &["scene", "NULL"],
+            ),
+            (
+                "mlt_intersect rays",
+                Box::new(|| intersect(live, null(), true)),
+                &["rays", "NULL"],
+            ),
+            (
+                "mlt_intersect hits_out",
+                Box::new(|| intersect(live, valid, false)),
+                &["hits_out", "NULL"],
+            ),
+            (
+                "mlt_occluded scene",
+                Box::new(|| occluded(null(), valid, true)),
+                &["scene", "NULL"],
+            ),
+            (
+                "mlt_occluded rays",
+                Box::new(|| occluded(live, null(), true)),
+                &["rays", "NULL"],
+            ),
+            (
+                "mlt_occluded occluded_out",
+                Box::new(|| occluded(live, valid, false)),
+                &["occluded_out", "NULL"],
+            ),
+        ],
+    );
 }
 
 #[test]

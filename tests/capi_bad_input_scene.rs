@@ -74,69 +74,124 @@ fn released_and_foreign_scene_pointers_are_refused() {
         unsafe { mlt_bytes_release(&mut bytes) };
         plan
     };
+    // Each call that takes a scene: its status, and whether its outputs are untouched.
+    type Call<'a> = (
+        &'a str,
+        Box<dyn Fn(*mut MltScene) -> (MltStatus, bool) + 'a>,
+    );
+    let calls: [Call; 7] = [
+        (
+            "mlt_render_plan",
+            Box::new(|scene| {
+                let mut out = empty_bytes();
+                // SAFETY: every other pointer is valid; `scene` must be refused before use.
+                let status = unsafe { mlt_render_plan(scene, &camera, &settings, &mut out) };
+                (status, out.data.is_null())
+            }),
+        ),
+        (
+            "mlt_render_job",
+            Box::new(|scene| {
+                let mut out = empty_bytes();
+                // SAFETY: as above; `plan` holds `plan.len()` bytes.
+                let status = unsafe {
+                    mlt_render_job(
+                        scene,
+                        plan.as_ptr(),
+                        plan.len(),
+                        0,
+                        1,
+                        1,
+                        None,
+                        null_mut(),
+                        &mut out,
+                        null_mut(),
+                    )
+                };
+                (status, out.data.is_null())
+            }),
+        ),
+        (
+            "mlt_scene_get_info",
+            Box::new(|scene| {
+                let mut info = scene_info_default();
+                // SAFETY: as above.
+                let status = unsafe { mlt_scene_get_info(scene, &mut info) };
+                (status, info.triangle_count == 0)
+            }),
+        ),
+        (
+            "mlt_render",
+            Box::new(|scene| {
+                let mut image = vec![SENTINEL_F32; 48];
+                // SAFETY: as above; `image` holds the floats passed.
+                let status = unsafe {
+                    mlt_render(
+                        scene,
+                        &camera,
+                        &settings,
+                        image.as_mut_ptr(),
+                        image.len(),
+                        None,
+                        null_mut(),
+                    )
+                };
+                (status, image.iter().all(|&v| v == SENTINEL_F32))
+            }),
+        ),
+        (
+            "mlt_intersect",
+            Box::new(|scene| {
+                let mut hits = [SENTINEL_HIT];
+                // SAFETY: as above; one ray, one hit.
+                let status = unsafe { mlt_intersect(scene, rays.as_ptr(), 1, hits.as_mut_ptr()) };
+                (status, hits[0].triangle_id == SENTINEL_HIT.triangle_id)
+            }),
+        ),
+        (
+            "mlt_occluded",
+            Box::new(|scene| {
+                let mut flags = [0xABu8];
+                // SAFETY: as above; one ray, one flag.
+                let status = unsafe { mlt_occluded(scene, rays.as_ptr(), 1, flags.as_mut_ptr()) };
+                (status, flags[0] == 0xAB)
+            }),
+        ),
+        (
+            "mlt_scene_retain",
+            // SAFETY: `scene` must be refused before use.
+            Box::new(|scene| (unsafe { mlt_scene_retain(scene) }, true)),
+        ),
+    ];
+    let mut results = Vec::new();
     for (what, scene) in [
         ("released", released),
         ("foreign", stack),
         ("misaligned", odd),
         ("sentinel", sentinel_scene()),
     ] {
-        let mut image = vec![SENTINEL_F32; 48];
-        let mut hits = [SENTINEL_HIT];
-        let mut flags = [0xABu8];
-        let mut info = scene_info_default();
-        let (mut plan_out, mut partial_out) = (empty_bytes(), empty_bytes());
-        // SAFETY: every other pointer is valid; `scene` must be refused before use.
-        let statuses = unsafe {
-            [
-                mlt_render_plan(scene, &camera, &settings, &mut plan_out),
-                mlt_render_job(
-                    scene,
-                    plan.as_ptr(),
-                    plan.len(),
-                    0,
-                    1,
-                    1,
-                    None,
-                    null_mut(),
-                    &mut partial_out,
-                    null_mut(),
-                ),
-                mlt_scene_get_info(scene, &mut info),
-                mlt_render(
-                    scene,
-                    &camera,
-                    &settings,
-                    image.as_mut_ptr(),
-                    image.len(),
-                    None,
-                    null_mut(),
-                ),
-                mlt_intersect(scene, rays.as_ptr(), 1, hits.as_mut_ptr()),
-                mlt_occluded(scene, rays.as_ptr(), 1, flags.as_mut_ptr()),
-                mlt_scene_retain(scene),
-            ]
-        };
-        for status in statuses {
-            assert_invalid(status, &["scene", "not a live scene"]);
+        for (name, call) in &calls {
+            let (status, untouched) = call(scene);
+            let result = check_error(
+                status,
+                MLT_STATUS_INVALID_ARGUMENT,
+                &["scene", "not a live scene"],
+            )
+            .and_then(|()| ensure(untouched, "an output was written"));
+            results.push((format!("{what} scene: {name}"), result));
         }
-        assert!(
-            image.iter().all(|&v| v == SENTINEL_F32),
-            "{what}: image written"
-        );
-        assert_eq!(hits[0].triangle_id, SENTINEL_HIT.triangle_id, "{what}");
-        assert_eq!((flags[0], info.triangle_count), (0xAB, 0), "{what}");
-        assert!(
-            plan_out.data.is_null() && partial_out.data.is_null(),
-            "{what}: bytes written"
-        );
         // SAFETY: looked up, not dereferenced; ignored with a message.
         unsafe { mlt_scene_release(scene) };
-        assert!(
-            last_error().contains("not a live scene"),
-            "{what}: {}",
-            last_error()
-        );
+        let message = last_error();
+        results.push((
+            format!("{what} scene: mlt_scene_release"),
+            ensure(
+                message.contains("not a live scene"),
+                &format!("message {message:?}"),
+            ),
+        ));
     }
+    assert_all("pointers that are not live scenes", results);
     assert_eq!(word, 0, "a foreign pointer's memory was written");
     // SAFETY: NULL is refused by retain.
     assert_invalid(unsafe { mlt_scene_retain(null_mut()) }, &["scene", "NULL"]);
@@ -144,15 +199,28 @@ fn released_and_foreign_scene_pointers_are_refused() {
 
 #[test]
 fn scene_create_null_desc_or_out() {
-    let mut out = sentinel_scene();
-    // SAFETY: NULL desc must be rejected.
-    let status = unsafe { mlt_scene_create(null(), &mut out) };
-    assert_invalid(status, &["desc", "NULL"]);
-    assert_eq!(out, sentinel_scene());
     let host = HostScene::floor_and_light();
-    // SAFETY: NULL out must be rejected.
-    let status = unsafe { mlt_scene_create(&host.desc(), null_mut()) };
-    assert_invalid(status, &["out", "NULL"]);
+    assert_calls_refused(
+        "NULL pointers of mlt_scene_create",
+        vec![
+            (
+                "desc",
+                Box::new(|| {
+                    let mut out = sentinel_scene();
+                    // SAFETY: NULL desc must be rejected.
+                    let status = unsafe { mlt_scene_create(null(), &mut out) };
+                    (status, out == sentinel_scene())
+                }),
+                &["desc", "NULL"],
+            ),
+            (
+                "out",
+                // SAFETY: NULL out must be rejected.
+                Box::new(|| (unsafe { mlt_scene_create(&host.desc(), null_mut()) }, true)),
+                &["out", "NULL"],
+            ),
+        ],
+    );
 }
 
 /// Array pointers mlt must refuse before reading them: NULL with a length, misaligned, and
@@ -440,18 +508,31 @@ fn a_scene_of_only_degenerate_triangles_renders_black() {
 
 #[test]
 fn get_info_null_pointers() {
-    let mut info = MltSceneInfo {
-        triangle_count: 99,
-        ..scene_info_default()
-    };
-    // SAFETY: NULL must be rejected.
-    let status = unsafe { mlt_scene_get_info(null(), &mut info) };
-    assert_invalid(status, &["scene", "NULL"]);
-    assert_eq!(info.triangle_count, 99);
     let scene = HostScene::floor_and_light().create();
-    // SAFETY: NULL out must be rejected.
-    let status = unsafe { mlt_scene_get_info(scene.0, null_mut()) };
-    assert_invalid(status, &["out", "NULL"]);
+    assert_calls_refused(
+        "NULL pointers of mlt_scene_get_info",
+        vec![
+            (
+                "scene",
+                Box::new(|| {
+                    let mut info = MltSceneInfo {
+                        triangle_count: 99,
+                        ..scene_info_default()
+                    };
+                    // SAFETY: NULL must be rejected.
+                    let status = unsafe { mlt_scene_get_info(null(), &mut info) };
+                    (status, info.triangle_count == 99)
+                }),
+                &["scene", "NULL"],
+            ),
+            (
+                "out",
+                // SAFETY: NULL out must be rejected.
+                Box::new(|| (unsafe { mlt_scene_get_info(scene.0, null_mut()) }, true)),
+                &["out", "NULL"],
+            ),
+        ],
+    );
 }
 
 /// Every build quality builds (the scene info says which, with the structure's memory and
@@ -498,17 +579,13 @@ fn build_qualities() {
         }
     }
     assert_eq!(default_desc().build_quality, MLT_BUILD_QUALITY_HIGH);
-    for (value, text) in [(3, "3"), (-1, "-1"), (i32::MIN, "-2147483648")] {
-        let desc = MltSceneDesc {
-            build_quality: value,
-            ..host.desc()
-        };
-        pass(check_create_refused(
-            &desc,
-            MLT_STATUS_INVALID_ARGUMENT,
-            &["desc.build_quality", text, "MLT_BUILD_QUALITY_HIGH"],
-        ));
-    }
+    let cases = cases![d = host.desc();
+        d.build_quality = 3 => ["desc.build_quality", "3", "MLT_BUILD_QUALITY_HIGH"],
+        d.build_quality = -1 => ["desc.build_quality", "-1", "MLT_BUILD_QUALITY_HIGH"],
+        d.build_quality = i32::MIN
+            => ["desc.build_quality", "-2147483648", "MLT_BUILD_QUALITY_HIGH"],
+    ];
+    assert_create_refuses("build qualities", &cases, |d| *d);
     let older = MltSceneDesc {
         struct_size: earlier_size::<MltSceneDesc>(std::mem::offset_of!(
             MltSceneDesc,

@@ -169,6 +169,30 @@ pub fn assert_all(table: &str, results: impl IntoIterator<Item = (String, Check)
     );
 }
 
+/// One row of a table of calls mlt must refuse: what the call passes wrong, the call (its
+/// status, and whether it left its outputs untouched), and what the last error message must
+/// contain.
+pub type RefusedCall<'a> = (
+    &'a str,
+    Box<dyn Fn() -> (MltStatus, bool) + 'a>,
+    &'a [&'a str],
+);
+
+/// Makes every call of `calls`, each to be refused as an invalid argument with its outputs
+/// untouched, then fails listing each call that was not.
+#[track_caller]
+pub fn assert_calls_refused(table: &str, calls: Vec<RefusedCall>) {
+    assert_all(
+        table,
+        calls.into_iter().map(|(label, call, needles)| {
+            let (status, untouched) = call();
+            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, needles)
+                .and_then(|()| ensure(untouched, "an output was written on failure"));
+            (label.to_owned(), result)
+        }),
+    );
+}
+
 /// An aligned, non-null pointer value no allocation will ever have: the "untouched" marker
 /// for out-parameters that are pointers.
 pub fn sentinel_scene() -> *mut MltScene {
