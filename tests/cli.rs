@@ -1,4 +1,8 @@
-//! The `mlt-render` command line: a small render end to end, and one-line errors.
+//! The `mlt-render` command line end to end: small renders with each algorithm's flags and
+//! the summary they print, the filter and time-limit flags, the lights' flags (an
+//! environment map, a constant sky, a sun) lighting a quad as bright as they should, a scene
+//! without a camera framed and its camera printed, and every bad input, one table of them, a
+//! one-line error naming what is wrong.
 #![cfg(feature = "cli")]
 
 use std::path::{Path, PathBuf};

@@ -1,4 +1,7 @@
-//! Scene loaders and image writers of `mlt::io`.
+//! Scene loaders and image writers of `mlt::io`: OBJ/MTL, glTF and GLB (meshes, materials,
+//! textures, cameras, punctual lights), camera sidecars, environment maps and PFM, PNG and
+//! EXR read exactly as written; malformed files are errors naming the file and the problem;
+//! and the committed generated scenes are what their generators in tests/common/ write.
 #![cfg(feature = "cli")]
 
 mod common {
