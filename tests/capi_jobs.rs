@@ -6,26 +6,24 @@
 //! buffer mlt did not give is never freed.
 
 mod common {
+    pub mod capi;
     pub mod scenes;
 }
 
+use common::capi::{
+    SENTINEL_F32, assert_invalid, assert_ok, default_camera, default_settings, last_error,
+    render_stats_default,
+};
 use mlt::capi::*;
 use mlt::error::*;
 use mlt::jobs::MLT_MAX_JOBS;
 use mlt::render::{MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS};
-use std::ffi::{CStr, c_void};
+use std::ffi::c_void;
 use std::ptr::{null, null_mut};
 
 // ---------------------------------------------------------------------------------------
 // A C host's calls
 // ---------------------------------------------------------------------------------------
-
-fn last_error() -> String {
-    // SAFETY: mlt returns a NUL-terminated string valid until the next call on this thread.
-    unsafe { CStr::from_ptr(mlt_last_error_message()) }
-        .to_string_lossy()
-        .into_owned()
-}
 
 /// Asserts `status` and that the last error message contains every one of `needles`.
 #[track_caller]
@@ -49,49 +47,13 @@ fn assert_outcome((status, message): (MltStatus, String), expected: MltStatus, n
     }
 }
 
-#[track_caller]
-fn assert_invalid(status: MltStatus, needles: &[&str]) {
-    assert_status(status, MLT_STATUS_INVALID_ARGUMENT, needles);
-}
-
-#[track_caller]
-fn assert_ok(status: MltStatus) {
-    assert_status(status, MLT_STATUS_OK, &[]);
-    assert_eq!(last_error(), "", "a success clears the last error");
-}
-
-fn default_camera() -> MltCamera {
-    let mut c = std::mem::MaybeUninit::<MltCamera>::uninit();
-    // SAFETY: writable memory for an MltCamera.
-    assert_ok(unsafe { mlt_camera_init(c.as_mut_ptr(), size_of::<MltCamera>()) });
-    // SAFETY: initialized on success.
-    unsafe { c.assume_init() }
-}
-
-fn default_settings() -> MltRenderSettings {
-    let mut s = std::mem::MaybeUninit::<MltRenderSettings>::uninit();
-    // SAFETY: as above.
-    assert_ok(unsafe { mlt_render_settings_init(s.as_mut_ptr(), size_of::<MltRenderSettings>()) });
-    // SAFETY: initialized on success.
-    unsafe { s.assume_init() }
-}
-
-fn stats_default() -> MltRenderStats {
-    let mut s = MltRenderStats::default();
-    // SAFETY: writable memory of this size.
-    assert_ok(unsafe { mlt_render_stats_init(&mut s, size_of::<MltRenderStats>()) });
-    s
-}
-
 /// Stats a failing call must leave as they are.
 fn sentinel_stats() -> MltRenderStats {
     MltRenderStats {
         samples: 77,
-        ..stats_default()
+        ..render_stats_default()
     }
 }
-
-const SENTINEL_F32: f32 = -12345.0;
 
 /// An `MltBytes` a failing call must leave as it is: a pointer no allocation has.
 fn sentinel_bytes() -> MltBytes {
@@ -221,7 +183,7 @@ fn render(
     settings: &MltRenderSettings,
 ) -> (Vec<f32>, MltRenderStats) {
     let mut image = vec![SENTINEL_F32; image_len(settings)];
-    let mut stats = stats_default();
+    let mut stats = render_stats_default();
     // SAFETY: valid pointers; `image` holds the floats passed.
     let status = unsafe {
         mlt_render_ex(
@@ -700,7 +662,7 @@ fn a_cancelled_job_still_gives_its_partial_result_and_the_merge_says_so() {
     let (status, image, merged) = {
         let mut calls = 0u32;
         let mut other = Bytes::new();
-        let mut job_stats = stats_default();
+        let mut job_stats = render_stats_default();
         // SAFETY: as above.
         let status = unsafe {
             mlt_render_job(
