@@ -1,6 +1,8 @@
 //! No heap allocation per sample or mutation: a render with 10× the samples makes as many
 //! allocations, up to the scheduling noise of rayon's internals (see below). A counting global
 //! allocator sees every thread's allocations.
+//!
+//! Runs in about 2 s on 2 cores (`cargo test --test allocations`).
 
 mod common {
     pub mod scenes;

@@ -3,7 +3,7 @@
 //! message naming it, unused fields ignored, and a host built against the header before
 //! the lights getting none.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_bad_input_lights`).
 
 mod common {
     pub mod capi;

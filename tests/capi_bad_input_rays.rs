@@ -3,7 +3,7 @@
 //! is written; and their results follow the header's conventions (t in multiples of the
 //! direction, barycentrics in the host's vertex order, tmax inclusive).
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_bad_input_rays`).
 
 mod common {
     pub mod capi;

@@ -3,7 +3,7 @@
 //! neither the image nor the stats written; the limits themselves and extreme but finite
 //! cameras render.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_bad_input_render`).
 
 mod common {
     pub mod capi;

@@ -4,7 +4,7 @@
 //! by every call; degenerate triangles are accepted, counted and never hit; every build
 //! quality builds.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_bad_input_scene`).
 
 mod common {
     pub mod capi;

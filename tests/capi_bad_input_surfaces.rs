@@ -3,7 +3,7 @@
 //! every bad value, pointer and count refused with a message naming it, and hosts built
 //! against older headers getting the defaults of the fields they lack.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_bad_input_surfaces`).
 
 mod common {
     pub mod capi;

@@ -4,7 +4,7 @@
 //! the surfaces scene described through the C ABI renders bit-identically to the same scene
 //! described in Rust.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_images`).
 
 mod common {
     pub mod capi;

@@ -4,6 +4,8 @@
 //! order of the partial results; every bad argument is `MLT_STATUS_INVALID_ARGUMENT` with a
 //! message naming it and leaves the outputs untouched; byte buffers are freed once, and a
 //! buffer mlt did not give is never freed.
+//!
+//! Runs in under a second on 2 cores (`cargo test --test capi_jobs`).
 
 mod common {
     pub mod capi;

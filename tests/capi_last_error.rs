@@ -1,7 +1,7 @@
 //! `mlt_last_error_message()`'s life cycle: every kind of successful call clears it, and it
 //! belongs to the thread whose call failed.
 //!
-//! About TIME on 2 cores.
+//! Runs in under a second on 2 cores (`cargo test --test capi_last_error`).
 
 mod common {
     pub mod capi;

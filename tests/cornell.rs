@@ -3,6 +3,8 @@
 //! analytic ground truth in `tests/furnace.rs` and `tests/area_light.rs`, and BDPT, a
 //! different estimator, on both Cornell scenes (the box and the glass one, whose caustics
 //! are reached only through specular chains) in `tests/bdpt.rs`.
+//!
+//! Runs in about 2 s on 2 cores (`cargo test --test cornell`).
 
 mod common {
     pub mod references;

@@ -12,6 +12,8 @@
 //! Abbe number 10% higher moves the blue centroid out of those bounds, and for path
 //! tracing and BDPT a 2% error in the luminance of the totals would leave them (both
 //! asserted).
+//!
+//! Runs in about 16 s on 2 cores (`cargo test --test dispersion`).
 
 mod common {
     pub mod references;

@@ -3,6 +3,8 @@
 //! errors estimated from independent renders, whose pixels are correlated by the chains; a
 //! 2% bias resolvable), identical images for any thread count, and the chain settings
 //! mattering (a render whose chains moved is not the initial samples' image).
+//!
+//! Runs in about 35 s on 2 cores (`cargo test --test erpt`).
 
 mod common {
     pub mod door_ajar_reference;

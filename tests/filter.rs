@@ -4,6 +4,8 @@
 //! path-space MLT and ERPT against a path-traced reference, while moving no 4 × 4 region's
 //! mean by more than a stated bound (its bias: the mean over seeds of filtered − unfiltered,
 //! which needs no reference, since the unfiltered image is unbiased).
+//!
+//! Runs in about 9 s on 2 cores (`cargo test --test filter`).
 
 mod common {
     pub mod references;

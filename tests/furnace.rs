@@ -2,6 +2,8 @@
 //! radiance along every ray is exactly Le·Σ_{k=0..d} aᵏ at max depth d. The tolerances come
 //! from the estimator's own variance (4 standard errors of the image mean), and each test
 //! also checks that a 2% brightness error would be outside them.
+//!
+//! Runs in under a second on 2 cores (`cargo test --test furnace`).
 
 mod common {
     pub mod scenes;

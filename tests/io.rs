@@ -2,6 +2,8 @@
 //! textures, cameras, punctual lights), camera sidecars, environment maps and PFM, PNG and
 //! EXR read exactly as written; malformed files are errors naming the file and the problem;
 //! and the committed generated scenes are what their generators in tests/common/ write.
+//!
+//! Runs in under a second on 2 cores (`cargo test --test io`).
 #![cfg(feature = "cli")]
 
 mod common {

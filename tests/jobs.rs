@@ -2,6 +2,8 @@
 //! machine makes, for any number of jobs, any thread count per job and any order of the
 //! partial results; buffers that are corrupted, truncated, from another plan or another
 //! scene are refused.
+//!
+//! Runs in about 1 s on 2 cores (`cargo test --test jobs`).
 
 mod common {
     pub mod scenes;

@@ -4,6 +4,8 @@
 //! non-symmetric BSDF of shading normals from the other end), and each Metropolis algorithm
 //! against BDPT. Tolerances come from the spread of independent renders, and each check
 //! also asserts that a 2% brightness error would fail (`assert_estimates_agree`).
+//!
+//! Runs in about 27 s on 2 cores (`cargo test --test surfaces`).
 
 mod common {
     pub mod references;
