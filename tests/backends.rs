@@ -22,15 +22,18 @@
 
 mod common {
     pub mod generate;
+    pub mod obj_text;
     pub mod references;
     pub mod scenes;
     pub mod stats;
+    pub mod window_room;
 }
 
 use common::generate::{MeshBuilder, bounce_ray, point_in_bounds, random_ray};
 use common::references::{path_traced_estimate, render_image};
 use common::scenes::{Mesh, canonical_camera, canonical_mesh, cornell_box, cornell_camera};
 use common::stats::{Estimate, assert_estimates_agree};
+use common::window_room;
 
 use glam::{DVec3, Vec3A};
 use mlt::accel::{BvhWidth, Hit, Ray, with_bvh_width};
