@@ -18,6 +18,8 @@
 //! explained ones at most 1e-5 of the queries (edge-aimed rays excepted: they are built to
 //! disagree, to exercise the explanations). A render of cornell-box through both backends
 //! must agree within its statistical error.
+//!
+//! Built only with the `embree` feature: CI's Embree step runs it (`.ci/run`).
 #![cfg(feature = "embree")]
 
 mod common {

@@ -2,6 +2,8 @@
 //! header: a small C program prints the size, alignment and every field offset of the structs
 //! we pass to Embree, the enum values we use, the memory monitor's signature, and what the header's inline
 //! `rtcInitIntersectContext` writes; each must equal its Rust counterpart.
+//!
+//! Built only with the `embree` feature: CI's Embree step runs it (`.ci/run`).
 #![cfg(feature = "embree")]
 
 mod common {
