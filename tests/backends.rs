@@ -18,12 +18,25 @@
 //! explained ones at most 1e-5 of the queries (edge-aimed rays excepted: they are built to
 //! disagree, to exercise the explanations). A render of cornell-box through both backends
 //! must agree within its statistical error.
+//!
+//! Built only with the `embree` feature: CI's Embree step runs it (`.ci/run`).
 #![cfg(feature = "embree")]
 
-mod common;
+mod common {
+    pub mod generate;
+    pub mod obj_text;
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+    pub mod window_room;
+}
 
 use common::generate::{MeshBuilder, bounce_ray, point_in_bounds, random_ray};
-use common::*;
+use common::references::{path_traced_estimate, render_image};
+use common::scenes::{Mesh, canonical_camera, canonical_mesh, cornell_box, cornell_camera};
+use common::stats::{Estimate, assert_estimates_agree};
+use common::window_room;
+
 use glam::{DVec3, Vec3A};
 use mlt::accel::{BvhWidth, Hit, Ray, with_bvh_width};
 use mlt::sampling::Rng;

@@ -20,9 +20,20 @@
 //! --nocapture the_cached_reference` renders it anew with the same test and prints the
 //! constants.
 
-mod common;
+mod common {
+    pub mod door_ajar_reference;
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::door_ajar_reference;
+use common::references::render_image;
+use common::scenes::{canonical_camera, canonical_mesh, load_canonical};
+use common::stats::{
+    CachedEstimate, Estimate, assert_regions_agree, assert_within_and_sharp, luminance, mean,
+};
+
 use mlt::{Algorithm, NormalizationStats, RenderSettings, Scene, render};
 
 /// The door-ajar image's mean RGB (256 × 256 camera, max depth 5), BDPT's, cached with

@@ -13,9 +13,16 @@
 //! The module `install` (c_hosts/install.rs) installs the same library with CMake and builds
 //! hosts against the installed prefix through pkg-config and `find_package`.
 
-mod common;
+// The shared helpers by path: with a directory tests/c_hosts/ beside this file, rustfmt
+// would look for an inline `mod common`'s files there.
+#[path = "common/compiler.rs"]
+mod compiler;
 #[path = "c_hosts/install.rs"]
 mod install;
+#[path = "common/scenes.rs"]
+mod scenes;
+#[path = "common/stats.rs"]
+mod stats;
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -136,7 +143,7 @@ fn compile(
 ) -> PathBuf {
     let out = scratch_dir().join(exe_name);
     let _ = std::fs::remove_file(&out);
-    let mut cmd = common::compiler(as_cpp);
+    let mut cmd = compiler::compiler(as_cpp);
     cmd.args(["-Wall", "-Wextra", "-Werror", "-pedantic"])
         .args(flags)
         .arg(crate_dir().join("c_examples").join(source))
@@ -210,7 +217,7 @@ fn read_pfm(path: &Path) -> Pfm {
 fn reference() -> &'static [f32] {
     static IMAGE: OnceLock<Vec<f32>> = OnceLock::new();
     IMAGE.get_or_init(|| {
-        let scene = common::cornell_box().scene();
+        let scene = scenes::cornell_box().scene();
         let settings = mlt::RenderSettings {
             width: WIDTH,
             height: HEIGHT,
@@ -220,7 +227,7 @@ fn reference() -> &'static [f32] {
         let mut image = vec![0.0f32; (WIDTH * HEIGHT * 3) as usize];
         let stats = mlt::render(
             &scene,
-            &common::cornell_camera(),
+            &scenes::cornell_camera(),
             &settings,
             &mut image,
             None,
@@ -275,7 +282,7 @@ fn run_and_check(exe: &Path, name: &str) -> String {
 fn check_picture(image: &Pfm, name: &str) {
     let (w, h) = (image.width, image.height);
     let pixel = |x: usize, y: usize| &image.rgb[(y * w + x) * 3..(y * w + x) * 3 + 3];
-    let mean = common::mean(&image.rgb);
+    let mean = stats::mean(&image.rgb);
     // The Cornell box at the light's (17, 12, 4): the mean is roughly (0.19, 0.12, 0.036).
     assert!(
         (0.05..2.0).contains(&mean[0]) && mean[0] > mean[2],
@@ -507,9 +514,9 @@ fn sky_c_lights_a_scene_with_a_constant_environment() {
         assert!(stdout.contains("(converges to 0.5)"), "{stdout}");
         let image = read_pfm(&pfm_path);
         assert_eq!((image.width, image.height), (16, 16));
-        let (mean, error) = common::mean_and_standard_error(&image.rgb);
+        let (mean, error) = stats::mean_and_standard_error(&image.rgb);
         for c in 0..3 {
-            common::assert_within_and_sharp(
+            stats::assert_within_and_sharp(
                 &format!("{exe_name} channel {c}"),
                 mean[c],
                 0.5,
@@ -585,7 +592,7 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
 /// and BDPT.
 #[test]
 fn split_render_c_merges_three_jobs_into_the_bits_of_one_render() {
-    let scene = common::cornell_box().scene();
+    let scene = scenes::cornell_box().scene();
     for (exe_name, as_cpp, flags) in [
         ("split_render_c99", false, &["-std=c99"][..]),
         ("split_render_cpp", true, &["-x", "c++"][..]),
@@ -632,7 +639,7 @@ fn split_render_c_merges_three_jobs_into_the_bits_of_one_render() {
             let mut expected = vec![0.0f32; settings.output_len().unwrap()];
             mlt::render(
                 &scene,
-                &common::cornell_camera(),
+                &scenes::cornell_camera(),
                 &settings,
                 &mut expected,
                 None,

@@ -3,10 +3,18 @@
 //! analytic ground truth in `tests/furnace.rs` and `tests/area_light.rs`, and BDPT, a
 //! different estimator, on both Cornell scenes (the box and the glass one, whose caustics
 //! are reached only through specular chains) in `tests/bdpt.rs`.
+//!
+//! Runs in about 2 s on 2 cores (`cargo test --test cornell`).
 
-mod common;
+mod common {
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::references::{path_traced_estimate, path_traced_image};
+use common::scenes::load_canonical;
+use common::stats::rmse;
 
 const SIZE: u32 = 64;
 

@@ -2,9 +2,13 @@
 //! header: a small C program prints the size, alignment and every field offset of the structs
 //! we pass to Embree, the enum values we use, the memory monitor's signature, and what the header's inline
 //! `rtcInitIntersectContext` writes; each must equal its Rust counterpart.
+//!
+//! Built only with the `embree` feature: CI's Embree step runs it (`.ci/run`).
 #![cfg(feature = "embree")]
 
-mod common;
+mod common {
+    pub mod compiler;
+}
 
 use mlt::accel::embree::ffi::*;
 use std::mem::{align_of, offset_of, size_of};
@@ -136,7 +140,7 @@ fn values_from_c(expressions: &[&str]) -> Vec<i64> {
     let source = dir.join("layout.c");
     let exe = dir.join("layout");
     std::fs::write(&source, c_program(expressions)).unwrap();
-    let mut cmd = common::compiler(false);
+    let mut cmd = common::compiler::compiler(false);
     cmd.args(["-std=c11", "-Wall", "-Werror"])
         .arg(&source)
         .arg("-o")

@@ -2,10 +2,17 @@
 //! radiance along every ray is exactly Le·Σ_{k=0..d} aᵏ at max depth d. The tolerances come
 //! from the estimator's own variance (4 standard errors of the image mean), and each test
 //! also checks that a 2% brightness error would be outside them.
+//!
+//! Runs in under a second on 2 cores (`cargo test --test furnace`).
 
-mod common;
+mod common {
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::scenes::{furnace_camera, furnace_scene, furnace_scene_of, furnace_truth};
+use common::stats::{assert_within_and_sharp, mean_and_standard_error, rmse};
+
 use mlt::{Algorithm, Camera, Material, RenderSettings, render};
 
 const ALBEDO: [f32; 3] = [0.5, 0.7, 0.9];

@@ -2,10 +2,17 @@
 //! machine makes, for any number of jobs, any thread count per job and any order of the
 //! partial results; buffers that are corrupted, truncated, from another plan or another
 //! scene are refused.
+//!
+//! Runs in about 1 s on 2 cores (`cargo test --test jobs`).
 
-mod common;
+mod common {
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::scenes::{cornell_box, furnace_camera, furnace_scene, furnace_truth, load_canonical};
+use common::stats::{assert_within_and_sharp, mean_and_standard_error};
+
 use mlt::jobs::{self, PartialRender, RenderPlan};
 use mlt::{Algorithm, MltStatus, RenderSettings, StopReason};
 

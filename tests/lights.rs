@@ -7,12 +7,19 @@
 //! front. Tolerances come from the spread of independent renders (Student's t with their
 //! degrees of freedom), and each check also asserts that a 2% brightness error would fail.
 
-mod common;
+mod common {
+    pub mod obj_text;
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+    pub mod window_room;
+}
 
-use common::{
-    Estimate, Mesh, assert_estimates_agree, cached_estimate, canonical_camera, canonical_mesh,
-    inward_icosphere, render_image, window_room,
-};
+use common::references::{cached_estimate, render_image};
+use common::scenes::{Mesh, canonical_camera, canonical_mesh, inward_icosphere};
+use common::stats::{Estimate, assert_estimates_agree};
+use common::window_room;
+
 use mlt::{
     Algorithm, Backend, Camera, EnvironmentDesc, LightsDesc, Material, PunctualLight,
     RenderSettings, Scene, SunDesc,
@@ -365,7 +372,7 @@ fn spot_and_sun_box() -> (Scene, Camera) {
 
 /// The glTF spheres under the window room's sky and sun.
 fn sky_spheres_scene() -> (Scene, Camera) {
-    let data = mlt::io::load_scene(&common::scenes_dir().join("sky-spheres.gltf")).unwrap();
+    let data = mlt::io::load_scene(&common::scenes::scenes_dir().join("sky-spheres.gltf")).unwrap();
     let sky = window_room::sky_pixels();
     let mut desc = data.desc(Backend::Bvh);
     desc.lights = window_room::lights(&sky);

@@ -4,9 +4,24 @@
 //! renders; a 2% bias resolvable), identical images for any thread count, and a stopped
 //! render normalized by the mutations actually made.
 
-mod common;
+mod common {
+    pub mod door_ajar_reference;
+    pub mod references;
+    pub mod scenes;
+    pub mod stats;
+}
 
-use common::*;
+use common::door_ajar_reference;
+use common::references::{
+    bdpt_estimate, cached_estimate, open_reference, path_reference, path_traced_estimate,
+    render_image,
+};
+use common::scenes::{
+    OPEN_MAX_DEPTH, OPEN_SIZE, OpenLights, furnace_camera, furnace_scene, furnace_truth,
+    inward_icosphere, load_canonical, open_scene,
+};
+use common::stats::{Estimate, assert_estimates_agree, assert_within_and_sharp, mean};
+
 use mlt::{Algorithm, Camera, RenderSettings, Scene, StopReason, render};
 
 /// An algorithm with its direct pass (`direct_samples_per_mutation`); path-space MLT also

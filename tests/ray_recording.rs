@@ -1,9 +1,14 @@
 //! The overhead bench's ray recording (`Scene::record_queries`, hidden API), which
 //! `benches/overhead.rs` relies on to replay a render's very rays.
+//!
+//! Runs in under a second on 2 cores (`cargo test --test ray_recording`).
 
-mod common;
+mod common {
+    pub mod scenes;
+}
 
-use common::load_canonical;
+use common::scenes::load_canonical;
+
 use mlt::scene::RecordedQuery;
 
 /// The overhead bench's ray recording (`Scene::record_queries`): it records every query a

@@ -2,8 +2,10 @@
 //! written by `MLT_REGENERATE_DOOR_AJAR_REFERENCE=1 cargo test --test brightness --
 //! the_cached_reference`, which renders `SEEDS.len()` BDPT images of `SIZE`² pixels at
 //! `SPP` samples (max depth 5). Everything below `source` is generated.
+// Each test file and bench uses a part of these helpers.
+#![allow(dead_code)]
 
-use super::CachedEstimate;
+use super::stats::CachedEstimate;
 
 pub const SIZE: u32 = 128;
 pub const SPP: u32 = 128;

@@ -1,6 +1,8 @@
 //! Wavefront OBJ text for the scenes the tests generate (door-ajar, lamp-behind-glass):
 //! exact, platform-independent text, so the committed files can be compared with their
 //! generators.
+// Each test file and bench uses a part of these helpers.
+#![allow(dead_code)]
 
 use std::fmt::Write;
 

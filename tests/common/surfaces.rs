@@ -7,7 +7,7 @@
 //! and path tracing see the non-symmetric BSDF of shading normals from opposite ends) and
 //! once colour and emission vary across a triangle.
 
-use super::{Mesh, canonical_mesh};
+use super::scenes::{Mesh, canonical_mesh, inward_icosphere};
 use mlt::{
     Backend, Material, Scene, SceneDesc, TexelData, TextureDesc, TextureEncoding, TextureFilter,
     TextureRef, WrapMode,
@@ -162,7 +162,7 @@ pub fn surfaces_mesh() -> SurfacesMesh {
         ..Material::metallic_roughness([1.0; 3], 0.0, 0.25)
     });
     let (radius, center) = (70.0f32, [185.0f32, 165.0 + 70.0, 169.0]);
-    let (unit, inward) = super::inward_icosphere(1, 1.0);
+    let (unit, inward) = inward_icosphere(1, 1.0);
     let outward: Vec<u32> = inward
         .chunks_exact(3)
         .flat_map(|t| [t[0], t[2], t[1]])

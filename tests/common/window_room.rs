@@ -12,6 +12,8 @@
 //! Millimetres, y up. The room spans x ∈ [0, 4000], y ∈ [0, 2800], z ∈ [0, 5000]; the
 //! window is in the wall z = 5000, x ∈ [1600, 2400], y ∈ [1000, 1800]; a table stands in
 //! the sun's way.
+// Each test file and bench uses a part of these helpers.
+#![allow(dead_code)]
 
 use super::obj_text::{self, Obj};
 use mlt::{EnvironmentDesc, LightsDesc, SunDesc};
