@@ -590,7 +590,7 @@ impl Scene {
 
     /// A light picked by power and what it sends towards shading point `p`, in `channels`
     /// (`SceneLights::sample_li`).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn sample_li(
         &self,
         p: Vec3A,
