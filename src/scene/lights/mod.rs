@@ -807,9 +807,10 @@ impl SceneLights {
                 self.light_select_pdf(index),
             )),
             EmitterKind::Directional(index) => match &self.lights[index as usize] {
-                Light::Directional { irradiance, .. } => {
-                    Some((*irradiance, self.light_select_pdf(index)))
-                }
+                Light::Directional { irradiance, .. } => Some((
+                    channels.illuminant(irradiance.to_array()),
+                    self.light_select_pdf(index),
+                )),
                 _ => None,
             },
             EmitterKind::Infinite => Some((

@@ -344,7 +344,7 @@ impl PathSpace<'_> {
         let t = n - s;
         let light = &path[0];
         // Le towards x_1 (radiance; intensity for a point light, irradiance for a
-        // directional one) and x_0's density as a light sample (`sample_light`'s, the same as
+        // directional one) and x_0's density as a light sample (`sample_vertex`'s, the same as
         // `sample_emission`'s): per unit area on a triangle, in solid angle at infinity.
         let emitter = light.emitter();
         // A delta light cannot be hit: strategy s = 0 has no density (BDPT skips it).
@@ -734,6 +734,58 @@ mod tests {
                         "{label}: ({s}, {t}) at infinity {at_infinity} times"
                     );
                 }
+            }
+        }
+    }
+
+    /// The same in spectral mode for the lights whose emission is converted to the sampled
+    /// wavelengths on its own (not through a triangle's material): a point light, a
+    /// directional light and a delta sun under a constant sky, in the box without a ceiling.
+    #[test]
+    fn unweighted_contributions_match_bdpt_in_spectral_mode_with_lights_that_are_not_triangles() {
+        use crate::scene::{EnvironmentDesc, LightsDesc, PunctualLight, SunDesc};
+        let sky = [0.4f32, 0.5, 0.7];
+        let point = [PunctualLight::point([278.0, 400.0, 280.0], [4e4, 3e4, 2e4])];
+        let directional = [PunctualLight::directional(
+            [0.3, -1.0, 0.5],
+            [3.0, 1.5, 0.5],
+        )];
+        let delta_sun = SunDesc {
+            direction: [-0.2, 1.0, -0.4],
+            angular_radius_degrees: 0.0,
+            irradiance: [0.5, 2.0, 1.5],
+        };
+        let cases: [(&str, LightsDesc); 3] = [
+            (
+                "point",
+                LightsDesc {
+                    punctual: &point,
+                    ..Default::default()
+                },
+            ),
+            (
+                "directional",
+                LightsDesc {
+                    punctual: &directional,
+                    ..Default::default()
+                },
+            ),
+            (
+                "delta sun + sky",
+                LightsDesc {
+                    environment: Some(EnvironmentDesc::constant(&sky)),
+                    sun: Some(delta_sun),
+                    punctual: &[],
+                },
+            ),
+        ];
+        for (label, lights) in cases {
+            let (scene, camera) = open("cornell-box", lights);
+            let compared = compare_with_bdpt_in(label, &scene, &camera, 3, 2_000, true);
+            println!("{label}: {compared:?}");
+            for (s, t) in [(1, 2), (2, 2), (1, 3)] {
+                let (count, ..) = compared.get(&(s, t)).copied().unwrap_or_default();
+                assert!(count > 20, "{label}: ({s}, {t}) compared {count} times");
             }
         }
     }
