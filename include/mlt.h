@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 2
+#define MLT_VERSION_MINOR 3
 
 /**
  * Patch version.

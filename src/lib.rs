@@ -66,6 +66,11 @@ pub use texture::{
     TextureFilter, WrapMode,
 };
 
+/// The README's Rust example, run as a doctest so that it stays true to the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExample;
+
 // One scene serves renders and queries from many threads at once.
 const _: () = {
     const fn shareable<T: Send + Sync>() {}

@@ -218,9 +218,9 @@ brightness_tests!(pssmlt_bdpt, Algorithm::PssmltBdpt, 8);
 brightness_tests!(mmlt, Algorithm::Mmlt, 8);
 brightness_tests!(path_space_mlt, Algorithm::PathSpaceMlt, 8);
 
-/// The companion: with b from a bootstrap of a fixed size alone (as before issue 15; MMLT's
-/// large steps never count), 4× the work leaves the brightness error where it was, and the
-/// check above fails.
+/// The companion: with b from a bootstrap of a fixed size alone (as before b was estimated
+/// for the whole render; MMLT's large steps never count), 4× the work leaves the brightness
+/// error where it was, and the check above fails.
 #[test]
 fn with_a_fixed_bootstrap_alone_the_brightness_error_does_not_shrink() {
     let fixed = Normalization {

@@ -2,6 +2,7 @@
 //! against include/mlt.hpp, as C++17 and C++20) and the static library cargo built, runs
 //! them on a small image and checks their PFM output against the same render through the
 //! Rust API (rendering is deterministic given the seed, so they must agree bit for bit).
+//! The README's C and C++ examples are built and run too.
 //!
 //! Finding the library: `cargo test` builds the `mlt` lib target once with all its crate types
 //! (rlib, staticlib, cdylib), so `libmlt.a` sits next to this test's executable in
@@ -824,4 +825,57 @@ fn hosts_are_clean_under_valgrind_memcheck() {
             output.status,
         );
     }
+}
+
+/// The fenced code blocks of the README in `language`, in order.
+fn readme_blocks(language: &str) -> Vec<String> {
+    let readme = std::fs::read_to_string(crate_dir().join("README.md")).expect("README.md");
+    let fence = format!("```{language}\n");
+    let mut blocks = Vec::new();
+    let mut rest = readme.as_str();
+    while let Some(start) = rest.find(&fence) {
+        let body = &rest[start + fence.len()..];
+        let end = body.find("```").expect("a closed code block");
+        blocks.push(body[..end].to_string());
+        rest = &body[end..];
+    }
+    blocks
+}
+
+/// Builds the README's only example in `language` (as C, or as C++ in `std`), runs it and
+/// checks that it prints the centre pixel of its square light: radiance 1.
+fn readme_example_renders(language: &str, as_cpp: bool, std: &str) {
+    let blocks = readme_blocks(language);
+    assert_eq!(blocks.len(), 1, "the README has one {language} example");
+    let source = scratch_dir().join(format!("readme.{language}"));
+    std::fs::write(&source, &blocks[0]).unwrap();
+    // `compile` takes sources under c_examples/; an absolute path replaces that folder.
+    let exe = build(
+        source.to_str().unwrap(),
+        &format!("readme_{language}"),
+        as_cpp,
+        &[std],
+    );
+    let output = Command::new(&exe).output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "the README's {language} example failed ({}):\n{stdout}\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert!(
+        stdout.contains("centre pixel 1.000"),
+        "the README's {language} example printed:\n{stdout}"
+    );
+}
+
+#[test]
+fn readme_c_example_renders() {
+    readme_example_renders("c", false, "-std=c99");
+}
+
+#[test]
+fn readme_cpp_example_renders() {
+    readme_example_renders("cpp", true, "-std=c++17");
 }

@@ -29,7 +29,7 @@ pub use types::*;
 
 use crate::accel::Backend;
 use crate::error::*;
-use crate::render::{self, StopReason};
+use crate::render::{self, StopReason, ValidSettings};
 use crate::scene::{
     Camera, EnvironmentDesc, LightsDesc, MLT_MAX_PUNCTUAL_LIGHTS, Scene, SceneDesc, SunDesc,
 };
@@ -512,8 +512,8 @@ pub unsafe extern "C" fn mlt_render_ex(
         } else {
             Some(unsafe { host_fields(stats_out, "stats_out") }?)
         };
-        settings.validate()?;
-        camera.validate()?;
+        let request = ValidSettings::new(&settings)?.with_camera(&camera)?;
+        let settings = request.settings();
         let needed = settings.output_len()?;
         if out_len < needed {
             return Err(Error::invalid(format!(
@@ -527,7 +527,8 @@ pub unsafe extern "C" fn mlt_render_ex(
             Some(callback) => unsafe { callback(fraction, user_data) },
             None => true,
         };
-        let stats = render::render(&handle.scene, &camera, &settings, image, Some(&mut forward))?;
+        let stats =
+            render::render_request(&handle.scene, &request, image, None, Some(&mut forward))?;
         if let Some(fields) = stats_fields {
             // SAFETY: checked by host_fields above; writable by the contract.
             unsafe { write_host(stats_out, fields, &stats_to_c(&stats)) };
@@ -634,6 +635,29 @@ mod tests {
             env!("CARGO_PKG_VERSION"),
             format!("{MLT_VERSION_MAJOR}.{MLT_VERSION_MINOR}.{MLT_VERSION_PATCH}")
         );
+    }
+
+    /// The committed header is what hosts compile against: its version macros must name this
+    /// crate's version, which is bumped whenever the C ABI grows.
+    #[test]
+    fn header_version_macros_match_the_crate() {
+        let header = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/include/mlt.h"))
+            .expect("include/mlt.h is readable");
+        let define = |name: &str| -> String {
+            let prefix = format!("#define {name} ");
+            let line = header
+                .lines()
+                .find(|line| line.starts_with(&prefix))
+                .unwrap_or_else(|| panic!("include/mlt.h defines {name}"));
+            line[prefix.len()..].trim().to_string()
+        };
+        let version = [
+            define("MLT_VERSION_MAJOR"),
+            define("MLT_VERSION_MINOR"),
+            define("MLT_VERSION_PATCH"),
+        ]
+        .join(".");
+        assert_eq!(version, env!("CARGO_PKG_VERSION"));
     }
 
     #[test]

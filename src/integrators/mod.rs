@@ -1,7 +1,7 @@
 //! Light-transport estimators.
 
 pub mod bdpt;
-pub(crate) mod camera_passes;
+pub(crate) mod camera_samples;
 pub mod mlt;
 pub mod path;
 

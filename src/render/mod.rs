@@ -1,10 +1,10 @@
 //! Rendering: the driver that runs an integrator over the film in parallel, with progress
 //! reporting, cancellation and a time limit (`render`). What a render is asked for and its
-//! validation are in `settings`, what it reports in `stats`, and the pass of camera samples
-//! (path tracer, BDPT, a Metropolis render's direct pass) in `camera_pass`.
+//! validation are in `settings`, the proof that a request was checked where it entered in
+//! `request`, and what a render reports in `stats`.
 
-mod camera_pass;
 pub mod jobs;
+mod request;
 mod settings;
 mod stats;
 
@@ -20,6 +20,8 @@ use crate::error::{Error, MLT_STATUS_INTERNAL_ERROR, MLT_STATUS_OUT_OF_MEMORY, R
 use crate::film::{Film, FixedPoint, FixedRgb};
 use crate::filter::{FilterSettings, FilterStats};
 use crate::integrators::bdpt::Bdpt;
+use crate::integrators::camera_samples::{self, CameraSamplePasses};
+use crate::integrators::mlt::direct_pass::DirectPass;
 use crate::integrators::mlt::driver::{ChainStart, ChainTally, MetropolisOutcome, finish};
 use crate::integrators::mlt::path_space::{self, PathSpaceTarget, PerturbationSizes};
 use crate::integrators::mlt::primary_space::{MetropolisSettings, PrimarySpaceTarget};
@@ -27,7 +29,7 @@ use crate::integrators::mlt::pssmlt;
 use crate::integrators::mlt::targets::{BdptAllStrategies, BdptMultiplexed};
 use crate::integrators::path::PathTracer;
 use crate::scene::{Camera, CameraModel, Scene};
-use camera_pass::CameraSampleJob;
+pub(crate) use request::{RenderRequest, ValidSettings};
 use std::sync::atomic::Ordering;
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -64,7 +66,7 @@ impl Estimator<'_> {
 const DIRECT_PASS_DEPTHS: u32 = 2;
 
 /// The settings of a render's Metropolis chains, or of `share` of them.
-fn metropolis_settings(settings: &RenderSettings, share: JobShare) -> MetropolisSettings {
+fn metropolis_settings(settings: &ValidSettings, share: JobShare) -> MetropolisSettings {
     MetropolisSettings {
         mutations_per_pixel: settings.mutations_per_pixel,
         bootstrap_samples: settings.resolved_bootstrap_samples(),
@@ -82,7 +84,7 @@ impl Estimator<'_> {
     fn chain_start(
         &self,
         camera: &CameraModel,
-        settings: &RenderSettings,
+        settings: &ValidSettings,
         control: &Control,
     ) -> Option<ChainStart> {
         let chains = metropolis_settings(settings, JobShare::WHOLE);
@@ -128,7 +130,7 @@ impl Estimator<'_> {
     fn run(
         &self,
         camera: &CameraModel,
-        settings: &RenderSettings,
+        settings: &ValidSettings,
         direct: Option<&PathTracer>,
         share: JobShare,
         start: Option<&ChainStart>,
@@ -138,63 +140,41 @@ impl Estimator<'_> {
         let seed = settings.seed;
         let spp = settings.samples_per_pixel;
         let chains = metropolis_settings(settings, share);
-        // The direct pass keeps pace with the chains: after each round of mutations it
-        // catches up to its share of samples.
-        let ratio = settings.direct_samples_per_mutation;
-        let mut direct_job = direct.map(|direct| {
-            let total = ratio * settings.mutations_per_pixel;
-            let mut job = CameraSampleJob::new(direct, camera, seed, total, film).with_share(share);
-            job.run_until(film, control, 1);
-            job
+        let mut direct_pass = direct.map(|direct| {
+            DirectPass::start(
+                direct,
+                camera,
+                seed,
+                settings.direct_samples_per_mutation,
+                settings.mutations_per_pixel,
+                share,
+                film,
+                control,
+            )
         });
-        let mut keep_pace = |film: &mut Film, mutations_per_pixel: f64| {
-            if let Some(job) = direct_job.as_mut() {
-                let target = (ratio as f64 * mutations_per_pixel)
-                    .ceil()
-                    .min(u32::MAX as f64);
-                job.run_until(film, control, target as u32);
-            }
-        };
+        let direct_pass = direct_pass.as_mut();
         match *self {
             Estimator::Path(estimator) => {
-                CameraSampleJob::new(estimator, camera, seed, spp, film)
+                CameraSamplePasses::new(estimator, camera, seed, spp, film)
                     .with_share(share)
                     .run(film, control);
                 MetropolisOutcome::default()
             }
             Estimator::Bdpt(estimator) => {
-                CameraSampleJob::new(estimator, camera, seed, spp, film)
+                CameraSamplePasses::new(estimator, camera, seed, spp, film)
                     .with_share(share)
                     .run(film, control);
                 MetropolisOutcome::default()
             }
-            Estimator::Pssmlt(target) => pssmlt::run(
-                target,
-                camera,
-                &chains,
-                start,
-                film,
-                control,
-                &mut keep_pace,
-            ),
-            Estimator::Mmlt(target) => pssmlt::run(
-                target,
-                camera,
-                &chains,
-                start,
-                film,
-                control,
-                &mut keep_pace,
-            ),
-            Estimator::PssmltBdpt(target) => pssmlt::run(
-                target,
-                camera,
-                &chains,
-                start,
-                film,
-                control,
-                &mut keep_pace,
-            ),
+            Estimator::Pssmlt(target) => {
+                pssmlt::run(target, camera, &chains, start, film, control, direct_pass)
+            }
+            Estimator::Mmlt(target) => {
+                pssmlt::run(target, camera, &chains, start, film, control, direct_pass)
+            }
+            Estimator::PssmltBdpt(target) => {
+                pssmlt::run(target, camera, &chains, start, film, control, direct_pass)
+            }
             Estimator::PathSpaceMlt(bdpt) => {
                 let target = PathSpaceTarget {
                     bdpt: BdptAllStrategies(Bdpt {
@@ -209,15 +189,7 @@ impl Estimator<'_> {
                     perturb_in_sample_space: settings.perturb_in_sample_space,
                 };
                 let adapt = settings.adapt_mutation_weights;
-                path_space::run(
-                    &target,
-                    &chains,
-                    start,
-                    adapt,
-                    film,
-                    control,
-                    &mut keep_pace,
-                )
+                path_space::run(&target, &chains, start, adapt, film, control, direct_pass)
             }
             Estimator::Erpt(bdpt) => {
                 let erpt = path_space::ErptSettings {
@@ -273,6 +245,7 @@ pub fn render_with_unfiltered(
     )
 }
 
+/// The Rust entry: checks the request and the output buffers.
 fn render_into(
     scene: &Scene,
     camera: &Camera,
@@ -281,7 +254,7 @@ fn render_into(
     unfiltered_out: Option<&mut [f32]>,
     progress: Option<Progress>,
 ) -> Result<RenderStats> {
-    settings.validate()?;
+    let settings = ValidSettings::new(settings)?;
     let needed = settings.output_len()?;
     let shortest = rgb_out
         .len()
@@ -292,12 +265,27 @@ fn render_into(
             settings.width, settings.height
         )));
     }
-    let (film, mut stats, _) =
-        render_film(scene, camera, settings, JobShare::WHOLE, None, progress)?;
-    stats.filter = film.write_rgb(
+    let request = settings.with_camera(camera)?;
+    render_request(
+        scene,
+        &request,
         &mut rgb_out[..needed],
         unfiltered_out.map(|u| &mut u[..needed]),
-    );
+        progress,
+    )
+}
+
+/// Renders a checked request into `rgb_out` (and `unfiltered_out`), each exactly the
+/// image's floats.
+pub(crate) fn render_request(
+    scene: &Scene,
+    request: &RenderRequest,
+    rgb_out: &mut [f32],
+    unfiltered_out: Option<&mut [f32]>,
+    progress: Option<Progress>,
+) -> Result<RenderStats> {
+    let (film, mut stats, _) = render_film(scene, request, JobShare::WHOLE, None, progress)?;
+    stats.filter = film.write_rgb(rgb_out, unfiltered_out);
     Ok(stats)
 }
 
@@ -305,14 +293,12 @@ fn render_into(
 /// job of a split render (`jobs`) have in common. The stats' `filter` is left at zero.
 fn render_film(
     scene: &Scene,
-    camera: &Camera,
-    settings: &RenderSettings,
+    request: &RenderRequest,
     share: JobShare,
     start_from: Option<&ChainStart>,
     progress: Option<Progress>,
 ) -> Result<(Film, RenderStats, Option<ChainTally>)> {
-    settings.validate()?;
-    camera.validate()?;
+    let settings = request.settings();
     let own_pool;
     let pool = if settings.threads == 0 {
         shared_pool()?
@@ -326,11 +312,10 @@ fn render_film(
     let deadline = (settings.time_limit_seconds > 0.0)
         .then(|| start + Duration::from_secs_f64(settings.time_limit_seconds));
     let control = Control::new(deadline, settings.algorithm.is_metropolis());
-    let model = camera.model(settings.width, settings.height);
-    model.validate()?;
+    let model = request.model();
     with_estimator(scene, settings, |estimator, direct| {
         run_estimator(
-            scene, settings, share, start_from, progress, estimator, direct, pool, threads, &model,
+            scene, settings, share, start_from, progress, estimator, direct, pool, threads, model,
             control, start,
         )
     })
@@ -338,11 +323,8 @@ fn render_film(
 
 /// The bootstrap and chain seeds of a Metropolis render (`None` for the other algorithms),
 /// made once by a split render's plan (`jobs::plan`) for all its jobs.
-fn plan_chain_start(
-    scene: &Scene,
-    camera: &Camera,
-    settings: &RenderSettings,
-) -> Result<Option<ChainStart>> {
+fn plan_chain_start(scene: &Scene, request: &RenderRequest) -> Result<Option<ChainStart>> {
+    let settings = request.settings();
     if !settings.algorithm.is_metropolis() {
         return Ok(None);
     }
@@ -356,9 +338,9 @@ fn plan_chain_start(
     let deadline = (settings.time_limit_seconds > 0.0)
         .then(|| Instant::now() + Duration::from_secs_f64(settings.time_limit_seconds));
     let control = Control::new(deadline, true);
-    let model = camera.model(settings.width, settings.height);
+    let model = request.model();
     with_estimator(scene, settings, |estimator, _| {
-        Ok(pool.install(|| estimator.chain_start(&model, settings, &control)))
+        Ok(pool.install(|| estimator.chain_start(model, settings, &control)))
     })
 }
 
@@ -366,7 +348,7 @@ fn plan_chain_start(
 /// them to `f`.
 fn with_estimator<R>(
     scene: &Scene,
-    settings: &RenderSettings,
+    settings: &ValidSettings,
     f: impl FnOnce(&Estimator, Option<&PathTracer>) -> Result<R>,
 ) -> Result<R> {
     // A Metropolis render with a direct pass leaves the shortest paths to a path tracer
@@ -432,7 +414,7 @@ fn with_estimator<R>(
 #[allow(clippy::too_many_arguments)]
 fn run_estimator(
     scene: &Scene,
-    settings: &RenderSettings,
+    settings: &ValidSettings,
     share: JobShare,
     start_from: Option<&ChainStart>,
     progress: Option<Progress>,
@@ -468,9 +450,9 @@ fn run_estimator(
         let rows = if settings.algorithm == Algorithm::Erpt {
             path_space::ERPT_BAND_ROWS
         } else {
-            camera_pass::ROWS
+            camera_samples::BAND_ROWS
         };
-        settings.samples_per_pixel as u64 * camera_pass::pixels_in_share(model, share, rows)
+        settings.samples_per_pixel as u64 * camera_samples::pixels_in_share(model, share, rows)
     };
 
     let mut progress = progress;
@@ -575,7 +557,7 @@ impl Drop for SignalOnDrop<'_> {
 
 /// Allocates the film (with a layer for each of `chain_groups` groups of Metropolis chains),
 /// reporting failure as a status instead of aborting.
-fn try_film(settings: &RenderSettings, chain_groups: usize, scene: &Scene) -> Result<Film> {
+fn try_film(settings: &ValidSettings, chain_groups: usize, scene: &Scene) -> Result<Film> {
     let (width, height) = (settings.width, settings.height);
     let pixels = width as usize * height as usize;
     // Probe the largest allocations first: `vec!` would abort the process on failure.

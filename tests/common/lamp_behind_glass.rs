@@ -3,8 +3,8 @@
 //! Next-event estimation cannot see the lamp through the glass, so a path tracer finds it
 //! only when a scattered ray happens to pass through the cover and hit its small emitter:
 //! rare, bright samples that make the normalization of PSSMLT heavy-tailed, while light
-//! tracing (BDPT) follows the light out through the glass. The case of issue 15: light that
-//! reaches the camera only through a specular path.
+//! tracing (BDPT) follows the light out through the glass. The hard case for a fixed
+//! bootstrap: light that reaches the camera only through a specular path.
 //!
 //! Written as tests/scenes/lamp-behind-glass.{obj,mtl,camera.json} by this generator, like
 //! door-ajar; `tests/io.rs` checks the committed files are what it writes

@@ -31,6 +31,7 @@
 //! rounds; within a round they run in parallel, each recording its deposits, which are added
 //! to the film in chain order after the round.
 
+use super::direct_pass::DirectPass;
 use super::normalization::{Moments, NormalizationEstimate, NormalizationPass, NormalizationStats};
 use super::primary_space::{MetropolisSettings, PathSample, PrimarySpaceTarget, new_sampler};
 use super::pss::PssSampler;
@@ -469,14 +470,14 @@ impl ChainPlan {
 }
 
 /// The end of a render whose bootstrap found no light reaching the camera: the chains'
-/// image is black and their mutations count as done; another pass still takes its share.
+/// image is black and their mutations count as done; the direct pass still takes its share.
 pub(crate) fn finish_without_light(
     camera: &CameraModel,
     settings: &MetropolisSettings,
     bootstrap: &NormalizationEstimate,
     film: &mut Film,
     control: &Control,
-    after_round: &mut dyn FnMut(&mut Film, f64),
+    direct: Option<&mut DirectPass>,
 ) -> MetropolisOutcome {
     let pixels = camera.width as u64 * camera.height as u64;
     // A job of a split render counts its share.
@@ -492,7 +493,9 @@ pub(crate) fn finish_without_light(
     } else {
         f64::INFINITY
     };
-    after_round(film, mutations_per_pixel);
+    if let Some(direct) = direct {
+        direct.keep_pace(film, control, mutations_per_pixel);
+    }
     MetropolisOutcome {
         normalization: bootstrap.stats(),
         tally: Some(ChainTally::without_chains(bootstrap.clone())),
@@ -631,8 +634,8 @@ where
 
 /// Runs `chains` in rounds, every chain making the same number of mutations, adds their
 /// deposits to the film after each round (each chain's into its group's layer), lets each
-/// chain's share of the normalization pass catch up with it, and returns what they did with
-/// the mutations each chain made in all.
+/// chain's share of the normalization pass and the direct pass (if any) catch up with them,
+/// and returns what they did with the mutations each chain made in all.
 ///
 /// The first round, about one mutation per pixel, always runs, so a stopped render still
 /// has an image. `done_before`: mutations per chain made in an earlier phase of the render
@@ -649,7 +652,7 @@ pub(crate) fn run_rounds<C: MarkovChain, N: PrimarySpaceTarget>(
     normalization: &mut NormalizationPass<N>,
     film: &mut Film,
     control: &Control,
-    after_round: &mut dyn FnMut(&mut Film, f64),
+    mut direct: Option<&mut DirectPass>,
 ) -> (MetropolisOutcome, u64)
 where
     N::Scratch: Send,
@@ -709,10 +712,10 @@ where
             film.add_weighted_splats(&chain.deposits.independent, independent_weight, buffer);
         }
         normalization.deposit_round(film);
-        after_round(
-            film,
-            made as f64 * plan.chain_count as f64 / plan.pixels as f64,
-        );
+        if let Some(direct) = direct.as_deref_mut() {
+            let mutations_per_pixel = made as f64 * plan.chain_count as f64 / plan.pixels as f64;
+            direct.keep_pace(film, control, mutations_per_pixel);
+        }
     }
 
     let mut outcome = MetropolisOutcome {

@@ -1,6 +1,7 @@
 //! Metropolis light transport: Markov chains whose states are light paths (or the random
 //! numbers that generate them), accepted with the Metropolis–Hastings rule.
 
+pub(crate) mod direct_pass;
 pub mod driver;
 pub mod image_chain;
 pub mod normalization;

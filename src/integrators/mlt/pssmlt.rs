@@ -4,6 +4,7 @@
 //! (`driver`) bootstraps, seeds and runs them.
 
 use super::acceptance;
+use super::direct_pass::DirectPass;
 use super::driver::{
     ChainPlan, ChainStart, Deposits, MarkovChain, MetropolisOutcome, WeightedChain, deposit,
     finish_without_light, restart_as_bootstrap, run_rounds, tally,
@@ -195,8 +196,7 @@ fn balance_weights(
     (offsets, weights)
 }
 
-/// Runs the chains. `after_round(film, mutations per pixel so far)` is called after each round
-/// of mutations, to let another pass keep pace.
+/// Runs the chains, and the direct pass alongside them if the render has one.
 pub(crate) fn run<T: PrimarySpaceTarget>(
     target: &T,
     camera: &CameraModel,
@@ -204,7 +204,7 @@ pub(crate) fn run<T: PrimarySpaceTarget>(
     start: Option<&ChainStart>,
     film: &mut Film,
     control: &Control,
-    after_round: &mut dyn FnMut(&mut Film, f64),
+    direct: Option<&mut DirectPass>,
 ) -> MetropolisOutcome
 where
     T::Scratch: Send,
@@ -213,7 +213,7 @@ where
     // with max_depth 1) has no paths for chains: the image is the other passes' alone.
     if target.groups() == 0 {
         let nothing = NormalizationEstimate::new(0);
-        return finish_without_light(camera, settings, &nothing, film, control, after_round);
+        return finish_without_light(camera, settings, &nothing, film, control, direct);
     }
     // 1. Bootstrap (or its result, made by a split render's plan).
     let n = settings.bootstrap_samples as u64;
@@ -224,7 +224,7 @@ where
     let b = boot.estimate.b();
     let normalization: f64 = b.iter().sum();
     if normalization <= 0.0 || !normalization.is_finite() {
-        return finish_without_light(camera, settings, &boot.estimate, film, control, after_round);
+        return finish_without_light(camera, settings, &boot.estimate, film, control, direct);
     }
 
     // 2. Chains, allotted to groups and seeded from resampled bootstrap samples; a job of
@@ -298,7 +298,7 @@ where
         &mut pass,
         film,
         control,
-        after_round,
+        direct,
     );
     outcome.tally = Some(tally(film, pass, &chains, &plan, settings, made));
     outcome

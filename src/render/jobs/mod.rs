@@ -18,6 +18,7 @@
 //! partial result names its plan's id and its job. A buffer from another plan, scene or
 //! version, a corrupted or truncated one, a job missing or given twice, is an error.
 
+use super::request::{RenderRequest, ValidSettings};
 use super::{
     JobShare, Progress, RenderSettings, RenderStats, StopReason, plan_chain_start, render_film,
 };
@@ -41,8 +42,8 @@ pub const MLT_MAX_JOBS: u32 = 1 << 16;
 /// What a split render is: made once by [`plan`], handed to every job and to the merge.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderPlan {
-    settings: RenderSettings,
-    camera: Camera,
+    /// The settings and camera, checked.
+    request: RenderRequest,
     /// `Scene::fingerprint` of the scene the plan was made for.
     scene: u64,
     /// A Metropolis render's bootstrap and chain seeds, made once for every job.
@@ -55,14 +56,11 @@ pub struct RenderPlan {
 /// For the Metropolis algorithms it runs the bootstrap (with `settings.threads`, within the
 /// time limit) and fixes every chain's group and seed, so the jobs need not repeat it.
 pub fn plan(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result<RenderPlan> {
-    settings.validate()?;
-    camera.validate()?;
-    camera.model(settings.width, settings.height).validate()?;
+    let request = ValidSettings::new(settings)?.with_camera(camera)?;
     let mut plan = RenderPlan {
-        settings: *settings,
-        camera: *camera,
+        request,
         scene: scene.fingerprint(),
-        chain_start: plan_chain_start(scene, camera, settings)?,
+        chain_start: plan_chain_start(scene, &request)?,
         id: 0,
     };
     let mut w = Writer::default();
@@ -73,11 +71,11 @@ pub fn plan(scene: &Scene, camera: &Camera, settings: &RenderSettings) -> Result
 
 impl RenderPlan {
     pub fn settings(&self) -> &RenderSettings {
-        &self.settings
+        self.request.settings()
     }
 
     pub fn camera(&self) -> &Camera {
-        &self.camera
+        self.request.camera()
     }
 
     /// Identifies the plan: a hash of its contents, named by its partial results.
@@ -100,33 +98,45 @@ impl RenderPlan {
         let chain_start = read_chain_start(&mut r, &settings)?;
         let id = r.u64()?;
         r.end()?;
-        let plan = RenderPlan {
-            settings,
-            camera,
-            scene,
-            chain_start,
-            id,
-        };
         let mut w = Writer::default();
-        plan.write_contents(&mut w);
+        write_contents(&mut w, &settings, &camera, scene, chain_start.as_ref());
         if xxhash_rust::xxh3::xxh3_64(&w.finish(PLAN_MAGIC)) != id {
             return Err(Error::new(
                 MLT_STATUS_INVALID_ARGUMENT,
                 "the render plan's id does not match its contents",
             ));
         }
-        settings.validate()?;
-        camera.validate()?;
-        camera.model(settings.width, settings.height).validate()?;
-        Ok(plan)
+        Ok(RenderPlan {
+            request: ValidSettings::new(&settings)?.with_camera(&camera)?,
+            scene,
+            chain_start,
+            id,
+        })
     }
 
     fn write_contents(&self, w: &mut Writer) {
-        write_settings(w, &self.settings);
-        write_camera(w, &self.camera);
-        w.u64(self.scene);
-        write_chain_start(w, self.chain_start.as_ref());
+        write_contents(
+            w,
+            self.settings(),
+            self.camera(),
+            self.scene,
+            self.chain_start.as_ref(),
+        );
     }
+}
+
+/// A plan's contents, which its id hashes.
+fn write_contents(
+    w: &mut Writer,
+    settings: &RenderSettings,
+    camera: &Camera,
+    scene: u64,
+    chain_start: Option<&ChainStart>,
+) {
+    write_settings(w, settings);
+    write_camera(w, camera);
+    w.u64(scene);
+    write_chain_start(w, chain_start);
 }
 
 /// What one job rendered (or, after [`combine`], several): its film's exact sums and its
@@ -252,22 +262,13 @@ pub fn render_job(
             "the scene is not the one the plan was made for: every job must build its scene from the same description (arrays, materials, lights, textures and backend)",
         ));
     }
-    let settings = RenderSettings {
-        threads,
-        ..plan.settings
-    };
+    let request = plan.request.with_threads(threads)?;
     let share = JobShare {
         index: job,
         count: jobs,
     };
-    let (film, stats, tally) = render_film(
-        scene,
-        &plan.camera,
-        &settings,
-        share,
-        plan.chain_start.as_ref(),
-        progress,
-    )?;
+    let (film, stats, tally) =
+        render_film(scene, &request, share, plan.chain_start.as_ref(), progress)?;
     Ok(PartialRender {
         plan: plan.id,
         held: vec![job],
@@ -288,13 +289,13 @@ pub fn merge(
     partials: impl IntoIterator<Item = PartialRender>,
     rgb_out: &mut [f32],
 ) -> Result<RenderStats> {
-    let needed = plan.settings.output_len()?;
+    let needed = plan.settings().output_len()?;
     if rgb_out.len() < needed {
         return Err(Error::invalid(format!(
             "the output buffer holds {} floats but a {} x {} RGB image needs {needed}",
             rgb_out.len(),
-            plan.settings.width,
-            plan.settings.height
+            plan.settings().width,
+            plan.settings().height
         )));
     }
     let Folded {
@@ -374,15 +375,16 @@ fn fold(plan: &RenderPlan, partials: impl IntoIterator<Item = PartialRender>) ->
                 plan.id
             )));
         }
-        if (partial.film.width, partial.film.height) != (plan.settings.width, plan.settings.height)
+        if (partial.film.width, partial.film.height)
+            != (plan.settings().width, plan.settings().height)
         {
             return Err(Error::invalid(format!(
                 "{}: the image is {} x {}, the plan's {} x {}",
                 partial.name(),
                 partial.film.width,
                 partial.film.height,
-                plan.settings.width,
-                plan.settings.height
+                plan.settings().width,
+                plan.settings().height
             )));
         }
         let Some(sum) = folded.as_mut() else {

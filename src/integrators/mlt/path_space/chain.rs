@@ -9,6 +9,7 @@ use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::Bdpt;
 use crate::integrators::mlt::acceptance;
+use crate::integrators::mlt::direct_pass::DirectPass;
 use crate::integrators::mlt::driver::{
     self, ChainPlan, ChainStart, Deposits, MarkovChain, MetropolisOutcome, Mutation,
     MutationCounts, MutationWeights, WeightedChain,
@@ -188,8 +189,9 @@ impl<'a> MarkovChain for PathChain<'a> {
     }
 }
 
-/// Runs path-space MLT; see `driver::run` for `after_round`. With `adapt_weights`, the
-/// mutation weights are adapted after a warm-up (see `adapted_weights`).
+/// Runs path-space MLT, and the direct pass alongside it if the render has one. With
+/// `adapt_weights`, the mutation weights are adapted after a warm-up (see
+/// `adapted_weights`).
 pub(crate) fn run(
     target: &PathSpaceTarget,
     settings: &MetropolisSettings,
@@ -197,7 +199,7 @@ pub(crate) fn run(
     adapt_weights: bool,
     film: &mut Film,
     control: &Control,
-    after_round: &mut dyn FnMut(&mut Film, f64),
+    mut direct: Option<&mut DirectPass>,
 ) -> MetropolisOutcome {
     let camera = &target.camera;
     // 1. Bootstrap with BDPT, all strategies summed: b = ∫ f.
@@ -208,14 +210,8 @@ pub(crate) fn run(
     };
     let b = boot.estimate.b()[0];
     if b <= 0.0 || !b.is_finite() {
-        let mut outcome = driver::finish_without_light(
-            camera,
-            settings,
-            &boot.estimate,
-            film,
-            control,
-            after_round,
-        );
+        let mut outcome =
+            driver::finish_without_light(camera, settings, &boot.estimate, film, control, direct);
         outcome.mutation_weights = target.weights;
         return outcome;
     }
@@ -266,7 +262,7 @@ pub(crate) fn run(
         &mut pass,
         film,
         control,
-        after_round,
+        direct.as_deref_mut(),
     );
     outcome.mutation_weights = target.weights;
     let Some(boot) = boot.filter(|_| !control.should_stop()) else {
@@ -301,7 +297,7 @@ pub(crate) fn run(
             &mut others_pass,
             &mut scratch_film,
             &Control::new(None, true),
-            &mut |_, _| {},
+            None,
         );
         for chain in &others_chains {
             others_counts.add(&chain.chain.counts);
@@ -338,7 +334,7 @@ pub(crate) fn run(
         &mut pass,
         film,
         control,
-        after_round,
+        direct,
     );
     outcome.mutations += rest.mutations;
     outcome.accepted += rest.accepted;

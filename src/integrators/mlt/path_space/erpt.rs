@@ -53,7 +53,7 @@ use super::{PathSpace, PathVertex};
 use crate::control::Control;
 use crate::film::Film;
 use crate::integrators::bdpt::{Bdpt, BdptScratch, CONNECTION_STREAM};
-use crate::integrators::camera_passes::{PassSchedule, PixelSamples};
+use crate::integrators::camera_samples::{PassSchedule, PixelSamples};
 use crate::integrators::mlt::acceptance;
 use crate::integrators::mlt::driver::{MetropolisOutcome, MutationCounts, MutationWeights};
 use crate::integrators::mlt::normalization::NormalizationStats;
@@ -104,6 +104,7 @@ const FIXED_POINT_BITS: i32 = 24;
 pub(crate) struct ErptSettings {
     /// 0: until stopped.
     pub samples_per_pixel: u32,
+    /// At least 1 (the render's settings are validated).
     pub chain_length: u32,
     /// 0: automatic (see the module documentation).
     pub deposit_energy: f32,
@@ -416,7 +417,7 @@ pub(crate) fn run(
 ) -> MetropolisOutcome {
     let (width, height) = (camera.width, camera.height);
     let pixels = width as usize * height as usize;
-    let chain_length = settings.chain_length.max(1);
+    let chain_length = settings.chain_length;
     let deposit_energy = if settings.deposit_energy > 0.0 {
         settings.deposit_energy
     } else {

@@ -629,10 +629,10 @@ mod tests {
         pixels
     }
 
-    /// The same for the lights of issue 17, in the box without a ceiling (its ceiling light
-    /// stays, and its front is open): a constant environment and a sun disc, a small
-    /// environment map and a sun disc (also through glass), a point light, a spot light, a
-    /// directional light and a delta sun. Strategies of every kind of connection to each
+    /// The same for the lights besides emissive triangles, in the box without a ceiling (its
+    /// ceiling light stays, and its front is open): a constant environment and a sun disc, a
+    /// small environment map and a sun disc (also through glass), a point light, a spot light,
+    /// a directional light and a delta sun. Strategies of every kind of connection to each
     /// kind of light, and escaped camera subpaths (s = 0 at infinity), were compared.
     #[test]
     fn unweighted_contributions_match_bdpt_with_every_kind_of_light() {
