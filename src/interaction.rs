@@ -115,16 +115,9 @@ mod tests {
                 .lobes()
                 .contains(BsdfLobes::SPECULAR)
         );
-        let Some(crate::scene::lights::LightSample::Area {
-            triangle,
-            area_pdf,
-            normal,
-            ..
-        }) = scene.lights.sample_light(0.3, [0.2, 0.7])
-        else {
-            panic!("the only light is an area light")
-        };
-        assert_eq!((triangle, area_pdf), (si.triangle, 0.5));
-        assert_eq!(normal, si.geometric_normal);
+        let light = scene.lights.sample_vertex(0.3, [0.2, 0.7]).unwrap();
+        assert!(light.light.is_area(), "the only light is an area light");
+        assert_eq!((light.triangle, light.pdf), (si.triangle, 0.5));
+        assert_eq!(light.normal, si.geometric_normal);
     }
 }

@@ -21,17 +21,19 @@
 //! lights (point, spot, directional) can be reached by connections only: the strategy that
 //! would need to hit one (s = 0) gets no weight.
 
-use super::{PathVertex, PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
+use super::{
+    PathVertex, PixelEstimator, SampleCounters, emission_ray, light_shadow_ray, shadow_ray,
+    spawn_ray,
+};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
 use crate::sampling::{PixelSampler, Sampler};
-use crate::scene::lights::{Emitter, LightSample};
+use crate::scene::lights::Emitter;
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
-use std::f32::consts::FRAC_1_PI;
 
 pub struct Bdpt<'a> {
     pub scene: &'a Scene,
@@ -113,7 +115,8 @@ impl Vertex {
     #[inline]
     fn offset_normal(&self) -> Vec3A {
         match self.kind {
-            VertexKind::Camera | VertexKind::Light(Emitter::Point(_)) => Vec3A::ZERO,
+            VertexKind::Camera => Vec3A::ZERO,
+            VertexKind::Light(e) if e.is_delta_position() => Vec3A::ZERO,
             _ => self.normal,
         }
     }
@@ -202,9 +205,7 @@ impl Bdpt<'_> {
             {
                 self.scene.emission(v.triangle, v.barycentrics, channels)
             }
-            VertexKind::Light(Emitter::Infinite) => {
-                self.scene.lights.infinite_radiance(v.normal, channels)
-            }
+            VertexKind::Light(light) => self.scene.lights.le(light, v.normal, channels),
             _ => Spectrum::ZERO,
         }
     }
@@ -241,32 +242,18 @@ impl Bdpt<'_> {
     /// surface or a light vertex), as light subpaths sample it.
     #[inline]
     fn pdf_light_direction(&self, v: &Vertex, next: &Vertex) -> f32 {
-        match v.kind {
-            VertexKind::Light(
-                emitter @ (Emitter::Point(_) | Emitter::Directional(_) | Emitter::Infinite),
-            ) => {
-                let Some((w, _)) = direction(v, next) else {
-                    return 0.0;
-                };
-                let pdf = self
-                    .scene
-                    .lights
-                    .emission_direction_pdf(emitter, v.normal, w);
-                if pdf <= 0.0 {
-                    return 0.0;
-                }
-                to_area(pdf, v, next)
-            }
-            _ => {
-                // A point on an area light: cosine-weighted about its normal.
-                let w = (next.p - v.p).normalize();
-                let cos = w.dot(v.normal);
-                if cos <= 0.0 {
-                    return 0.0;
-                }
-                to_area(cos * FRAC_1_PI, v, next)
-            }
+        let light = match v.kind {
+            VertexKind::Light(light) => light,
+            _ => Emitter::triangle(v.triangle),
+        };
+        let pdf = self
+            .scene
+            .lights
+            .pdf_le_direction(light, v.p, v.normal, next.p);
+        if pdf <= 0.0 {
+            return 0.0;
         }
+        to_area(pdf, v, next)
     }
 
     /// Density of sampling `v` (an emitting surface or a light vertex) as a light
@@ -299,9 +286,11 @@ impl Bdpt<'_> {
             counters.rays += 1;
             let Some(hit) = self.scene.closest_hit(&ray) else {
                 // A camera subpath that leaves the scene ends on the lights at infinity.
-                if mode == TransportMode::Radiance && self.scene.lights.has_infinite_light() {
+                if mode == TransportMode::Radiance
+                    && let Some(light) = self.scene.lights.infinite_emitter()
+                {
                     path[count] = Vertex {
-                        kind: VertexKind::Light(Emitter::Infinite),
+                        kind: VertexKind::Light(light),
                         p: ray.origin,
                         normal: ray.direction,
                         wo: -ray.direction,
@@ -420,10 +409,6 @@ impl Bdpt<'_> {
         else {
             return 0;
         };
-        let triangle = match light.emitter {
-            Emitter::Area(triangle) => triangle,
-            _ => 0,
-        };
         path[0] = Vertex {
             kind: VertexKind::Light(light.emitter),
             p: light.point,
@@ -431,17 +416,20 @@ impl Bdpt<'_> {
             // Le / p_origin: what a connection to this vertex carries.
             beta: light.emission / light.pdf_origin,
             pdf_forward: light.pdf_origin,
-            triangle,
+            triangle: light.triangle,
             barycentrics: light.barycentrics,
             ..Vertex::EMPTY
         };
         if light.pdf_direction <= 0.0 || light.beta.is_black() {
             return 1;
         }
-        let ray = match light.emitter {
-            Emitter::Area(_) => spawn_ray(self.scene, light.point, light.normal, light.direction),
-            _ => crate::accel::Ray::new(light.point, light.direction, 0.0, f32::INFINITY),
-        };
+        let ray = emission_ray(
+            self.scene,
+            light.emitter,
+            light.point,
+            light.normal,
+            light.direction,
+        );
         self.random_walk(
             path,
             ray,
@@ -556,13 +544,6 @@ impl Bdpt<'_> {
             return Spectrum::ZERO;
         }
         self.bsdf(v, channels).eval(v.wo, w / length, mode)
-    }
-
-    /// Whether nothing blocks the way from surface vertex `a` to infinity along `w`.
-    #[inline]
-    fn unoccluded_towards(&self, a: &Vertex, w: Vec3A, counters: &mut SampleCounters) -> bool {
-        counters.rays += 1;
-        !self.scene.blocked(&spawn_ray(self.scene, a.p, a.normal, w))
     }
 
     /// Whether nothing blocks the segment between two vertices.
@@ -802,104 +783,32 @@ impl Bdpt<'_> {
             if !pt.connectible() || pt.kind != VertexKind::Surface {
                 return None;
             }
-            let (sampled, contribution) = match self
-                .scene
-                .sample_light(u_select, u_point, channels)?
-            {
-                LightSample::Area {
-                    point,
-                    normal,
-                    emission,
-                    area_pdf,
-                    triangle,
-                    barycentrics,
-                } => {
-                    let sampled = Vertex {
-                        kind: VertexKind::Light(Emitter::Area(triangle)),
-                        p: point,
-                        normal,
-                        beta: emission / area_pdf,
-                        pdf_forward: area_pdf,
-                        triangle,
-                        barycentrics,
-                        ..Vertex::EMPTY
-                    };
-                    let d = sampled.p - pt.p;
-                    let distance2 = d.length_squared();
-                    if distance2 == 0.0 {
-                        return None;
-                    }
-                    let w = d / distance2.sqrt();
-                    let cos_light = -w.dot(normal);
-                    if cos_light <= 0.0 {
-                        return None;
-                    }
-                    let geometry = w.dot(pt.normal).abs() * cos_light / distance2;
-                    let contribution = pt.beta
-                        * self.f(&pt, sampled.p, TransportMode::Radiance, channels)
-                        * sampled.beta
-                        * geometry;
-                    if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
-                        return None;
-                    }
-                    (sampled, contribution)
-                }
-                LightSample::Point {
-                    light,
-                    position,
-                    pdf,
-                } => {
-                    let d = position - pt.p;
-                    let distance2 = d.length_squared();
-                    if distance2 == 0.0 {
-                        return None;
-                    }
-                    let w = d / distance2.sqrt();
-                    let sampled = Vertex {
-                        kind: VertexKind::Light(Emitter::Point(light)),
-                        p: position,
-                        normal: -w,
-                        beta: self.scene.lights.point_light(light).intensity(-w, channels) / pdf,
-                        pdf_forward: pdf,
-                        ..Vertex::EMPTY
-                    };
-                    let geometry = w.dot(pt.normal).abs() / distance2;
-                    let contribution = pt.beta
-                        * self.f(&pt, position, TransportMode::Radiance, channels)
-                        * sampled.beta
-                        * geometry;
-                    if contribution.is_black() || !self.visible(&pt, &sampled, counters) {
-                        return None;
-                    }
-                    (sampled, contribution)
-                }
-                LightSample::Direction {
-                    emitter,
-                    toward,
-                    radiance,
-                    pdf,
-                } => {
-                    if pdf <= 0.0 {
-                        return None;
-                    }
-                    let sampled = Vertex {
-                        kind: VertexKind::Light(emitter),
-                        p: pt.p,
-                        normal: toward,
-                        beta: radiance / pdf,
-                        pdf_forward: pdf,
-                        ..Vertex::EMPTY
-                    };
-                    let f = self
-                        .bsdf(&pt, channels)
-                        .eval(pt.wo, toward, TransportMode::Radiance);
-                    let contribution = pt.beta * f * sampled.beta * toward.dot(pt.normal).abs();
-                    if contribution.is_black() || !self.unoccluded_towards(&pt, toward, counters) {
-                        return None;
-                    }
-                    (sampled, contribution)
-                }
+            let sample = self.scene.sample_li(pt.p, u_select, u_point, channels)?;
+            if sample.pdf <= 0.0 {
+                return None;
+            }
+            let sampled = Vertex {
+                kind: VertexKind::Light(sample.light),
+                p: sample.point,
+                normal: sample.normal,
+                beta: sample.radiance / sample.pdf,
+                pdf_forward: sample.pdf,
+                triangle: sample.triangle,
+                barycentrics: sample.barycentrics,
+                ..Vertex::EMPTY
             };
+            let f = self
+                .bsdf(&pt, channels)
+                .eval(pt.wo, sample.wi, TransportMode::Radiance);
+            let contribution = pt.beta * f * sampled.beta * sample.geometry(pt.normal);
+            if contribution.is_black() {
+                return None;
+            }
+            let ray = light_shadow_ray(self.scene, pt.p, pt.normal, &sample)?;
+            counters.rays += 1;
+            if self.scene.blocked(&ray) {
+                return None;
+            }
             let saved = light[0];
             light[0] = sampled;
             let weight = self.mis_weight(camera_model, camera, light, 1, t, channels);
@@ -956,9 +865,8 @@ impl Bdpt<'_> {
     ) {
         let as_path_vertex = |v: &Vertex| match v.kind {
             // A point on an emissive triangle is told by its triangle, as a surface hit.
-            VertexKind::Light(Emitter::Point(light)) => PathVertex::point_light(light, v.p),
-            VertexKind::Light(emitter @ (Emitter::Directional(_) | Emitter::Infinite)) => {
-                PathVertex::at_infinity(emitter, v.normal)
+            VertexKind::Light(light) => {
+                PathVertex::on_light(light, v.p, v.normal, v.triangle, v.barycentrics)
             }
             _ => PathVertex::on_triangle(v.p, v.normal, v.triangle, v.barycentrics),
         };

@@ -9,7 +9,7 @@ use crate::accel::Ray;
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
 use crate::sampling::PixelSampler;
-use crate::scene::lights::Emitter;
+use crate::scene::lights::{Emitter, LightLiSample};
 use crate::scene::{CameraModel, Scene};
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
@@ -83,16 +83,36 @@ impl PathVertex {
         }
     }
 
-    /// Point or spot light number `light` at `position`.
+    /// The vertex on light `emitter` at `p` with normal `normal` (a triangle's and the
+    /// barycentrics for an area light): a point on a triangle, a point without a surface
+    /// (a delta position), or a direction at infinity (`normal`).
     #[inline]
-    pub fn point_light(light: u32, position: Vec3A) -> PathVertex {
-        PathVertex {
-            p: position,
-            normal: Vec3A::ZERO,
-            triangle: 0,
-            barycentrics: [0.0; 2],
-            light: Some(Emitter::Point(light)),
+    pub fn on_light(
+        emitter: Emitter,
+        p: Vec3A,
+        normal: Vec3A,
+        triangle: u32,
+        barycentrics: [f32; 2],
+    ) -> PathVertex {
+        if emitter.is_area() {
+            PathVertex::on_triangle(p, normal, triangle, barycentrics)
+        } else if emitter.at_infinity() {
+            PathVertex::at_infinity(emitter, normal)
+        } else {
+            PathVertex {
+                p,
+                normal: Vec3A::ZERO,
+                triangle: 0,
+                barycentrics: [0.0; 2],
+                light: Some(emitter),
+            }
         }
+    }
+
+    /// The light of a path's first vertex (a surface vertex's is its triangle's).
+    #[inline]
+    pub fn emitter(&self) -> Emitter {
+        self.light.unwrap_or(Emitter::triangle(self.triangle))
     }
 
     /// Whether the vertex is a direction at infinity.
@@ -101,10 +121,10 @@ impl PathVertex {
         matches!(self.light, Some(e) if e.at_infinity())
     }
 
-    /// Whether the vertex is a point or spot light.
+    /// Whether the vertex is a point light without a surface (a delta position).
     #[inline]
-    pub fn is_point_light(&self) -> bool {
-        matches!(self.light, Some(Emitter::Point(_)))
+    pub fn is_delta_position(&self) -> bool {
+        matches!(self.light, Some(e) if e.is_delta_position())
     }
 }
 
@@ -147,6 +167,40 @@ pub(crate) fn spawn_ray(scene: &Scene, p: Vec3A, normal: Vec3A, direction: Vec3A
         -normal * scene.ray_epsilon
     };
     Ray::new(p + offset, direction, 0.0, f32::INFINITY)
+}
+
+/// The first ray of a light subpath from light vertex `emitter` at `origin`: off an area
+/// light's surface (normal `normal`), from the point itself for the other lights.
+#[inline]
+pub(crate) fn emission_ray(
+    scene: &Scene,
+    emitter: Emitter,
+    origin: Vec3A,
+    normal: Vec3A,
+    direction: Vec3A,
+) -> Ray {
+    if emitter.is_area() {
+        spawn_ray(scene, origin, normal, direction)
+    } else {
+        Ray::new(origin, direction, 0.0, f32::INFINITY)
+    }
+}
+
+/// A shadow ray from surface point `p` (geometric normal `normal`) towards the light vertex
+/// of `light`: to its point, or along `wi` to a light at infinity; `None` when the points
+/// are too close to tell apart.
+#[inline]
+pub(crate) fn light_shadow_ray(
+    scene: &Scene,
+    p: Vec3A,
+    normal: Vec3A,
+    light: &LightLiSample,
+) -> Option<Ray> {
+    if light.light.at_infinity() {
+        Some(spawn_ray(scene, p, normal, light.wi))
+    } else {
+        shadow_ray(scene, p, normal, light.point, light.offset_normal())
+    }
 }
 
 /// A shadow ray from surface point `p` to surface point `target`, both offset off their

@@ -3,12 +3,11 @@
 //! the lights rays can hit (area lights, the environment, the sun's disc), and Russian
 //! roulette.
 
-use super::{PixelEstimator, SampleCounters, shadow_ray, spawn_ray};
+use super::{PixelEstimator, SampleCounters, light_shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::film::Splat;
 use crate::interaction::SurfaceInteraction;
 use crate::sampling::{PixelSampler, Sampler, power_heuristic};
-use crate::scene::lights::LightSample;
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
@@ -159,88 +158,29 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
-        match scene.sample_light(u_select, u_point, channels) {
-            None => Spectrum::ZERO,
-            Some(LightSample::Area {
-                point: y,
-                normal: light_normal,
-                emission,
-                area_pdf,
-                ..
-            }) => {
-                let to_light = y - p;
-                let distance2 = to_light.length_squared();
-                if distance2 <= 0.0 {
-                    return Spectrum::ZERO;
-                }
-                let wi = to_light / distance2.sqrt();
-                let cos_light = -wi.dot(light_normal);
-                if cos_light <= 0.0 {
-                    return Spectrum::ZERO;
-                }
-                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
-                if f.is_black() {
-                    return Spectrum::ZERO;
-                }
-                let Some(ray) = shadow_ray(scene, p, normal, y, light_normal) else {
-                    return Spectrum::ZERO;
-                };
-                *rays += 1;
-                if scene.blocked(&ray) {
-                    return Spectrum::ZERO;
-                }
-                let light_pdf = area_pdf * distance2 / cos_light;
-                let weight = power_heuristic(light_pdf, bsdf.pdf(wo, wi));
-                f * emission * (wi.dot(normal).abs() * weight / light_pdf)
-            }
-            Some(LightSample::Point {
-                light,
-                position,
-                pdf,
-            }) => {
-                let to_light = position - p;
-                let distance2 = to_light.length_squared();
-                if distance2 <= 0.0 {
-                    return Spectrum::ZERO;
-                }
-                let wi = to_light / distance2.sqrt();
-                let intensity = scene.lights.point_light(light).intensity(-wi, channels);
-                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
-                if f.is_black() || intensity.is_black() {
-                    return Spectrum::ZERO;
-                }
-                let Some(ray) = shadow_ray(scene, p, normal, position, Vec3A::ZERO) else {
-                    return Spectrum::ZERO;
-                };
-                *rays += 1;
-                if scene.blocked(&ray) {
-                    return Spectrum::ZERO;
-                }
-                // A delta position: no other strategy finds it, so no MIS.
-                f * intensity * (wi.dot(normal).abs() / (distance2 * pdf))
-            }
-            Some(LightSample::Direction {
-                emitter,
-                toward: wi,
-                radiance,
-                pdf,
-            }) => {
-                let f = bsdf.eval(wo, wi, TransportMode::Radiance);
-                if f.is_black() || radiance.is_black() || pdf <= 0.0 {
-                    return Spectrum::ZERO;
-                }
-                *rays += 1;
-                if scene.blocked(&spawn_ray(scene, p, normal, wi)) {
-                    return Spectrum::ZERO;
-                }
-                let weight = if emitter.is_delta() {
-                    1.0
-                } else {
-                    power_heuristic(pdf, bsdf.pdf(wo, wi))
-                };
-                f * radiance * (wi.dot(normal).abs() * weight / pdf)
-            }
+        let Some(light) = scene.sample_li(p, u_select, u_point, channels) else {
+            return Spectrum::ZERO;
+        };
+        let wi = light.wi;
+        let f = bsdf.eval(wo, wi, TransportMode::Radiance);
+        if f.is_black() || light.radiance.is_black() || light.pdf <= 0.0 {
+            return Spectrum::ZERO;
         }
+        let Some(ray) = light_shadow_ray(scene, p, normal, &light) else {
+            return Spectrum::ZERO;
+        };
+        *rays += 1;
+        if scene.blocked(&ray) {
+            return Spectrum::ZERO;
+        }
+        let light_pdf = light.solid_angle_pdf();
+        // A delta light: no other strategy finds it, so no MIS.
+        let weight = if light.light.is_delta() {
+            1.0
+        } else {
+            power_heuristic(light_pdf, bsdf.pdf(wo, wi))
+        };
+        f * light.radiance * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
 

@@ -355,10 +355,8 @@ impl Scene {
             lights::SceneLights::new(lights, &desc.lights, (center, radius), |internal| {
                 internal_to_input[internal as usize]
             })?;
-        for light in &scene_lights.lights {
-            if let lights::Light::Area(light) = light {
-                shading[light.triangle as usize].light_area_pdf = light.area_pdf;
-            }
+        for (triangle, area_pdf) in scene_lights.area_light_pdfs() {
+            shading[triangle as usize].light_area_pdf = area_pdf;
         }
         let magnitude = bounds_min
             .abs()
@@ -400,7 +398,7 @@ impl Scene {
         self.fingerprint
     }
 
-    /// The area density with which `sample_light` picks a point on internal triangle
+    /// The area density with which `sample_li` picks a point on internal triangle
     /// `triangle` (0 for triangles that do not emit).
     #[inline]
     pub(crate) fn light_area_pdf(&self, triangle: u32) -> f32 {
@@ -590,40 +588,21 @@ impl Scene {
             .emission(channels)
     }
 
-    /// A light sample (`SceneLights::sample_light`) with the emission texture applied, its
-    /// radiance in `channels` (a point light's intensity is looked up by the caller, in
-    /// `PointLight::intensity`).
-    #[inline]
-    pub(crate) fn sample_light(
+    /// A light picked by power and what it sends towards shading point `p`, in `channels`
+    /// (`SceneLights::sample_li`).
+    #[inline(always)]
+    pub(crate) fn sample_li(
         &self,
+        p: Vec3A,
         u_select: f32,
         u_point: [f32; 2],
         channels: &Channels,
-    ) -> Option<lights::LightSample> {
-        let mut sample = self.lights.sample_light(u_select, u_point)?;
-        match &mut sample {
-            lights::LightSample::Area {
-                triangle,
-                barycentrics,
-                emission,
-                ..
-            } => {
-                // In RGB the light's own emission, unless textured; spectra from the
-                // material's fit.
-                if self.emission_is_textured(*triangle) || *channels != Channels::Rgb {
-                    *emission = self.emission(*triangle, *barycentrics, channels);
-                }
-            }
-            lights::LightSample::Direction { radiance, .. } => {
-                *radiance = channels.illuminant(radiance.to_array());
-            }
-            lights::LightSample::Point { .. } => {}
-        }
-        Some(sample)
+    ) -> Option<lights::LightLiSample> {
+        self.lights.sample_li(self, p, u_select, u_point, channels)
     }
 
-    /// An emission sample (`SceneLights::sample_emission`) with the emission texture
-    /// applied, its emission and weight in `channels`.
+    /// The start of a light subpath, its emission and weight in `channels`
+    /// (`SceneLights::sample_emission`).
     #[inline]
     pub(crate) fn sample_emission(
         &self,
@@ -632,22 +611,8 @@ impl Scene {
         u_direction: [f32; 2],
         channels: &Channels,
     ) -> Option<lights::EmissionSample> {
-        let mut sample = self
-            .lights
-            .sample_emission(u_select, u_point, u_direction)?;
-        if let lights::Emitter::Area(triangle) = sample.emitter
-            && (self.emission_is_textured(triangle) || *channels != Channels::Rgb)
-        {
-            sample.emission = self.emission(triangle, sample.barycentrics, channels);
-            let cos = sample.direction.dot(sample.normal);
-            sample.beta = sample.emission * (cos / (sample.pdf_origin * sample.pdf_direction));
-        } else {
-            // The weight is the emission times a number, and the upsampling scales with
-            // its argument, so it converts as the emission does.
-            sample.emission = channels.illuminant(sample.emission.to_array());
-            sample.beta = channels.illuminant(sample.beta.to_array());
-        }
-        Some(sample)
+        self.lights
+            .sample_emission(self, u_select, u_point, u_direction, channels)
     }
 
     /// Whether internal triangle `triangle`'s material has an emission texture.
@@ -657,17 +622,26 @@ impl Scene {
         self.materials[material as usize].emission_texture.is_some()
     }
 
-    /// Density of light vertex `emitter` as the start of a light subpath (see
-    /// `EmissionSample::pdf_origin`); `toward` is the direction of a light at infinity.
+    /// Density of light vertex `emitter` as the start of a light subpath
+    /// (`SceneLights::pdf_origin`); `toward` is the direction of a light at infinity.
     #[inline]
     pub(crate) fn emission_origin_pdf(&self, emitter: lights::Emitter, toward: Vec3A) -> f32 {
-        match emitter {
-            lights::Emitter::Area(triangle) => self.light_area_pdf(triangle),
-            lights::Emitter::Point(index) | lights::Emitter::Directional(index) => {
-                self.lights.light_select_pdf(index)
-            }
-            lights::Emitter::Infinite => self.lights.infinite_pdf(toward),
-        }
+        self.lights.pdf_origin(self, emitter, toward)
+    }
+
+    /// What light vertex `light` emits towards `w`, in `channels`, and its density as a
+    /// light sample (`SceneLights::emitted`).
+    #[inline]
+    pub(crate) fn light_emitted(
+        &self,
+        light: lights::Emitter,
+        normal: Vec3A,
+        barycentrics: [f32; 2],
+        w: Vec3A,
+        channels: &Channels,
+    ) -> Option<(Spectrum, f32)> {
+        self.lights
+            .emitted(self, light, normal, barycentrics, w, channels)
     }
 
     /// The scale of the scene's units of light (`SceneLights::brightest`).
@@ -691,6 +665,28 @@ impl Scene {
     /// alpha cut-outs.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.blocked(ray)
+    }
+}
+
+impl lights::EmissiveSurfaces for Scene {
+    #[inline]
+    fn surface_emission(
+        &self,
+        triangle: u32,
+        barycentrics: [f32; 2],
+        channels: &Channels,
+    ) -> Spectrum {
+        self.emission(triangle, barycentrics, channels)
+    }
+
+    #[inline]
+    fn is_emission_textured(&self, triangle: u32) -> bool {
+        self.emission_is_textured(triangle)
+    }
+
+    #[inline]
+    fn triangle_light_pdf(&self, triangle: u32) -> f32 {
+        self.light_area_pdf(triangle)
     }
 }
 

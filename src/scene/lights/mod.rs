@@ -2,10 +2,16 @@
 //! point and spot lights, directional lights, and the lights at infinity (environment and
 //! sun disc, one light), picked in proportion to their power.
 //!
-//! Every integrator that samples a light (next-event estimation, light subpaths, the
-//! bidirectional mutation's new light vertex) calls `sample_light` or `sample_emission`,
-//! and every ray that leaves the scene asks `infinite_radiance` (the `Scene` forwards them
-//! to its [`SceneLights`]), so another kind of light changes this module, not theirs.
+//! Every light answers the same questions, in the shape of pbrt's light interface:
+//! `sample_li` (a light seen from a shading point, for next-event estimation and BDPT's
+//! connections), `sample_emission` and `sample_le_ray` (where a light subpath starts and
+//! its first ray), `le` (what a ray that found a light at infinity carries), `emitted`,
+//! `pdf_origin` and `pdf_le_direction` (a light vertex's emission and densities, for MIS
+//! and the Metropolis targets). A light vertex names its light by an [`Emitter`], which the
+//! integrators only hand back and ask for its type (area, delta position, at infinity,
+//! delta): they never match on the kind of light, so another kind changes this module,
+//! not theirs. The `Scene` forwards the questions and answers the lights' own
+//! ([`EmissiveSurfaces`]: an area light's textured or spectral emission).
 //!
 //! Power is measured as Φ/π (luminance times area for an area light), so that a scene of
 //! area lights picks them exactly as before the other kinds existed.
@@ -42,7 +48,7 @@ pub struct AreaLight {
 
 /// A spot light's cone, with glTF's smooth falloff.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct SpotCone {
+struct SpotCone {
     /// Unit axis the light shines along.
     pub axis: Vec3A,
     /// cos of the inner angle: full intensity within it.
@@ -70,7 +76,7 @@ impl SpotCone {
 
 /// A point or spot light: a delta position.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct PointLight {
+struct PointLight {
     pub position: Vec3A,
     /// Radiant intensity (on the axis, for a spot).
     pub intensity: Spectrum,
@@ -131,7 +137,7 @@ impl PointLight {
 
 /// One light the scene picks among.
 #[derive(Clone, Copy, Debug)]
-pub(crate) enum Light {
+enum Light {
     Area(AreaLight),
     Point(PointLight),
     /// A delta direction: `toward` (unit) points from the scene to the light.
@@ -143,68 +149,149 @@ pub(crate) enum Light {
     Infinite,
 }
 
-/// Which light a light vertex is on, for the densities of bidirectional strategies.
+/// Which light a light vertex is on: a handle the integrators hand back to the lights'
+/// questions and ask for the light's type (the flags below), never taken apart outside this
+/// module.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Emitter {
+pub(crate) struct Emitter(EmitterKind);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum EmitterKind {
     /// An emissive triangle (internal index).
     Area(u32),
     /// A point or spot light (index into the scene's lights).
     Point(u32),
-    /// A directional light (index into the scene's lights): a delta direction.
+    /// A directional light (index into the scene's lights).
     Directional(u32),
-    /// The environment and sun disc: a direction at infinity.
+    /// The environment and sun disc.
     Infinite,
 }
 
+/// The type of a light, as pbrt's light types: what the integrators may ask of its vertex.
 impl Emitter {
+    /// The light of emissive internal triangle `triangle` (a surface vertex on a light is
+    /// told by its triangle).
+    #[inline]
+    pub fn triangle(triangle: u32) -> Emitter {
+        Emitter(EmitterKind::Area(triangle))
+    }
+
+    /// A point on an emissive surface: rays leave it offset along its normal, rays hit it.
+    #[inline]
+    pub fn is_area(self) -> bool {
+        matches!(self.0, EmitterKind::Area(_))
+    }
+
+    /// A delta position (point, spot): a point without a surface, that no ray hits.
+    #[inline]
+    pub fn is_delta_position(self) -> bool {
+        matches!(self.0, EmitterKind::Point(_))
+    }
+
     /// Whether the light sits at infinity: its vertex is a direction, not a point.
     #[inline]
     pub fn at_infinity(self) -> bool {
-        matches!(self, Emitter::Directional(_) | Emitter::Infinite)
+        matches!(self.0, EmitterKind::Directional(_) | EmitterKind::Infinite)
     }
 
     /// Whether the light is a delta in position or direction: no ray can hit it.
     #[inline]
     pub fn is_delta(self) -> bool {
-        matches!(self, Emitter::Point(_) | Emitter::Directional(_))
+        matches!(self.0, EmitterKind::Point(_) | EmitterKind::Directional(_))
     }
 }
 
-/// A light sampled from the scene's lights, as next-event estimation sees it.
-#[derive(Clone, Copy, Debug)]
-pub(crate) enum LightSample {
-    /// A point on an area light.
-    Area {
-        point: Vec3A,
-        /// The light's front normal: it emits into that hemisphere.
-        normal: Vec3A,
-        /// Radiance leaving the front side.
-        emission: Spectrum,
-        /// Density of `point` per unit area, the light's selection probability included.
-        area_pdf: f32,
-        /// Internal index of the light's triangle.
+/// What the lights ask of the scene's surfaces about an emissive triangle (`Scene`
+/// answers): textures and spectra stay with the materials.
+pub(crate) trait EmissiveSurfaces {
+    /// Radiance internal triangle `triangle` emits at `barycentrics`, in `channels`.
+    fn surface_emission(
+        &self,
         triangle: u32,
-        /// The point's barycentrics on that triangle.
         barycentrics: [f32; 2],
-    },
-    /// A point or spot light.
-    Point {
-        light: u32,
-        position: Vec3A,
-        /// The light's selection probability.
-        pdf: f32,
-    },
-    /// A direction towards a light at infinity.
-    Direction {
-        emitter: Emitter,
-        /// Unit, from the scene towards the light.
-        toward: Vec3A,
-        /// Radiance arriving from `toward` (infinite light), or irradiance (directional).
-        radiance: Spectrum,
-        /// Selection probability times the density of `toward` in solid angle; for a
-        /// directional light, the selection probability alone.
-        pdf: f32,
-    },
+        channels: &Channels,
+    ) -> Spectrum;
+    /// Whether the triangle's material has an emission texture.
+    fn is_emission_textured(&self, triangle: u32) -> bool;
+    /// The density with which light sampling picks a point on the triangle, per unit area
+    /// (0: not a light).
+    fn triangle_light_pdf(&self, triangle: u32) -> f32;
+}
+
+/// A point or direction on a light picked by power (`SceneLights::sample_vertex`), before
+/// anything is known of where it is seen from.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightVertex {
+    pub light: Emitter,
+    /// The point on an area or point light (zero at infinity).
+    pub point: Vec3A,
+    /// An area light's front normal, the unit direction from the scene to a light at
+    /// infinity (zero for a point light).
+    pub normal: Vec3A,
+    /// Density of the vertex: selection × area density (area), selection (point,
+    /// directional), selection × density in solid angle (infinite).
+    pub pdf: f32,
+    /// An area light's internal triangle and the point's barycentrics on it (zero for the
+    /// other lights).
+    pub triangle: u32,
+    pub barycentrics: [f32; 2],
+    /// In RGB: the area light's emission factor, a directional light's irradiance, the
+    /// radiance from the infinite light (a point light's comes with its direction).
+    emission: Spectrum,
+}
+
+/// A light sampled for shading point `p` (pbrt's `SampleLi`): the direction to it, what
+/// arrives along it, and the light vertex, for next-event estimation and BDPT's connection
+/// to a new light vertex.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightLiSample {
+    pub light: Emitter,
+    /// Unit direction from `p` towards the light.
+    pub wi: Vec3A,
+    /// What the light sends towards `p`, before the falloff with distance: radiance (area,
+    /// infinite), intensity (point, spot), irradiance (directional).
+    pub radiance: Spectrum,
+    /// Density of the light vertex (`LightVertex::pdf`).
+    pub pdf: f32,
+    /// Squared distance to the light vertex (1 at infinity: no falloff).
+    pub distance2: f32,
+    /// Cosine between the light's normal and −`wi` (1 for a light without a surface).
+    pub cos_light: f32,
+    /// The light vertex: the point on the light, or `p` itself for a light at infinity.
+    pub point: Vec3A,
+    /// Its normal: an area light's front normal, −`wi` for a point light, `wi` at infinity.
+    pub normal: Vec3A,
+    /// An area light's internal triangle and the point's barycentrics on it.
+    pub triangle: u32,
+    pub barycentrics: [f32; 2],
+}
+
+impl LightLiSample {
+    /// Density of `wi` in solid angle, the selection included; for a delta light, what
+    /// `radiance` is divided by to give the light arriving at `p` (selection × distance²
+    /// for a point light, the selection alone for a directional one).
+    #[inline]
+    pub fn solid_angle_pdf(&self) -> f32 {
+        self.pdf * self.distance2 / self.cos_light
+    }
+
+    /// The geometry factor between `p` (normal `normal`) and the light vertex: |cos| at
+    /// `p` × the light's cosine / distance².
+    #[inline]
+    pub fn geometry(&self, normal: Vec3A) -> f32 {
+        self.wi.dot(normal).abs() * self.cos_light / self.distance2
+    }
+
+    /// The normal a shadow ray's end at the light vertex is offset along (none for a point
+    /// light, which has no surface).
+    #[inline]
+    pub fn offset_normal(&self) -> Vec3A {
+        if self.light.is_delta_position() {
+            Vec3A::ZERO
+        } else {
+            self.normal
+        }
+    }
 }
 
 /// The start of a light subpath: the light vertex and the first ray.
@@ -231,7 +318,9 @@ pub(crate) struct EmissionSample {
     pub pdf_direction: f32,
     /// The first ray's throughput: emission·|cos| / (pdf_origin · pdf_direction).
     pub beta: Spectrum,
-    /// An area light's point's barycentrics on its triangle (zero for other lights).
+    /// An area light's internal triangle and the point's barycentrics on it (zero for
+    /// other lights).
+    pub triangle: u32,
     pub barycentrics: [f32; 2],
 }
 
@@ -257,55 +346,179 @@ impl SceneLights {
         brightest
     }
 
+    /// Each area light's internal triangle and its `area_pdf`.
+    pub(crate) fn area_light_pdfs(&self) -> impl Iterator<Item = (u32, f32)> + '_ {
+        self.lights.iter().filter_map(|light| match light {
+            Light::Area(light) => Some((light.triangle, light.area_pdf)),
+            _ => None,
+        })
+    }
+
     /// Picks a light by power with `u_select` and a point or direction on it with
     /// `u_point`; `None` if the scene has no lights or the sample has zero density. The
     /// caller draws both numbers (always, whether or not there are lights, where its
     /// sampler's coordinates must stay in place).
-    #[inline]
-    pub(crate) fn sample_light(&self, u_select: f32, u_point: [f32; 2]) -> Option<LightSample> {
+    #[inline(always)]
+    pub(crate) fn sample_vertex(&self, u_select: f32, u_point: [f32; 2]) -> Option<LightVertex> {
         if self.lights.is_empty() {
             return None;
         }
         let (index, select_pdf, _) = self.distribution.sample_discrete(u_select);
+        let vertex = |light, point, normal, pdf, emission| LightVertex {
+            light: Emitter(light),
+            point,
+            normal,
+            pdf,
+            triangle: 0,
+            barycentrics: [0.0; 2],
+            emission,
+        };
         match &self.lights[index] {
             Light::Area(light) => {
                 let [b1, b2] = uniform_triangle(u_point);
-                Some(LightSample::Area {
-                    point: light.v0 + light.edge1 * b1 + light.edge2 * b2,
-                    normal: light.normal,
-                    emission: light.emission,
-                    area_pdf: light.area_pdf,
+                Some(LightVertex {
                     triangle: light.triangle,
                     barycentrics: [b1, b2],
+                    ..vertex(
+                        EmitterKind::Area(light.triangle),
+                        light.v0 + light.edge1 * b1 + light.edge2 * b2,
+                        light.normal,
+                        light.area_pdf,
+                        light.emission,
+                    )
                 })
             }
-            Light::Point(light) => Some(LightSample::Point {
-                light: index as u32,
-                position: light.position,
-                pdf: select_pdf,
-            }),
-            Light::Directional { toward, irradiance } => Some(LightSample::Direction {
-                emitter: Emitter::Directional(index as u32),
-                toward: *toward,
-                radiance: *irradiance,
-                pdf: select_pdf,
-            }),
+            Light::Point(light) => Some(vertex(
+                EmitterKind::Point(index as u32),
+                light.position,
+                Vec3A::ZERO,
+                select_pdf,
+                light.intensity,
+            )),
+            Light::Directional { toward, irradiance } => Some(vertex(
+                EmitterKind::Directional(index as u32),
+                Vec3A::ZERO,
+                *toward,
+                select_pdf,
+                *irradiance,
+            )),
             Light::Infinite => {
                 let (toward, radiance, pdf) = self.infinite.as_ref()?.sample(u_point)?;
-                Some(LightSample::Direction {
-                    emitter: Emitter::Infinite,
+                Some(vertex(
+                    EmitterKind::Infinite,
+                    Vec3A::ZERO,
                     toward,
+                    select_pdf * pdf,
                     radiance,
-                    pdf: select_pdf * pdf,
-                })
+                ))
+            }
+        }
+    }
+
+    /// Picks a light by power and a point or direction on it (`sample_vertex`, the same
+    /// numbers) and what it sends towards shading point `p`, in `channels`; `None` if there
+    /// is none, `p` is on the light or behind it.
+    // Always inlined, as the path tracer's own light sampling was (its callgrind count is
+    // 3-5% higher as a call).
+    #[inline(always)]
+    pub(crate) fn sample_li(
+        &self,
+        surfaces: &impl EmissiveSurfaces,
+        p: Vec3A,
+        u_select: f32,
+        u_point: [f32; 2],
+        channels: &Channels,
+    ) -> Option<LightLiSample> {
+        let vertex = self.sample_vertex(u_select, u_point)?;
+        let sample = |wi, radiance, distance2, cos_light, point, normal| LightLiSample {
+            light: vertex.light,
+            wi,
+            radiance,
+            pdf: vertex.pdf,
+            distance2,
+            cos_light,
+            point,
+            normal,
+            triangle: vertex.triangle,
+            barycentrics: vertex.barycentrics,
+        };
+        match vertex.light.0 {
+            EmitterKind::Area(triangle) => {
+                // In RGB the light's own emission, unless textured; spectra from the
+                // material's fit.
+                let emission =
+                    if surfaces.is_emission_textured(triangle) || *channels != Channels::Rgb {
+                        surfaces.surface_emission(triangle, vertex.barycentrics, channels)
+                    } else {
+                        vertex.emission
+                    };
+                let to_light = vertex.point - p;
+                let distance2 = to_light.length_squared();
+                if distance2 <= 0.0 {
+                    return None;
+                }
+                let wi = to_light / distance2.sqrt();
+                let cos_light = -wi.dot(vertex.normal);
+                if cos_light <= 0.0 {
+                    return None;
+                }
+                Some(sample(
+                    wi,
+                    emission,
+                    distance2,
+                    cos_light,
+                    vertex.point,
+                    vertex.normal,
+                ))
+            }
+            EmitterKind::Point(index) => {
+                let to_light = vertex.point - p;
+                let distance2 = to_light.length_squared();
+                if distance2 <= 0.0 {
+                    return None;
+                }
+                let wi = to_light / distance2.sqrt();
+                let intensity = self.point_light(index).intensity(-wi, channels);
+                Some(sample(wi, intensity, distance2, 1.0, vertex.point, -wi))
+            }
+            EmitterKind::Directional(_) | EmitterKind::Infinite => {
+                let radiance = channels.illuminant(vertex.emission.to_array());
+                Some(sample(vertex.normal, radiance, 1.0, 1.0, p, vertex.normal))
             }
         }
     }
 
     /// Picks a light by power and samples where a light subpath starts and its first
-    /// direction (5 numbers, always all read by the caller).
+    /// direction (5 numbers, always all read by the caller), its emission and weight in
+    /// `channels`.
     #[inline]
     pub(crate) fn sample_emission(
+        &self,
+        surfaces: &impl EmissiveSurfaces,
+        u_select: f32,
+        u_point: [f32; 2],
+        u_direction: [f32; 2],
+        channels: &Channels,
+    ) -> Option<EmissionSample> {
+        let mut sample = self.sample_emission_rgb(u_select, u_point, u_direction)?;
+        if let EmitterKind::Area(triangle) = sample.emitter.0
+            && (surfaces.is_emission_textured(triangle) || *channels != Channels::Rgb)
+        {
+            sample.emission = surfaces.surface_emission(triangle, sample.barycentrics, channels);
+            let cos = sample.direction.dot(sample.normal);
+            sample.beta = sample.emission * (cos / (sample.pdf_origin * sample.pdf_direction));
+        } else {
+            // The weight is the emission times a number, and the upsampling scales with
+            // its argument, so it converts as the emission does.
+            sample.emission = channels.illuminant(sample.emission.to_array());
+            sample.beta = channels.illuminant(sample.beta.to_array());
+        }
+        Some(sample)
+    }
+
+    /// `sample_emission` with the lights' own RGB emission.
+    #[inline]
+    fn sample_emission_rgb(
         &self,
         u_select: f32,
         u_point: [f32; 2],
@@ -321,7 +534,7 @@ impl SceneLights {
                 let local = crate::sampling::cosine_hemisphere(u_direction);
                 let pdf_direction = local.z * FRAC_1_PI;
                 Some(EmissionSample {
-                    emitter: Emitter::Area(light.triangle),
+                    emitter: Emitter(EmitterKind::Area(light.triangle)),
                     point: light.v0 + light.edge1 * b1 + light.edge2 * b2,
                     normal: light.normal,
                     direction: OrthonormalBasis::from_normal(light.normal).to_world(local),
@@ -330,6 +543,7 @@ impl SceneLights {
                     pdf_direction,
                     // Le·cos / (p_position · p_direction).
                     beta: light.emission * (local.z / (light.area_pdf * pdf_direction)),
+                    triangle: light.triangle,
                     barycentrics: [b1, b2],
                 })
             }
@@ -338,7 +552,7 @@ impl SceneLights {
                 let pdf_direction = light.direction_pdf(direction);
                 let emission = light.intensity(direction, &Channels::Rgb);
                 Some(EmissionSample {
-                    emitter: Emitter::Point(index as u32),
+                    emitter: Emitter(EmitterKind::Point(index as u32)),
                     point: light.position,
                     normal: direction,
                     direction,
@@ -346,11 +560,12 @@ impl SceneLights {
                     pdf_origin: select_pdf,
                     pdf_direction,
                     beta: emission / (select_pdf * pdf_direction),
+                    triangle: 0,
                     barycentrics: [0.0; 2],
                 })
             }
             Light::Directional { toward, irradiance } => self.emission_from_infinity(
-                Emitter::Directional(index as u32),
+                Emitter(EmitterKind::Directional(index as u32)),
                 *toward,
                 *irradiance,
                 select_pdf,
@@ -359,7 +574,7 @@ impl SceneLights {
             Light::Infinite => {
                 let (toward, radiance, pdf) = self.infinite.as_ref()?.sample(u_direction)?;
                 self.emission_from_infinity(
-                    Emitter::Infinite,
+                    Emitter(EmitterKind::Infinite),
                     toward,
                     radiance,
                     select_pdf * pdf,
@@ -369,9 +584,19 @@ impl SceneLights {
         }
     }
 
-    /// A light subpath from infinity along −`toward`: it starts on the disc facing
-    /// `toward` that covers the scene's bounding sphere (pbrt's construction), so every
-    /// point of the scene can be reached with an area density of |cos| / (π R²).
+    /// The point a light subpath from infinity along −`toward` starts from: uniform on
+    /// the disc facing `toward` that covers the scene's bounding sphere (pbrt's
+    /// construction), so every point of the scene can be reached with an area density of
+    /// |cos| / (π R²).
+    #[inline]
+    fn disc_point(&self, toward: Vec3A, u_point: [f32; 2]) -> Vec3A {
+        let (center, radius) = self.bounding_sphere;
+        let [dx, dy] = uniform_disk(u_point);
+        let basis = OrthonormalBasis::from_normal(toward);
+        center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius
+    }
+
+    /// A light subpath from infinity along −`toward`, from `disc_point`.
     #[inline]
     fn emission_from_infinity(
         &self,
@@ -381,10 +606,7 @@ impl SceneLights {
         pdf_origin: f32,
         u_point: [f32; 2],
     ) -> Option<EmissionSample> {
-        let (center, radius) = self.bounding_sphere;
-        let [dx, dy] = uniform_disk(u_point);
-        let basis = OrthonormalBasis::from_normal(toward);
-        let point = center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
+        let point = self.disc_point(toward, u_point);
         let pdf_direction = self.disc_pdf();
         Some(EmissionSample {
             emitter,
@@ -395,13 +617,47 @@ impl SceneLights {
             pdf_origin,
             pdf_direction,
             beta: emission / (pdf_origin * pdf_direction),
+            triangle: 0,
             barycentrics: [0.0; 2],
         })
     }
 
+    /// The first ray of a light subpath from light vertex `light` (at `point`, normal
+    /// `normal`, as `LightVertex` has them), with the direction density
+    /// `pdf_le_direction` gives it: cosine-weighted from an area light, uniform over the
+    /// sphere or the spot's outer cone from a point light, from `disc_point` along the
+    /// light at infinity. Returns the origin and direction; `None` if the direction has no
+    /// density.
+    #[inline]
+    pub(crate) fn sample_le_ray(
+        &self,
+        light: Emitter,
+        point: Vec3A,
+        normal: Vec3A,
+        u: [f32; 2],
+    ) -> Option<(Vec3A, Vec3A)> {
+        match light.0 {
+            EmitterKind::Area(_) => {
+                let local = crate::sampling::cosine_hemisphere(u);
+                if local.z <= 0.0 {
+                    return None;
+                }
+                Some((point, OrthonormalBasis::from_normal(normal).to_world(local)))
+            }
+            EmitterKind::Point(index) => {
+                let light = self.point_light(index);
+                let direction = light.sample_direction(u);
+                (light.direction_pdf(direction) > 0.0).then_some((point, direction))
+            }
+            EmitterKind::Directional(_) | EmitterKind::Infinite => {
+                Some((self.disc_point(normal, u), -normal))
+            }
+        }
+    }
+
     /// Area density of a light subpath's start on the disc of lights at infinity.
     #[inline]
-    pub(crate) fn disc_pdf(&self) -> f32 {
+    fn disc_pdf(&self) -> f32 {
         let radius = self.bounding_sphere.1;
         1.0 / (PI * radius * radius)
     }
@@ -418,6 +674,13 @@ impl SceneLights {
         self.infinite_select_pdf > 0.0
     }
 
+    /// The light a ray that leaves the scene ends on (`None` if it finds no light).
+    #[inline]
+    pub(crate) fn infinite_emitter(&self) -> Option<Emitter> {
+        self.has_infinite_light()
+            .then_some(Emitter(EmitterKind::Infinite))
+    }
+
     /// Radiance arriving from direction `w` (unit) along a ray that left the scene, in
     /// `channels`.
     #[inline]
@@ -428,7 +691,7 @@ impl SceneLights {
         }
     }
 
-    /// Density in solid angle with which `sample_light` (and `sample_emission`) choose
+    /// Density in solid angle with which `sample_vertex` (and `sample_emission`) choose
     /// direction `w` on the lights at infinity, the selection probability included.
     #[inline]
     pub(crate) fn infinite_pdf(&self, w: Vec3A) -> f32 {
@@ -438,9 +701,20 @@ impl SceneLights {
         }
     }
 
+    /// Radiance light vertex `light` sends along a ray that found it, arriving from
+    /// `toward` (pbrt's `Le`): the lights at infinity that rays can hit; zero for the others
+    /// (an area light is found as its triangle, by the surface hit).
+    #[inline]
+    pub(crate) fn le(&self, light: Emitter, toward: Vec3A, channels: &Channels) -> Spectrum {
+        match light.0 {
+            EmitterKind::Infinite => self.infinite_radiance(toward, channels),
+            _ => Spectrum::ZERO,
+        }
+    }
+
     /// Point or spot light number `index` of the scene's lights.
     #[inline]
-    pub(crate) fn point_light(&self, index: u32) -> &PointLight {
+    fn point_light(&self, index: u32) -> &PointLight {
         match &self.lights[index as usize] {
             Light::Point(light) => light,
             _ => unreachable!("light {index} is not a point light"),
@@ -449,38 +723,174 @@ impl SceneLights {
 
     /// Selection probability of light number `index`.
     #[inline]
-    pub(crate) fn light_select_pdf(&self, index: u32) -> f32 {
+    fn light_select_pdf(&self, index: u32) -> f32 {
         self.distribution.discrete_pdf(index as usize)
     }
 
-    /// Density in solid angle with which a light subpath leaves light vertex `emitter`
-    /// (at `point`, front normal `normal`) in direction `w`; for lights at infinity, the
-    /// disc's area density (times |cos| at the next vertex, which the caller applies).
+    /// Density of light vertex `light` as the start of a light subpath (see
+    /// `EmissionSample::pdf_origin`); `toward` is the direction of a light at infinity.
     #[inline]
-    pub(crate) fn emission_direction_pdf(&self, emitter: Emitter, normal: Vec3A, w: Vec3A) -> f32 {
-        match emitter {
-            Emitter::Area(_) => {
+    pub(crate) fn pdf_origin(
+        &self,
+        surfaces: &impl EmissiveSurfaces,
+        light: Emitter,
+        toward: Vec3A,
+    ) -> f32 {
+        match light.0 {
+            EmitterKind::Area(triangle) => surfaces.triangle_light_pdf(triangle),
+            EmitterKind::Point(index) | EmitterKind::Directional(index) => {
+                self.light_select_pdf(index)
+            }
+            EmitterKind::Infinite => self.infinite_pdf(toward),
+        }
+    }
+
+    /// Density with which a light subpath leaves light vertex `light` (at `from`, normal
+    /// `normal` as `LightVertex` has them) towards point `to` (pbrt's `PDF_Le`'s
+    /// direction part): in solid angle from area and point lights; for lights at infinity
+    /// the disc's area density (times |cos| at `to`, which the caller applies).
+    #[inline]
+    pub(crate) fn pdf_le_direction(
+        &self,
+        light: Emitter,
+        from: Vec3A,
+        normal: Vec3A,
+        to: Vec3A,
+    ) -> f32 {
+        match light.0 {
+            EmitterKind::Area(_) => {
+                let w = (to - from).normalize();
                 let cos = w.dot(normal);
                 if cos > 0.0 { cos * FRAC_1_PI } else { 0.0 }
             }
-            Emitter::Point(index) => self.point_light(index).direction_pdf(w),
-            Emitter::Directional(_) | Emitter::Infinite => self.disc_pdf(),
+            EmitterKind::Point(index) => {
+                let d = to - from;
+                let distance2 = d.length_squared();
+                if distance2 <= 0.0 || distance2.is_nan() {
+                    return 0.0;
+                }
+                self.point_light(index).direction_pdf(d / distance2.sqrt())
+            }
+            EmitterKind::Directional(_) | EmitterKind::Infinite => self.disc_pdf(),
         }
+    }
+
+    /// What light vertex `light` (normal `normal`; an area light's point at `barycentrics`)
+    /// emits towards unit direction `w`, in `channels`, and the vertex's density as a light
+    /// sample (`LightVertex::pdf`); `None` for a triangle that is not a light or a
+    /// direction behind an area light.
+    #[inline]
+    pub(crate) fn emitted(
+        &self,
+        surfaces: &impl EmissiveSurfaces,
+        light: Emitter,
+        normal: Vec3A,
+        barycentrics: [f32; 2],
+        w: Vec3A,
+        channels: &Channels,
+    ) -> Option<(Spectrum, f32)> {
+        match light.0 {
+            EmitterKind::Area(triangle) => {
+                let area_pdf = surfaces.triangle_light_pdf(triangle);
+                if area_pdf <= 0.0 {
+                    return None;
+                }
+                let emission = surfaces.surface_emission(triangle, barycentrics, channels);
+                // The light leaves its front side only.
+                if w.dot(normal) <= 0.0 {
+                    return None;
+                }
+                Some((emission, area_pdf))
+            }
+            EmitterKind::Point(index) => Some((
+                self.point_light(index).intensity(w, channels),
+                self.light_select_pdf(index),
+            )),
+            EmitterKind::Directional(index) => match &self.lights[index as usize] {
+                Light::Directional { irradiance, .. } => Some((
+                    channels.illuminant(irradiance.to_array()),
+                    self.light_select_pdf(index),
+                )),
+                _ => None,
+            },
+            EmitterKind::Infinite => Some((
+                self.infinite_radiance(normal, channels),
+                self.infinite_pdf(normal),
+            )),
+        }
+    }
+
+    /// A light subpath's throughput `beta` (emission over the origin's density) after its
+    /// first direction `w` from light vertex `light`: times the cosine at the light over
+    /// the direction's density (`pdf_le_direction`). From an area light the cosine cancels
+    /// (π); from the disc of a light at infinity the cosine at the next vertex is in both
+    /// the geometry term and its area density, and is left out. `None` where the
+    /// direction has no density.
+    #[inline]
+    pub(crate) fn weight_first_direction(
+        &self,
+        light: Emitter,
+        w: Vec3A,
+        beta: Spectrum,
+    ) -> Option<Spectrum> {
+        match light.0 {
+            EmitterKind::Area(_) => Some(beta * PI),
+            EmitterKind::Point(index) => {
+                let pdf = self.point_light(index).direction_pdf(w);
+                (pdf > 0.0).then(|| beta / pdf)
+            }
+            EmitterKind::Directional(_) | EmitterKind::Infinite => Some(beta / self.disc_pdf()),
+        }
+    }
+}
+
+/// What the path-space tests need to build light vertices of each kind.
+#[cfg(test)]
+impl SceneLights {
+    /// Light number `index` in selection order (area lights first, then the punctual
+    /// lights, the delta sun, the infinite light).
+    pub(crate) fn emitter(&self, index: usize) -> Emitter {
+        Emitter(match &self.lights[index] {
+            Light::Area(light) => EmitterKind::Area(light.triangle),
+            Light::Point(_) => EmitterKind::Point(index as u32),
+            Light::Directional { .. } => EmitterKind::Directional(index as u32),
+            Light::Infinite => EmitterKind::Infinite,
+        })
+    }
+
+    /// The number of area lights.
+    pub(crate) fn area_light_count(&self) -> usize {
+        self.area_light_pdfs().count()
+    }
+
+    /// A point or spot light's cone: its axis and cos of its outer angle.
+    pub(crate) fn cone(&self, light: Emitter) -> Option<(Vec3A, f32)> {
+        match light.0 {
+            EmitterKind::Point(index) => {
+                self.point_light(index).cone.map(|c| (c.axis, c.cos_outer))
+            }
+            _ => None,
+        }
+    }
+
+    /// The centre and radius of the sphere around the scene.
+    pub(crate) fn bounding_sphere(&self) -> (Vec3A, f32) {
+        self.bounding_sphere
     }
 }
 
 /// The scene's lights in selection order, their selection distribution and the lights at
 /// infinity: built by `Scene::new` after the area lights.
 pub(crate) struct SceneLights {
-    pub lights: Vec<Light>,
-    pub distribution: crate::sampling::Distribution1D,
+    lights: Vec<Light>,
+    distribution: crate::sampling::Distribution1D,
     /// The environment and sun disc, if any.
-    pub infinite: Option<InfiniteLight>,
+    infinite: Option<InfiniteLight>,
     /// Selection probability of the lights at infinity (0: none, or black).
-    pub infinite_select_pdf: f32,
+    infinite_select_pdf: f32,
     /// Centre and radius of a sphere around the geometry: light subpaths from infinity
     /// start on a disc of this radius.
-    pub bounding_sphere: (Vec3A, f32),
+    bounding_sphere: (Vec3A, f32),
 }
 
 impl SceneLights {

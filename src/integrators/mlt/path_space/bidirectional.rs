@@ -35,9 +35,9 @@
 //! where |·| is luminance and splits that cannot produce the path (a connection at a
 //! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term.
 //!
-//! A new light vertex is picked as `Scene::sample_light` picks it (a point on a triangle, a
-//! point or spot light, or a direction at infinity), and the light side's first ray leaves
-//! it as `sample_emission`'s would (`emission_ray`); a lens side whose last vertex is the
+//! A new light vertex is picked as `SceneLights::sample_vertex` picks it (a point on a
+//! triangle, a point or spot light, or a direction at infinity), and the light side's first
+//! ray leaves it as `sample_emission`'s would (`SceneLights::sample_le_ray`); a lens side whose last vertex is the
 //! path's light ends on the lights at infinity if its ray leaves the scene. A light that is
 //! not a triangle never becomes an inner vertex (a move keeping the whole path as its lens
 //! side and adding vertices before it is refused; such paths have f = 0). This is Veach's form (the sum over splits);
@@ -47,13 +47,11 @@
 use super::{PathSpace, PathVertex};
 use crate::accel::Ray;
 use crate::bsdf::TransportMode;
-use crate::integrators::spawn_ray;
-use crate::sampling::{OrthonormalBasis, Rng, cosine_hemisphere, uniform_disk};
-use crate::scene::lights::{Emitter, LightSample, uniform_sphere};
+use crate::integrators::{emission_ray, spawn_ray};
+use crate::sampling::Rng;
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
-use std::f32::consts::TAU;
 
 /// Probabilities of δ = n_a − n_d = −2, −1, 0, 1, 2: mostly the same length, as Veach
 /// suggests. Symmetric, so p_add(n_a | n_d) = p_add(n_d | n_a).
@@ -257,43 +255,26 @@ impl Bidirectional {
                 if !scene.lights.has_lights() {
                     return None;
                 }
-                // With the densities `unweighted_contribution` gives x_0 (`sample_light`'s,
+                // With the densities `unweighted_contribution` gives x_0 (`sample_vertex`'s,
                 // which are `sample_emission`'s).
-                match scene.sample_light(rng.uniform(), rng.uniform2(), &space.channels)? {
-                    LightSample::Area {
-                        point,
-                        normal,
-                        triangle,
-                        barycentrics,
-                        ..
-                    } => Some(PathVertex::on_triangle(
-                        point,
-                        normal,
-                        triangle,
-                        barycentrics,
-                    )),
-                    LightSample::Point {
-                        light, position, ..
-                    } => Some(PathVertex::point_light(light, position)),
-                    LightSample::Direction {
-                        emitter, toward, ..
-                    } => Some(PathVertex::at_infinity(emitter, toward)),
-                }
+                let v = scene.lights.sample_vertex(rng.uniform(), rng.uniform2())?;
+                Some(PathVertex::on_light(
+                    v.light,
+                    v.point,
+                    v.normal,
+                    v.triangle,
+                    v.barycentrics,
+                ))
             }
-            [light] => match light.light {
-                None => {
-                    let local = cosine_hemisphere(rng.uniform2());
-                    if local.z <= 0.0 {
-                        return None;
-                    }
-                    let direction = OrthonormalBasis::from_normal(light.normal).to_world(local);
-                    space.trace(&spawn_ray(scene, light.p, light.normal, direction), rays)
-                }
-                Some(_) => {
-                    let ray = emission_ray(scene, light, rng.uniform2())?;
-                    space.trace(&ray, rays)
-                }
-            },
+            [light] => {
+                let emitter = light.emitter();
+                let (origin, direction) =
+                    scene
+                        .lights
+                        .sample_le_ray(emitter, light.p, light.normal, rng.uniform2())?;
+                let ray = emission_ray(scene, emitter, origin, light.normal, direction);
+                space.trace(&ray, rays)
+            }
             [.., previous, end] => {
                 let wo = arrival_back(space, previous, false, end);
                 let wi = sample_direction(space, wo, end, TransportMode::Importance, rng)?;
@@ -357,46 +338,6 @@ impl Bidirectional {
     }
 }
 
-/// The first ray of a light side from light vertex `light` that is not a triangle, with
-/// the density `unweighted_contribution` gives it: from a point or spot light uniformly
-/// over the sphere or the spot's outer cone (`PointLight::direction_pdf`); from a light at
-/// infinity along it, from a uniform point of the disc facing it that covers the scene's
-/// bounding sphere (`Scene::disc_pdf`, as `sample_emission`).
-fn emission_ray(scene: &crate::scene::Scene, light: &PathVertex, u: [f32; 2]) -> Option<Ray> {
-    match light.light? {
-        Emitter::Point(index) => {
-            let point = scene.lights.point_light(index);
-            let direction = match &point.cone {
-                None => uniform_sphere(u),
-                Some(cone) => {
-                    let cos_theta = 1.0 - u[0] * (1.0 - cone.cos_outer);
-                    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                    let (sin_phi, cos_phi) = (TAU * u[1]).sin_cos();
-                    OrthonormalBasis::from_normal(cone.axis).to_world(Vec3A::new(
-                        cos_phi * sin_theta,
-                        sin_phi * sin_theta,
-                        cos_theta,
-                    ))
-                }
-            };
-            if point.direction_pdf(direction) <= 0.0 {
-                return None;
-            }
-            Some(Ray::new(light.p, direction, 0.0, f32::INFINITY))
-        }
-        Emitter::Area(_) => None,
-        Emitter::Directional(_) | Emitter::Infinite => {
-            let (center, radius) = scene.lights.bounding_sphere;
-            let toward = light.normal;
-            let [dx, dy] = uniform_disk(u);
-            let basis = OrthonormalBasis::from_normal(toward);
-            let origin =
-                center + toward * radius + basis.to_world(Vec3A::new(dx, dy, 0.0)) * radius;
-            Some(Ray::new(origin, -toward, 0.0, f32::INFINITY))
-        }
-    }
-}
-
 /// The unit direction from `at` back along the ray that reached it from `from`. That ray
 /// left from `from`'s offset origin (`spawn_ray`), unless `from` is the lens or a light that
 /// is not a triangle: a direction rebuilt from the two points alone would bend a specular
@@ -440,12 +381,14 @@ mod tests {
     use super::*;
     use crate::accel::Backend;
     use crate::integrators::mlt::acceptance;
+    use crate::sampling::OrthonormalBasis;
     use crate::sampling::chi_square::{
         Z_999, Z_9999, quantile as chi_square_quantile, statistic as chi_square,
     };
     use crate::scene::{Camera, CameraModel, Material, Scene, SceneDesc};
     use crate::spectral::Channels;
     use glam::DVec3;
+    use std::f32::consts::TAU;
     use std::f64::consts::PI;
 
     #[test]
@@ -921,62 +864,62 @@ mod tests {
             punctual: &punctual,
             ..Default::default()
         });
-        let (center, radius) = scene.lights.bounding_sphere;
+        let (center, radius) = scene.lights.bounding_sphere();
         let bins = 20;
         let draws = 100_000;
         let threshold = chi_square_quantile(bins - 1, Z_9999);
         let uniform = vec![1.0 / bins as f64; bins];
         let bin = |x: f32| ((x * bins as f32) as usize).min(bins - 1);
-        // The lights' indices: the area lights (triangles) first, then the punctual ones.
-        let areas = scene
-            .lights
-            .lights
-            .iter()
-            .filter(|l| matches!(l, crate::scene::lights::Light::Area(_)))
-            .count() as u32;
+        // The lights' indices: the area lights (triangles) first, then the punctual ones,
+        // then the sun.
+        let areas = scene.lights.area_light_count();
+        let position = Vec3A::new(0.0, 1.2, 0.0);
         let lights = [
-            PathVertex::point_light(areas, Vec3A::new(0.0, 1.2, 0.0)),
-            PathVertex::point_light(areas + 1, Vec3A::new(0.0, 1.2, 0.0)),
-            PathVertex::at_infinity(
-                Emitter::Directional(areas + 2),
+            (scene.lights.emitter(areas), position),
+            (scene.lights.emitter(areas + 1), position),
+            (
+                scene.lights.emitter(areas + 2),
                 Vec3A::new(-0.3, 1.0, -0.4).normalize(),
             ),
-            PathVertex::at_infinity(Emitter::Infinite, Vec3A::new(0.1, 0.9, 0.2).normalize()),
+            (
+                scene.lights.emitter(areas + 3),
+                Vec3A::new(0.1, 0.9, 0.2).normalize(),
+            ),
         ];
         let mut rng = Rng::new(0xE111, 0);
-        for (index, light) in lights.iter().enumerate() {
+        for (index, &(light, at)) in lights.iter().enumerate() {
+            let vertex = PathVertex::on_light(light, at, at, 0, [0.0; 2]);
+            let cone = scene.lights.cone(light);
             let (mut first, mut second) = (vec![0u64; bins], vec![0u64; bins]);
             let mut shaped = vec![0u64; bins];
             for _ in 0..draws {
                 let u = rng.uniform2();
-                let ray = emission_ray(&scene, light, u).expect("a ray");
+                let (origin, direction) = scene
+                    .lights
+                    .sample_le_ray(light, vertex.p, vertex.normal, u)
+                    .expect("a ray");
+                let ray = emission_ray(&scene, light, origin, vertex.normal, direction);
                 // Coordinates that are uniform under the density.
-                let (a, b) = match light.light {
-                    Some(Emitter::Point(i)) => {
-                        let point = scene.lights.point_light(i);
-                        let (axis, cos_max) = point
-                            .cone
-                            .map_or((Vec3A::Y, -1.0), |c| (c.axis, c.cos_outer));
-                        let basis = OrthonormalBasis::from_normal(axis);
-                        let w = ray.direction;
-                        assert!((ray.origin - light.p).length() < 1e-6);
-                        let phi = basis.bitangent.dot(w).atan2(basis.tangent.dot(w));
-                        let a = (1.0 - axis.dot(w)) / (1.0 - cos_max);
-                        if point.cone.is_some() {
-                            // A shaped cone, cos θ = 1 − u²(1 − cos θ_max), would have a = u².
-                            shaped[bin(u[0] * u[0])] += 1;
-                        }
-                        (a, phi / TAU + 0.5)
+                let (a, b) = if light.is_delta_position() {
+                    let (axis, cos_max) = cone.unwrap_or((Vec3A::Y, -1.0));
+                    let basis = OrthonormalBasis::from_normal(axis);
+                    let w = ray.direction;
+                    assert!((ray.origin - vertex.p).length() < 1e-6);
+                    let phi = basis.bitangent.dot(w).atan2(basis.tangent.dot(w));
+                    let a = (1.0 - axis.dot(w)) / (1.0 - cos_max);
+                    if cone.is_some() {
+                        // A shaped cone, cos θ = 1 − u²(1 − cos θ_max), would have a = u².
+                        shaped[bin(u[0] * u[0])] += 1;
                     }
-                    _ => {
-                        let toward = light.normal;
-                        assert!((ray.direction + toward).length() < 1e-5);
-                        let offset = ray.origin - center - toward * radius;
-                        assert!(offset.dot(toward).abs() < 1e-3 * radius);
-                        let basis = OrthonormalBasis::from_normal(toward);
-                        let (x, y) = (basis.tangent.dot(offset), basis.bitangent.dot(offset));
-                        ((x * x + y * y) / (radius * radius), y.atan2(x) / TAU + 0.5)
-                    }
+                    (a, phi / TAU + 0.5)
+                } else {
+                    let toward = vertex.normal;
+                    assert!((ray.direction + toward).length() < 1e-5);
+                    let offset = ray.origin - center - toward * radius;
+                    assert!(offset.dot(toward).abs() < 1e-3 * radius);
+                    let basis = OrthonormalBasis::from_normal(toward);
+                    let (x, y) = (basis.tangent.dot(offset), basis.bitangent.dot(offset));
+                    ((x * x + y * y) / (radius * radius), y.atan2(x) / TAU + 0.5)
                 };
                 first[bin(a)] += 1;
                 second[bin(b)] += 1;
@@ -988,8 +931,7 @@ mod tests {
                     "light {index} {name}: chi-square {stat} ≥ {threshold}: {counts:?}"
                 );
             }
-            if matches!(light.light, Some(Emitter::Point(i)) if scene.lights.point_light(i).cone.is_some())
-            {
+            if cone.is_some() {
                 let stat = chi_square(&shaped, 0, &uniform);
                 assert!(stat > 10.0 * threshold, "the shaped cone passes: {stat}");
             }

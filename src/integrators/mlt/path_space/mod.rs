@@ -78,12 +78,10 @@ pub(crate) use perturbation::PerturbationSizes;
 use crate::bsdf::{Bsdf, TransportMode};
 use crate::integrators::PathVertex;
 use crate::interaction::{SurfaceInteraction, vertex_bsdf};
-use crate::scene::lights::{Emitter, Light};
 use crate::scene::{CameraModel, Scene};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
-use std::f32::consts::PI;
 
 /// A vertex's class for the perturbations (see [`PathSpace::class`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -241,10 +239,11 @@ impl PathSpace<'_> {
     fn trace_or_escape(&self, ray: &crate::accel::Ray, rays: &mut u64) -> Option<PathVertex> {
         match self.trace(ray, rays) {
             Some(v) => Some(v),
-            None if self.scene.lights.has_infinite_light() => {
-                Some(PathVertex::at_infinity(Emitter::Infinite, ray.direction))
-            }
-            None => None,
+            None => self
+                .scene
+                .lights
+                .infinite_emitter()
+                .map(|light| PathVertex::at_infinity(light, ray.direction)),
         }
     }
 
@@ -259,12 +258,12 @@ impl PathSpace<'_> {
             return !self.scene.blocked(&ray);
         }
         // Point lights and the lens have no surface to offset from.
-        let normal_a = if a.is_point_light() {
+        let normal_a = if a.is_delta_position() {
             Vec3A::ZERO
         } else {
             a.normal
         };
-        let normal_b = if b_is_lens || b.is_point_light() {
+        let normal_b = if b_is_lens || b.is_delta_position() {
             Vec3A::ZERO
         } else {
             b.normal
@@ -345,50 +344,22 @@ impl PathSpace<'_> {
         let t = n - s;
         let light = &path[0];
         // Le towards x_1 (radiance; intensity for a point light, irradiance for a
-        // directional one) and x_0's density as a light sample (`sample_light`'s, the same as
+        // directional one) and x_0's density as a light sample (`sample_vertex`'s, the same as
         // `sample_emission`'s): per unit area on a triangle, in solid angle at infinity.
-        let (emission, origin_pdf) = match light.light {
-            None => {
-                let area_pdf = self.scene.light_area_pdf(light.triangle);
-                if area_pdf <= 0.0 {
-                    return None;
-                }
-                let emission =
-                    self.scene
-                        .emission(light.triangle, light.barycentrics, &self.channels);
-                // The light leaves its front side only.
-                let (w_light, _) = direction(&path[0], &path[1])?;
-                if w_light.dot(light.normal) <= 0.0 {
-                    return None;
-                }
-                (emission, area_pdf)
-            }
-            // A delta light cannot be hit: strategy s = 0 has no density (BDPT skips it).
-            Some(e) if s == 0 && e.is_delta() => return None,
-            Some(Emitter::Point(index)) => {
-                let (w, _) = direction(&path[0], &path[1])?;
-                let intensity = self
-                    .scene
-                    .lights
-                    .point_light(index)
-                    .intensity(w, &self.channels);
-                (intensity, self.scene.lights.light_select_pdf(index))
-            }
-            Some(Emitter::Directional(index)) => match &self.scene.lights.lights[index as usize] {
-                Light::Directional { irradiance, .. } => {
-                    (*irradiance, self.scene.lights.light_select_pdf(index))
-                }
-                _ => return None,
-            },
-            Some(Emitter::Infinite) => (
-                self.scene
-                    .lights
-                    .infinite_radiance(light.normal, &self.channels),
-                self.scene.lights.infinite_pdf(light.normal),
-            ),
-            Some(Emitter::Area(_)) => return None,
-        };
-        if light.light.is_some() && s >= 1 && origin_pdf <= 0.0 {
+        let emitter = light.emitter();
+        // A delta light cannot be hit: strategy s = 0 has no density (BDPT skips it).
+        if s == 0 && emitter.is_delta() {
+            return None;
+        }
+        let (w_light, _) = direction(&path[0], &path[1])?;
+        let (emission, origin_pdf) = self.scene.light_emitted(
+            emitter,
+            light.normal,
+            light.barycentrics,
+            w_light,
+            &self.channels,
+        )?;
+        if s >= 1 && origin_pdf <= 0.0 {
             return None;
         }
 
@@ -397,23 +368,10 @@ impl PathSpace<'_> {
         if s >= 1 {
             beta_light = emission / origin_pdf;
             if s >= 2 {
-                match light.light {
-                    // Cosine-weighted emission: Le·cos / (p_position · cos/π).
-                    None => beta_light *= PI,
-                    // Divided by the emitted direction's density: the cosine at x_1 is in
-                    // both the geometry term and its area density.
-                    Some(Emitter::Point(index)) => {
-                        let (w, _) = direction(&path[0], &path[1])?;
-                        let pdf = self.scene.lights.point_light(index).direction_pdf(w);
-                        if pdf <= 0.0 {
-                            return None;
-                        }
-                        beta_light /= pdf;
-                    }
-                    // From the disc facing the scene: x_1's area density is the disc's times
-                    // its |cos|, which cancels the geometry term's.
-                    Some(_) => beta_light /= self.scene.lights.disc_pdf(),
-                }
+                beta_light = self
+                    .scene
+                    .lights
+                    .weight_first_direction(emitter, w_light, beta_light)?;
             }
             for j in 1..s.saturating_sub(1) {
                 beta_light *= self.weight(
@@ -471,7 +429,7 @@ impl PathSpace<'_> {
             let geometry = if qs.is_at_infinity() {
                 // Towards a direction: no distance, and no cosine at the light.
                 w.dot(pt.normal).abs()
-            } else if qs.is_point_light() {
+            } else if qs.is_delta_position() {
                 w.dot(pt.normal).abs() / distance2
             } else {
                 w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2
@@ -780,6 +738,58 @@ mod tests {
         }
     }
 
+    /// The same in spectral mode for the lights whose emission is converted to the sampled
+    /// wavelengths on its own (not through a triangle's material): a point light, a
+    /// directional light and a delta sun under a constant sky, in the box without a ceiling.
+    #[test]
+    fn unweighted_contributions_match_bdpt_in_spectral_mode_with_lights_that_are_not_triangles() {
+        use crate::scene::{EnvironmentDesc, LightsDesc, PunctualLight, SunDesc};
+        let sky = [0.4f32, 0.5, 0.7];
+        let point = [PunctualLight::point([278.0, 400.0, 280.0], [4e4, 3e4, 2e4])];
+        let directional = [PunctualLight::directional(
+            [0.3, -1.0, 0.5],
+            [3.0, 1.5, 0.5],
+        )];
+        let delta_sun = SunDesc {
+            direction: [-0.2, 1.0, -0.4],
+            angular_radius_degrees: 0.0,
+            irradiance: [0.5, 2.0, 1.5],
+        };
+        let cases: [(&str, LightsDesc); 3] = [
+            (
+                "point",
+                LightsDesc {
+                    punctual: &point,
+                    ..Default::default()
+                },
+            ),
+            (
+                "directional",
+                LightsDesc {
+                    punctual: &directional,
+                    ..Default::default()
+                },
+            ),
+            (
+                "delta sun + sky",
+                LightsDesc {
+                    environment: Some(EnvironmentDesc::constant(&sky)),
+                    sun: Some(delta_sun),
+                    punctual: &[],
+                },
+            ),
+        ];
+        for (label, lights) in cases {
+            let (scene, camera) = open("cornell-box", lights);
+            let compared = compare_with_bdpt_in(label, &scene, &camera, 3, 2_000, true);
+            println!("{label}: {compared:?}");
+            for (s, t) in [(1, 2), (2, 2), (1, 3)] {
+                let (count, ..) = compared.get(&(s, t)).copied().unwrap_or_default();
+                assert!(count > 20, "{label}: ({s}, {t}) compared {count} times");
+            }
+        }
+    }
+
     /// Fixed perturbation moves: a film offset, directions turned by a fixed rotation.
     struct FixedKernel {
         film_offset: [f32; 2],
@@ -894,8 +904,8 @@ mod tests {
                         bdpt.strategy_path(&scratch, s, t, &mut x);
                         let kind = match x[0].light {
                             None => continue,
-                            Some(Emitter::Infinite) => "infinite",
-                            Some(Emitter::Point(_)) => "point",
+                            Some(light) if !light.is_delta() => "infinite",
+                            Some(light) if light.is_delta_position() => "point",
                             Some(_) => "directional",
                         };
                         // Paths into a corner (an edge of a few units in a box of 550) or

@@ -78,7 +78,6 @@ use crate::accel::Ray;
 use crate::bsdf::{Microfacet, SpecularLobe};
 use crate::integrators::spawn_ray;
 use crate::sampling::{OrthonormalBasis, Rng};
-use crate::scene::lights::Emitter;
 use crate::spectral::{Channels, SampledWavelengths};
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, TAU};
@@ -494,7 +493,8 @@ pub(crate) fn lens(
                     }
                     v
                 }
-                Some(Emitter::Infinite) => {
+                // A light at infinity that rays hit (the environment, the sun disc).
+                Some(light) if !light.is_delta() => {
                     let v = space.trace_or_escape(&ray, rays)?;
                     if !v.is_at_infinity() {
                         return None;
