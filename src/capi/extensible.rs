@@ -11,7 +11,7 @@
 //! an explicit `_reserved` one), and its end goes into `EARLIER_LAYOUTS` of the previous
 //! layout. The unit tests check the sizes stay distinct.
 
-use super::convert::algorithm_to_c;
+use super::convert::CField;
 use super::marshal::check_pointer;
 use super::types::*;
 use crate::error::*;
@@ -370,32 +370,41 @@ impl Extensible for MltRenderSettings {
     const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltRenderSettings, filter_buffers)];
     fn defaults() -> Self {
         let d = RenderSettings::default();
-        MltRenderSettings {
-            struct_size: size_of::<Self>() as u32,
-            width: d.width,
-            height: d.height,
-            algorithm: algorithm_to_c(d.algorithm),
-            samples_per_pixel: d.samples_per_pixel,
-            max_depth: d.max_depth,
-            threads: d.threads,
-            seed: d.seed,
-            time_limit_seconds: d.time_limit_seconds,
-            mutations_per_pixel: d.mutations_per_pixel,
-            bootstrap_samples: d.bootstrap_samples,
-            chains: d.chains,
-            large_step_probability: d.large_step_probability,
-            small_step_sigma: d.small_step_sigma,
-            direct_samples_per_mutation: d.direct_samples_per_mutation,
-            mutation_weights: d.mutation_weights.0,
-            erpt_chain_length: d.erpt_chain_length,
-            erpt_deposit_energy: d.erpt_deposit_energy,
-            adapt_mutation_weights: d.adapt_mutation_weights as u32,
-            perturb_in_sample_space: d.perturb_in_sample_space as u32,
-            filter_buffers: d.filter_buffers,
-            filter_strength: d.filter_strength,
-            filter_radius: d.filter_radius,
-            normalization_work_fraction: d.normalization_work_fraction,
-            spectral: d.spectral as u32,
+        macro_rules! to_c {
+            ($($name:ident,)*) => {
+                MltRenderSettings {
+                    struct_size: size_of::<Self>() as u32,
+                    $($name: d.$name.to_c(),)*
+                }
+            };
+        }
+        to_c! {
+            // BEGIN GENERATED settings to C: tests/parameters.rs writes these lines from src/render/settings.rs
+            width,
+            height,
+            algorithm,
+            samples_per_pixel,
+            max_depth,
+            threads,
+            seed,
+            time_limit_seconds,
+            mutations_per_pixel,
+            bootstrap_samples,
+            chains,
+            large_step_probability,
+            small_step_sigma,
+            direct_samples_per_mutation,
+            mutation_weights,
+            erpt_chain_length,
+            erpt_deposit_energy,
+            adapt_mutation_weights,
+            perturb_in_sample_space,
+            filter_buffers,
+            filter_strength,
+            filter_radius,
+            normalization_work_fraction,
+            spectral,
+            // END GENERATED settings to C
         }
     }
 }
