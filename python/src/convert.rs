@@ -160,6 +160,27 @@ pub fn algorithm_name(algorithm: Algorithm) -> &'static str {
 }
 
 static SETTINGS_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// A setting's value as `mlt.RenderSettings` holds it.
+pub fn setting_to_py<'py>(
+    py: Python<'py>,
+    kind: Kind,
+    value: Value,
+) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match (kind, value) {
+        (_, Value::Int(v)) => v.into_pyobject(py)?.into_any(),
+        (Kind::F32, Value::Float(v)) => shortest(v as f32).into_pyobject(py)?.into_any(),
+        (_, Value::Float(v)) => v.into_pyobject(py)?.into_any(),
+        (_, Value::Bool(v)) => v.into_pyobject(py)?.to_owned().into_any(),
+        (_, Value::Floats(v)) => {
+            let [a, b, c, d] = v.map(shortest);
+            (a, b, c, d).into_pyobject(py)?.into_any()
+        }
+        (_, Value::Choice(name)) => ALGORITHM_CLASS
+            .import(py, "mlt._types", "Algorithm")?
+            .call1((name,))?,
+    })
+}
 static ALGORITHM_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// An `mlt.RenderSettings`, the inverse of `settings`.
@@ -170,20 +191,7 @@ pub fn settings_to_py<'py>(
     let kwargs = PyDict::new(py);
     for p in RenderSettings::parameters() {
         let value = settings.get(p.name).expect("a declared setting");
-        match (p.kind, value) {
-            (_, Value::Int(v)) => kwargs.set_item(p.name, v)?,
-            (Kind::F32, Value::Float(v)) => kwargs.set_item(p.name, shortest(v as f32))?,
-            (_, Value::Float(v)) => kwargs.set_item(p.name, v)?,
-            (_, Value::Bool(v)) => kwargs.set_item(p.name, v)?,
-            (_, Value::Floats(v)) => {
-                let [a, b, c, d] = v.map(shortest);
-                kwargs.set_item(p.name, (a, b, c, d))?
-            }
-            (_, Value::Choice(name)) => {
-                let class = ALGORITHM_CLASS.import(py, "mlt._types", "Algorithm")?;
-                kwargs.set_item(p.name, class.call1((name,))?)?
-            }
-        }
+        kwargs.set_item(p.name, setting_to_py(py, p.kind, value)?)?;
     }
     SETTINGS_CLASS
         .import(py, "mlt._types", "RenderSettings")?
