@@ -904,3 +904,33 @@ fn every_setting_has_its_flag_default_and_message() {
         );
     }
 }
+
+/// A material the kernel refuses is named as the file names it: the kernel's error says
+/// which material it is about, not only by its text.
+#[test]
+fn a_refused_material_is_named_from_the_file() {
+    let dir = temp_path("bad-material");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("bad.mtl"),
+        "newmtl fine\nKd 0.5 0.5 0.5\nnewmtl too_bright\nKd 1.5 0.5 0.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bad.obj"),
+        "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl fine\nf 1 2 3\nusemtl too_bright\nf 1 3 2\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bad.camera.json"),
+        r#"{"eye": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40, "width": 4, "height": 4}"#,
+    )
+    .unwrap();
+    let output = mlt_render(&[&dir.join("bad.obj"), &"--out", &dir.join("out.pfm")]);
+    let line = assert_one_line_error(&output);
+    assert!(
+        line.contains("desc.materials[1].color.x is 1.5")
+            && line.ends_with("(material 'too_bright')"),
+        "{line}"
+    );
+}

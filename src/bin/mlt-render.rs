@@ -6,7 +6,7 @@ use clap::builder::{PossibleValuesParser, TypedValueParser, ValueParser};
 use clap::parser::ValueSource;
 use clap::{Arg, ArgAction, ArgMatches, Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use mlt::io::{CameraFile, ImageFormat, SceneData};
+use mlt::io::{CameraFile, ImageFormat};
 use mlt::params::{ChoiceParameter, Kind, Parameters, Value};
 use mlt::scene::{EnvironmentDesc, LightsDesc, SunDesc};
 use mlt::{RenderSettings, RenderStats, Scene, StopReason};
@@ -331,18 +331,7 @@ fn run(args: &Args) -> Result<(), String> {
 
     let load_start = Instant::now();
     let mut data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    for material in &mut data.materials {
-        material.energy_compensation = args.energy_compensation;
-        let transmits = material.kind == mlt::MaterialKind::Dielectric
-            || (material.kind == mlt::MaterialKind::MetallicRoughness
-                && material.transmission > 0.0);
-        if let Some(abbe_number) = args.abbe_number
-            && transmits
-            && material.abbe_number == 0.0
-        {
-            material.abbe_number = abbe_number;
-        }
-    }
+    data.override_materials(args.energy_compensation, args.abbe_number);
     let framed = data.camera.is_none() && args.camera.is_none();
     let camera_file = match &args.camera {
         Some(path) => mlt::io::load_camera_json(path).map_err(|e| e.to_string())?,
@@ -390,7 +379,7 @@ fn run(args: &Args) -> Result<(), String> {
             "cannot build the scene from {}: {}: {}",
             args.scene.display(),
             e.status.description(),
-            describe_scene_error(&e, &data)
+            data.describe_error(&e)
         )
     })?;
     let load_seconds = load_start.elapsed().as_secs_f64();
@@ -486,20 +475,6 @@ fn settings(args: &Args, camera: &CameraFile) -> Result<RenderSettings, String> 
         settings.filter_buffers = RenderSettings::DEFAULT_FILTER_BUFFERS;
     }
     Ok(settings)
-}
-
-/// The kernel names a material by index; add its name from the file.
-fn describe_scene_error(error: &mlt::Error, data: &SceneData) -> String {
-    let message = &error.message;
-    let named = message
-        .strip_prefix("desc.materials[")
-        .and_then(|rest| rest.split(']').next())
-        .and_then(|index| index.parse::<usize>().ok())
-        .and_then(|index| data.material_names.get(index));
-    match named {
-        Some(name) => format!("{message} (material '{name}')"),
-        None => message.clone(),
-    }
 }
 
 fn check_output_directory(out: &Path) -> Result<(), String> {
