@@ -369,7 +369,13 @@ impl Extensible for MltRenderSettings {
     /// not told apart: a host passes the filter fields with it or not at all.
     const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltRenderSettings, filter_buffers)];
     fn defaults() -> Self {
-        let d = RenderSettings::default();
+        (&RenderSettings::default()).into()
+    }
+}
+
+/// The C struct of Rust's settings, with today's `struct_size`.
+impl From<&RenderSettings> for MltRenderSettings {
+    fn from(d: &RenderSettings) -> Self {
         macro_rules! to_c {
             ($($name:ident,)*) => {
                 MltRenderSettings {
