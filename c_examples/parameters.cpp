@@ -130,6 +130,10 @@ int main() {
     show("c++", "normalization_work_fraction", cpp.normalization_work_fraction);
     show("c", "spectral", c.spectral);
     show("c++", "spectral", cpp.spectral);
+    show("c", "roulette_start_depth", c.roulette_start_depth);
+    show("c++", "roulette_start_depth", cpp.roulette_start_depth);
+    show("c", "roulette_max_survival", c.roulette_max_survival);
+    show("c++", "roulette_max_survival", cpp.roulette_max_survival);
     {
         mlt::RenderSettings s;
         s.width = 0;
@@ -274,6 +278,22 @@ int main() {
         MltRenderSettings cs = c;
         cs.normalization_work_fraction = 1.8f;
         message("c", "normalization_work_fraction", scene, cs);
+    }
+    {
+        mlt::RenderSettings s;
+        s.roulette_start_depth = 1025;
+        message("c++", "roulette_start_depth", scene, s.to_c());
+        MltRenderSettings cs = c;
+        cs.roulette_start_depth = 1025;
+        message("c", "roulette_start_depth", scene, cs);
+    }
+    {
+        mlt::RenderSettings s;
+        s.roulette_max_survival = 0.0f;
+        message("c++", "roulette_max_survival", scene, s.to_c());
+        MltRenderSettings cs = c;
+        cs.roulette_max_survival = 0.0f;
+        message("c", "roulette_max_survival", scene, cs);
     }
     // END GENERATED checks
     mlt_scene_release(scene);

@@ -992,6 +992,16 @@ typedef struct MltRenderSettings {
    * 0 or 1. Default 0.
    */
   uint32_t spectral;
+  /**
+   * Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path. It
+   * must be at most 1024. Default 3.
+   */
+  uint32_t roulette_start_depth;
+  /**
+   * Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+   * on. It must be in (0, 1]. Default 0.95.
+   */
+  float roulette_max_survival;
 } MltRenderSettings;
 
 /**

@@ -913,6 +913,11 @@ struct RenderSettings {
     float normalization_work_fraction = 0.05f;
     /// Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
     bool spectral = false;
+    /// Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.
+    std::uint32_t roulette_start_depth = 3;
+    /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    /// on.
+    float roulette_max_survival = 0.95f;
     // END GENERATED members
 
     /// The C struct: mlt_render_settings_default, then every field of this struct.
@@ -944,6 +949,8 @@ struct RenderSettings {
         c.filter_radius = filter_radius;
         c.normalization_work_fraction = normalization_work_fraction;
         c.spectral = spectral ? 1u : 0u;
+        c.roulette_start_depth = roulette_start_depth;
+        c.roulette_max_survival = roulette_max_survival;
         // END GENERATED to C
         return c;
     }
@@ -974,6 +981,8 @@ struct RenderSettings {
         s.filter_radius = c.filter_radius;
         s.normalization_work_fraction = c.normalization_work_fraction;
         s.spectral = c.spectral != 0;
+        s.roulette_start_depth = c.roulette_start_depth;
+        s.roulette_max_survival = c.roulette_max_survival;
         // END GENERATED from C
         return s;
     }

@@ -223,6 +223,11 @@ class RenderSettings:
     normalization_work_fraction: float = 0.05
     #: Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
     spectral: bool = False
+    #: Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.
+    roulette_start_depth: int = 3
+    #: Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    #: on.
+    roulette_max_survival: float = 0.95
     # END GENERATED render settings
 
 

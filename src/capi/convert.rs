@@ -277,6 +277,8 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         filter_radius,
         normalization_work_fraction,
         spectral,
+        roulette_start_depth,
+        roulette_max_survival,
         // END GENERATED settings from C
     }
 }

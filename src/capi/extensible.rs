@@ -366,8 +366,12 @@ impl Extensible for MltRenderSettings {
     /// The settings before the post-process filter's fields (mlt 0.1 had them without
     /// `struct_size`). `normalization_work_fraction`, added after the filter, fits the
     /// filter layout's tail padding, so that intermediate layout has today's size and is
-    /// not told apart: a host passes the filter fields with it or not at all.
-    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltRenderSettings, filter_buffers)];
+    /// not told apart: a host passes the filter fields with it or not at all. Then the
+    /// settings before Russian roulette's.
+    const EARLIER_LAYOUTS: &'static [usize] = &[
+        offset_of!(MltRenderSettings, filter_buffers),
+        offset_of!(MltRenderSettings, roulette_start_depth),
+    ];
     fn defaults() -> Self {
         (&RenderSettings::default()).into()
     }
@@ -410,6 +414,8 @@ impl From<&RenderSettings> for MltRenderSettings {
             filter_radius,
             normalization_work_fraction,
             spectral,
+            roulette_start_depth,
+            roulette_max_survival,
             // END GENERATED settings to C
         }
     }

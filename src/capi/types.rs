@@ -522,6 +522,12 @@ pub struct MltRenderSettings {
     /// Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
     /// 0 or 1. Default 0.
     pub spectral: u32,
+    /// Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path. It
+    /// must be at most 1024. Default 3.
+    pub roulette_start_depth: u32,
+    /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    /// on. It must be in (0, 1]. Default 0.95.
+    pub roulette_max_survival: f32,
     // END GENERATED render settings
 }
 

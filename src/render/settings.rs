@@ -6,6 +6,7 @@ use crate::filter::{
     MLT_MAX_FILTER_BUFFERS, MLT_MAX_FILTER_RADIUS, MLT_MAX_FILTER_STRENGTH, MLT_MIN_FILTER_BUFFERS,
 };
 use crate::integrators::mlt::driver::MutationWeights;
+use crate::integrators::path::Roulette;
 use crate::params::{
     ChoiceParameter, Kind, ParameterType, Range, Unfit, Value, declare_parameters,
 };
@@ -304,6 +305,18 @@ declare_parameters! {
             doc: "Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.",
             flag: "spectral",
         },
+        roulette_start_depth: u32 = 3 => {
+            doc: "Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.",
+            flag: "roulette-start-depth",
+            range: Range::closed(0.0, MLT_MAX_DEPTH_LIMIT as f64),
+            rule: |_| format!("it must be at most {MLT_MAX_DEPTH_LIMIT}"),
+        },
+        roulette_max_survival: f32 = 0.95 => {
+            doc: "Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go on.",
+            flag: "roulette-max-survival",
+            range: Range::above(0.0, 1.0),
+            rule: |_| "it must be in (0, 1]".into(),
+        },
     }
 }
 
@@ -408,6 +421,14 @@ impl RenderSettings {
             )));
         }
         Ok(())
+    }
+
+    /// The path tracer's Russian roulette.
+    pub(crate) fn roulette(&self) -> Roulette {
+        Roulette {
+            start_depth: self.roulette_start_depth,
+            max_survival: self.roulette_max_survival,
+        }
     }
 
     /// Floats the RGB output of this image holds, or an error if it overflows.
