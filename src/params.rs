@@ -1,5 +1,5 @@
 //! Parameters declared once. A struct of parameters (the render settings) is written as one
-//! [`declare_parameters!`] table: each field with its type, default, valid range, the rule
+//! `declare_parameters!` table: each field with its type, default, valid range, the rule
 //! its error message states, a one-line doc and its command-line flag. The macro makes the
 //! struct, its `Default`, the range checks of its validation, access by name
 //! ([`Parameters::get`], [`Parameters::set`]) and the metadata ([`Parameter`]) every front end
@@ -141,7 +141,7 @@ impl<S> Parameter<S> {
     }
 }
 
-/// A struct made by [`declare_parameters!`].
+/// A struct made by `declare_parameters!`.
 pub trait Parameters: Default + Sized + 'static {
     /// What messages name the struct by: `settings` in `settings.width is 0; …`.
     const PREFIX: &'static str;

@@ -447,7 +447,9 @@ pub struct MltCamera {
     pub focus_distance: f32,
 }
 
-/// How to render. Initialize with `mlt_render_settings_default`.
+/// How to render. Initialize with `mlt_render_settings_default`. Each field is a setting
+/// declared in mlt's `src/render/settings.rs`; `docs/settings.md` lists them with their
+/// defaults, valid values and command-line flags. Booleans are 0 or 1.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltRenderSettings {
