@@ -502,13 +502,16 @@ mod tests {
     /// The layouts older headers have: mlt 0.2's material ends at `ior`, its scene
     /// description at `backend`; the one with lights but no surface attributes is 112 bytes,
     /// the one without the build quality 192; the scene info without the acceleration
-    /// structure's facts 64.
+    /// structure's facts 64; the settings without the filter 104, without Russian roulette
+    /// 128.
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
         assert_eq!(sizes::<MltMaterial>(), [36, 168]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
+        // Before the filter, before Russian roulette, today.
+        assert_eq!(sizes::<MltRenderSettings>(), [104, 128, 136]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);
     }
