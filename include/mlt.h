@@ -869,7 +869,9 @@ typedef struct MltCamera {
 } MltCamera;
 
 /**
- * How to render. Initialize with `mlt_render_settings_default`.
+ * How to render. Initialize with `mlt_render_settings_default`. Each field is a setting
+ * declared in mlt's `src/render/settings.rs`; `docs/settings.md` lists them with their
+ * defaults, valid values and command-line flags. Booleans are 0 or 1.
  */
 typedef struct MltRenderSettings {
   /**
@@ -878,137 +880,130 @@ typedef struct MltRenderSettings {
    */
   uint32_t struct_size;
   /**
-   * Image size in pixels, each in [1, 65536].
+   * Image width in pixels. It must be between 1 and 65536. Default 256.
    */
   uint32_t width;
+  /**
+   * Image height in pixels. It must be between 1 and 65536. Default 256.
+   */
   uint32_t height;
   /**
-   * One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_MMLT`.
+   * The light-transport algorithm. One of `MLT_ALGORITHM_*`. Default `MLT_ALGORITHM_MMLT`.
    */
   int32_t algorithm;
   /**
-   * Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
-   * `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.
+   * Path tracing, BDPT and ERPT: samples per pixel (0: until the time limit). At most 16777216
+   * are supported. Default 64.
    */
   uint32_t samples_per_pixel;
   /**
-   * Most scattering vertices between camera and light (0: only directly visible
-   * emitters), at most 1024.
+   * Most scattering vertices between camera and light (0: emitters seen directly). At most 1024
+   * is supported. Default 5.
    */
   uint32_t max_depth;
   /**
-   * Worker threads; 0 runs on one pool of one thread per core that every such render in
-   * the process shares (renders from several host threads at once then share the cores
-   * instead of oversubscribing them); a count gives the render a pool of its own. The
-   * image does not depend on it.
+   * Worker threads (0: a pool of one per core shared by such renders); the image does not depend
+   * on it. Use 0 for all cores or at most 4096. Default 0.
    */
   uint32_t threads;
   /**
-   * Seed of every random number; equal seeds and settings give bitwise equal images.
+   * Seed of every random number: equal seeds and settings give equal images. Any value of its
+   * type. Default 0.
    */
   uint64_t seed;
   /**
-   * Stop after this many seconds (0: no limit). Finite, at most 1e7.
+   * Stop after this many seconds (0: no limit). It must be 0 (no limit) or a positive number of
+   * seconds up to 10000000. Default 0.0.
    */
   double time_limit_seconds;
   /**
-   * Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
+   * Metropolis: mutations per pixel (0: until the time limit). At most 16777216 are supported.
+   * Default 32.
    */
   uint32_t mutations_per_pixel;
   /**
-   * Metropolis: independent samples that seed the chains and start the estimate of the
-   * image normalization, at most 2^28. 0 (the default) sizes it to the render: one
-   * sample per 8 planned mutations, at least 2^16 (2^18 for a render planned by its time
-   * limit alone).
+   * Metropolis: samples seeding the chains and the brightness estimate (0: one per 8 planned
+   * mutations, at least 65536; 262144 for a render planned by time alone). It must be 0
+   * (automatic) or at most 268435456. Default 0.
    */
   uint32_t bootstrap_samples;
   /**
-   * Metropolis: number of Markov chains, from 1 to the bootstrap samples. The image does
-   * not depend on the thread count.
+   * Metropolis: number of Markov chains, at most the bootstrap samples. It must be between 1 and
+   * the bootstrap samples (262144). Default 1024.
    */
   uint32_t chains;
   /**
-   * PSSMLT: probability of a large (independent) step, in [0, 1].
+   * PSSMLT: probability of a large (independent) step. It must be in [0, 1]. Default 0.3.
    */
   float large_step_probability;
   /**
-   * PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
+   * PSSMLT: standard deviation of a small step in primary sample space. It must be in (0, 1].
+   * Default 0.01.
    */
   float small_step_sigma;
   /**
-   * Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
-   * mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
-   * depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
-   * the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
-   * pass, the chains render every depth.
+   * Metropolis: path-traced samples of depths 0 and 1 per chain mutation (0: the chains render
+   * every depth). Any value of its type. Default 1.
    */
   uint32_t direct_samples_per_mutation;
   /**
-   * `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
-   * `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among
-   * those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
-   * positive.
+   * Path-space MLT: relative probabilities of the bidirectional mutation and the lens, caustic
+   * and multi-chain perturbations (the first positive). Weights must be finite, from 0 to 1e6.
+   * Default 0.5, 0.25, 0.25, 0.25.
    */
   float mutation_weights[4];
   /**
-   * `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 10.
+   * ERPT: perturbations per chain. It must be between 1 and 1048576. Default 10.
    */
   uint32_t erpt_chain_length;
   /**
-   * `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
-   * sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
-   * e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
+   * ERPT: energy (luminance) each chain step deposits (0: one chain per camera sample on
+   * average). It must be 0 (automatic) or a positive number up to 1e30. Default 0.0.
    */
   float erpt_deposit_energy;
   /**
-   * `MLT_ALGORITHM_PATH_SPACE_MLT`, 0 or 1: run a warm-up of about one mutation per pixel
-   * with `mutation_weights`, then weight each mutation by its acceptance rate there
-   * (within a factor of 8) for the rest of the render, on chains seeded anew. The weights
-   * used are reported in `MltRenderStats::mutation_weights`. Default 0.
+   * Path-space MLT: after a warm-up, weight each mutation by its acceptance rate there. 0 or 1.
+   * Default 0.
    */
   uint32_t adapt_mutation_weights;
   /**
-   * `MLT_ALGORITHM_PATH_SPACE_MLT` and `MLT_ALGORITHM_ERPT`, 0 or 1: perturb directions at
-   * diffuse vertices and lights by small steps in their cosine-weighted sample space
-   * instead of within a cone. Default 0.
+   * Path-space MLT and ERPT: perturb directions in the BSDF's sample space instead of within a
+   * cone. 0 or 1. Default 0.
    */
   uint32_t perturb_in_sample_space;
   /**
-   * Metropolis algorithms and `MLT_ALGORITHM_ERPT`: the post-process filter for blotchy
-   * noise, non-local means guided by per-pixel variances measured from partial images.
-   * 0 (the default) turns it off; otherwise the number of partial images the deposits are
-   * split into, from `MLT_MIN_FILTER_BUFFERS` to `MLT_MAX_FILTER_BUFFERS` (8 is a good
-   * start; each costs 12 bytes per pixel). The image keeps its total: the filter moves
-   * energy between pixels (a local bias) to lower the error. `MltRenderStats` reports
-   * what it did.
+   * Metropolis and ERPT: partial images of the post-process noise filter (0: no filter; 8 is a
+   * good start). It must be 0 (no filter) or from 2 to 32. Default 0.
    */
   uint32_t filter_buffers;
   /**
-   * The filter's strength, in (0, `MLT_MAX_FILTER_STRENGTH`]; default 0.45. Higher
-   * smooths more.
+   * The filter's strength (higher smooths more). It must be positive, up to 100. Default 0.45.
    */
   float filter_strength;
   /**
-   * The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
+   * The filter's search radius in pixels. It must be from 1 to 32 pixels. Default 7.
    */
   uint32_t filter_radius;
   /**
-   * Metropolis: the share of the rays spent on independent samples of the chains' target,
-   * drawn alongside the chains to go on estimating the normalization b, which sets the
-   * image's brightness; in [0, 0.9], default 0.05. The image is scaled by the final
-   * estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
-   * large steps), so its brightness error shrinks as the render goes on. 0: no such
-   * samples.
+   * Metropolis: share of the rays spent on samples that go on estimating the brightness (0: the
+   * bootstrap and large steps alone). It must be from 0 to 0.9. Default 0.05.
    */
   float normalization_work_fraction;
   /**
-   * 0 or 1: spectral transport. Each camera path carries four wavelengths (hero-wavelength
-   * sampling) instead of RGB; colours given as RGB become smooth spectra, lights emit
-   * them times D65, and the image is CIE XYZ converted to linear sRGB. Dielectrics with
-   * an `MltMaterial.abbe_number` disperse light (a path through one goes on at one
-   * wavelength). Default 0 (RGB).
+   * Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
+   * 0 or 1. Default 0.
    */
   uint32_t spectral;
+  /**
+   * Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path. It
+   * must be at most 1024. Default 3.
+   */
+  uint32_t roulette_start_depth;
+  /**
+   * Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+   * on. It must be in (0, 1]. Default 0.95.
+   */
+  float roulette_max_survival;
 } MltRenderSettings;
 
 /**

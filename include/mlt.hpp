@@ -856,43 +856,75 @@ struct Camera {
 /// defaults are mlt_render_settings_default's: 256 × 256, multiplexed MLT with 32
 /// mutations per pixel. The library validates the values when rendering.
 struct RenderSettings {
+    // BEGIN GENERATED members: tests/parameters.rs writes these lines from src/render/settings.rs
+    /// Image width in pixels.
     std::uint32_t width = 256;
+    /// Image height in pixels.
     std::uint32_t height = 256;
+    /// The light-transport algorithm.
     Algorithm algorithm = Algorithm::Mmlt;
-    /// Path tracing and BDPT; 0 renders until the time limit.
+    /// Path tracing, BDPT and ERPT: samples per pixel (0: until the time limit).
     std::uint32_t samples_per_pixel = 64;
+    /// Most scattering vertices between camera and light (0: emitters seen directly).
     std::uint32_t max_depth = 5;
-    /// 0: the process-wide pool of one thread per core.
+    /// Worker threads (0: a pool of one per core shared by such renders); the image does not depend
+    /// on it.
     std::uint32_t threads = 0;
+    /// Seed of every random number: equal seeds and settings give equal images.
     std::uint64_t seed = 0;
-    /// 0: no limit.
+    /// Stop after this many seconds (0: no limit).
     double time_limit_seconds = 0.0;
-    /// Metropolis algorithms; 0 renders until the time limit.
+    /// Metropolis: mutations per pixel (0: until the time limit).
     std::uint32_t mutations_per_pixel = 32;
-    /// 0: sized to the render.
+    /// Metropolis: samples seeding the chains and the brightness estimate (0: one per 8 planned
+    /// mutations, at least 65536; 262144 for a render planned by time alone).
     std::uint32_t bootstrap_samples = 0;
+    /// Metropolis: number of Markov chains, at most the bootstrap samples.
     std::uint32_t chains = 1024;
+    /// PSSMLT: probability of a large (independent) step.
     float large_step_probability = 0.3f;
+    /// PSSMLT: standard deviation of a small step in primary sample space.
     float small_step_sigma = 0.01f;
+    /// Metropolis: path-traced samples of depths 0 and 1 per chain mutation (0: the chains render
+    /// every depth).
     std::uint32_t direct_samples_per_mutation = 1;
-    /// Indexed by index(Mutation::...).
+    /// Path-space MLT: relative probabilities of the bidirectional mutation and the lens, caustic
+    /// and multi-chain perturbations (the first positive).
     std::array<float, 4> mutation_weights{0.5f, 0.25f, 0.25f, 0.25f};
+    /// ERPT: perturbations per chain.
     std::uint32_t erpt_chain_length = 10;
-    /// 0: automatic.
+    /// ERPT: energy (luminance) each chain step deposits (0: one chain per camera sample on
+    /// average).
     float erpt_deposit_energy = 0.0f;
+    /// Path-space MLT: after a warm-up, weight each mutation by its acceptance rate there.
     bool adapt_mutation_weights = false;
+    /// Path-space MLT and ERPT: perturb directions in the BSDF's sample space instead of within a
+    /// cone.
     bool perturb_in_sample_space = false;
-    /// 0: no post-process filter; else the number of partial images (8 is a good start).
+    /// Metropolis and ERPT: partial images of the post-process noise filter (0: no filter; 8 is a
+    /// good start).
     std::uint32_t filter_buffers = 0;
+    /// The filter's strength (higher smooths more).
     float filter_strength = 0.45f;
+    /// The filter's search radius in pixels.
     std::uint32_t filter_radius = 7;
+    /// Metropolis: share of the rays spent on samples that go on estimating the brightness (0: the
+    /// bootstrap and large steps alone).
     float normalization_work_fraction = 0.05f;
+    /// Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
     bool spectral = false;
+    /// Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.
+    std::uint32_t roulette_start_depth = 3;
+    /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    /// on.
+    float roulette_max_survival = 0.95f;
+    // END GENERATED members
 
     /// The C struct: mlt_render_settings_default, then every field of this struct.
     MltRenderSettings to_c() const {
         MltRenderSettings c;
         detail::check(mlt_render_settings_default(&c), "mlt_render_settings_default");
+        // BEGIN GENERATED to C
         c.width = width;
         c.height = height;
         c.algorithm = detail::c_value(algorithm);
@@ -917,10 +949,14 @@ struct RenderSettings {
         c.filter_radius = filter_radius;
         c.normalization_work_fraction = normalization_work_fraction;
         c.spectral = spectral ? 1u : 0u;
+        c.roulette_start_depth = roulette_start_depth;
+        c.roulette_max_survival = roulette_max_survival;
+        // END GENERATED to C
         return c;
     }
     static RenderSettings from_c(const MltRenderSettings &c) noexcept {
         RenderSettings s;
+        // BEGIN GENERATED from C
         s.width = c.width;
         s.height = c.height;
         s.algorithm = detail::from_c<Algorithm>(c.algorithm);
@@ -945,6 +981,9 @@ struct RenderSettings {
         s.filter_radius = c.filter_radius;
         s.normalization_work_fraction = c.normalization_work_fraction;
         s.spectral = c.spectral != 0;
+        s.roulette_start_depth = c.roulette_start_depth;
+        s.roulette_max_survival = c.roulette_max_survival;
+        // END GENERATED from C
         return s;
     }
     /// The linked library's defaults (equal to a default-constructed RenderSettings when

@@ -48,6 +48,9 @@ impl MltStatus {
 pub struct Error {
     pub status: MltStatus,
     pub message: String,
+    /// The index of the material in the scene description the error is about, if any: a
+    /// front end that loaded the scene from a file names it (`SceneData::describe_error`).
+    pub material: Option<usize>,
 }
 
 impl Error {
@@ -55,6 +58,15 @@ impl Error {
         Error {
             status,
             message: message.into(),
+            material: None,
+        }
+    }
+
+    /// The error, as about the scene description's material `index`.
+    pub fn about_material(self, index: usize) -> Self {
+        Error {
+            material: Some(index),
+            ..self
         }
     }
 

@@ -36,6 +36,7 @@ pub mod film;
 pub mod filter;
 pub mod integrators;
 mod interaction;
+pub mod params;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -8,7 +8,7 @@ use crate::error::{Error, MLT_STATUS_INVALID_ARGUMENT, Result};
 use xxhash_rust::xxh3::xxh3_64;
 
 /// Raised with every change to what a frame holds: an older or newer buffer is refused.
-pub(crate) const FORMAT_VERSION: u32 = 2;
+pub(crate) const FORMAT_VERSION: u32 = 3;
 
 /// The library that writes and reads a frame: renders from two versions of the kernel need
 /// not agree bit for bit.

@@ -371,6 +371,64 @@ fn cornell_cpp_renders_and_answers_ray_queries() {
     }
 }
 
+/// Every declared render setting reaches C (`MltRenderSettings`) and C++
+/// (`mlt::RenderSettings`) with its declared default, and a value outside its range, set in
+/// either, is refused with the message Rust's validation gives (`c_examples/parameters.cpp`,
+/// generated from the declarations by `tests/parameters.rs`).
+#[test]
+fn every_setting_reaches_c_and_cpp_with_its_default_and_message() {
+    use mlt::params::{Kind, Parameters, Value};
+    let exe = build("parameters.cpp", "parameters", true, &["-std=c++17"]);
+    let output = Command::new(&exe).output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    // A printed value ("%.9g" for floats, "%.17g" for doubles, 0 or 1 for booleans, the
+    // MLT_* code of a choice) and the declared one are the same number.
+    let same = |kind: Kind, text: &str, value: Value| -> bool {
+        let words: Vec<&str> = text.split(' ').collect();
+        match (kind, value) {
+            (_, Value::Int(v)) => words == [v.to_string()],
+            (Kind::F32, Value::Float(v)) => words[0].parse::<f32>() == Ok(v as f32),
+            (_, Value::Float(v)) => words[0].parse::<f64>() == Ok(v),
+            (_, Value::Bool(v)) => words == [(v as u32).to_string()],
+            (Kind::Choice(names), Value::Choice(name)) => {
+                words == [names.iter().position(|&n| n == name).unwrap().to_string()]
+            }
+            (_, Value::Floats(v)) => words.iter().map(|w| w.parse::<f32>().ok()).eq(v.map(Some)),
+            _ => false,
+        }
+    };
+    for p in mlt::RenderSettings::parameters() {
+        for language in ["c", "c++"] {
+            let prefix = format!("{language} {} ", p.name);
+            let shown = stdout
+                .lines()
+                .find_map(|l| {
+                    l.strip_prefix(&prefix)
+                        .filter(|v| !v.starts_with("message"))
+                })
+                .unwrap_or_else(|| panic!("no default of {} in {language}:\n{stdout}", p.name));
+            assert!(
+                same(p.kind, shown, (p.default)()),
+                "{language}'s default of {} is {shown}, declared {:?}",
+                p.name,
+                (p.default)()
+            );
+            let Some(bad) = p.outside_value() else {
+                continue;
+            };
+            let mut settings = mlt::RenderSettings::default();
+            settings.set(p.name, bad).unwrap();
+            let expected = settings.validate().unwrap_err().message;
+            let line = format!("{language} {} message {expected}", p.name);
+            assert!(
+                stdout.lines().any(|l| l == line),
+                "no {line:?} in:\n{stdout}"
+            );
+        }
+    }
+}
+
 /// `c_examples/cpp_checks.cpp` checks what `include/mlt.hpp` adds to the C API: defaults
 /// equal to the library's, errors as `mlt::Error` with the status and message, progress
 /// lambdas that cancel or throw (the render is cancelled and the exception reaches the

@@ -749,3 +749,100 @@ fn a_scene_without_a_camera_is_framed_and_the_camera_printed() {
     assert!(camera.camera.eye[2] > 2.0, "{:?}", camera.camera.eye);
     assert!(out.is_file());
 }
+
+/// Every declared render setting has its flag, with the declared default (the image size's
+/// is the camera's), and a value outside its range is refused with the message every front
+/// end gives.
+#[test]
+fn every_setting_has_its_flag_default_and_message() {
+    use mlt::RenderSettings;
+    use mlt::params::{Kind, Parameters, Value};
+    let help = String::from_utf8(mlt_render(&[&"--help"]).stdout).unwrap();
+    let text = |kind: Kind, value: Value| match (kind, value) {
+        (Kind::F32, Value::Float(v)) => (v as f32).to_string(),
+        (_, Value::Floats(v)) => v.map(|x| x.to_string()).join(","),
+        (_, v) => v.to_string(),
+    };
+    for p in RenderSettings::parameters() {
+        let flag = format!("--{}", p.flag);
+        // The flag's entry: its line and the indented help lines below it.
+        let lines: Vec<&str> = help.lines().collect();
+        let first = lines
+            .iter()
+            .position(|l| {
+                let l = l.trim_start();
+                l.strip_prefix(&flag)
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with([' ', ',']))
+            })
+            .unwrap_or_else(|| panic!("no {flag} in:\n{help}"));
+        let last = lines[first + 1..]
+            .iter()
+            .position(|l| l.trim_start().starts_with('-') || l.is_empty())
+            .map_or(lines.len(), |n| first + 1 + n);
+        let entry = lines[first..last].join(" ");
+        assert!(entry.contains(p.doc.trim_end_matches('.')), "{entry}");
+        if !matches!(p.kind, Kind::Bool) && !["width", "height"].contains(&p.name) {
+            let default = format!("[default: {}]", text(p.kind, (p.default)()));
+            assert!(entry.contains(&default), "{default} not in {entry}");
+        }
+        let Some(bad) = p.outside_value() else {
+            continue;
+        };
+        let mut settings = RenderSettings::default();
+        settings.set(p.name, bad).unwrap();
+        let expected = settings.validate().unwrap_err().message;
+        let out = temp_path("never-written.pfm");
+        let value = text(p.kind, bad);
+        // The declared image size, so that settings ruled by it (the chains, by the
+        // bootstrap) are refused as from the other front ends.
+        let mut args: Vec<std::ffi::OsString> = vec![
+            scene("cornell-box.obj").into(),
+            flag.into(),
+            value.clone().into(),
+        ];
+        for size in ["width", "height"] {
+            if p.name != size {
+                args.extend([format!("--{size}").into(), "256".into()]);
+            }
+        }
+        args.extend(["--out".into(), out.into()]);
+        let args: Vec<&dyn AsRef<std::ffi::OsStr>> = args.iter().map(|a| a as _).collect();
+        let output = mlt_render(&args);
+        let line = assert_one_line_error(&output);
+        assert!(
+            line.contains(&expected),
+            "--{} {value}: {line}, not {expected}",
+            p.flag
+        );
+    }
+}
+
+/// A material the kernel refuses is named as the file names it: the kernel's error says
+/// which material it is about, not only by its text.
+#[test]
+fn a_refused_material_is_named_from_the_file() {
+    let dir = temp_path("bad-material");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("bad.mtl"),
+        "newmtl fine\nKd 0.5 0.5 0.5\nnewmtl too_bright\nKd 1.5 0.5 0.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bad.obj"),
+        "mtllib bad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl fine\nf 1 2 3\nusemtl too_bright\nf 1 3 2\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("bad.camera.json"),
+        r#"{"eye": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 40, "width": 4, "height": 4}"#,
+    )
+    .unwrap();
+    let output = mlt_render(&[&dir.join("bad.obj"), &"--out", &dir.join("out.pfm")]);
+    let line = assert_one_line_error(&output);
+    assert!(
+        line.contains("desc.materials[1].color.x is 1.5")
+            && line.ends_with("(material 'too_bright')"),
+        "{line}"
+    );
+}

@@ -44,6 +44,48 @@ fn render_furnace_with(camera: &Camera, depth: u32, spp: u32, seed: u64, size: u
     image
 }
 
+/// Russian roulette after the first bounce with at most 3 in 4 odds of going on
+/// (`roulette_start_depth`, `roulette_max_survival`) still converges to the series: it
+/// only trades time for noise. The default roulette renders another image.
+#[test]
+fn earlier_likelier_roulette_still_matches_the_geometric_series() {
+    let scene = furnace_scene(ALBEDO, EMISSION);
+    let depth = 5;
+    let settings = RenderSettings {
+        width: 64,
+        height: 64,
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 64,
+        max_depth: depth,
+        seed: 3,
+        roulette_start_depth: 1,
+        roulette_max_survival: 0.75,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; 64 * 64 * 3];
+    render(&scene, &furnace_camera(), &settings, &mut image, None).unwrap();
+    let (mean, error) = mean_and_standard_error(&image);
+    let truth = expected(depth);
+    for c in 0..3 {
+        assert_within_and_sharp(&format!("channel {c}"), mean[c], truth[c], error[c], 4.0);
+    }
+    let mut default_roulette = vec![0.0; 64 * 64 * 3];
+    let defaults = RenderSettings {
+        roulette_start_depth: RenderSettings::default().roulette_start_depth,
+        roulette_max_survival: RenderSettings::default().roulette_max_survival,
+        ..settings
+    };
+    render(
+        &scene,
+        &furnace_camera(),
+        &defaults,
+        &mut default_roulette,
+        None,
+    )
+    .unwrap();
+    assert_ne!(image, default_roulette);
+}
+
 #[test]
 fn depth_zero_sees_only_the_emission_exactly() {
     let image = render_furnace(0, 2, 1, 16);

@@ -14,7 +14,9 @@
 
 use arbitrary::Unstructured;
 use mlt::MltStatus::{self, *};
+use mlt::RenderSettings;
 use mlt::capi::*;
+use mlt::params::{Kind, Parameter, Parameters, Value};
 use std::cell::Cell;
 use std::ffi::{CStr, c_void};
 use std::mem::{MaybeUninit, offset_of, size_of};
@@ -176,7 +178,6 @@ const MAX_TEXTURES: usize = 2;
 const MAX_TEXTURE_SIDE: u32 = 3;
 const MAX_ENVIRONMENT_SIDE: u32 = 4;
 const MAX_LIGHTS: usize = 3;
-const MAX_IMAGE_SIDE: u32 = 4;
 
 /// Texels as the host holds them: bytes or floats, of exactly the length mlt will read.
 #[derive(Debug)]
@@ -436,83 +437,96 @@ fn camera(u: &mut Unstructured) -> Result<MltCamera> {
     Ok(c)
 }
 
-/// Render settings with every field fuzzed, but the work of a valid render kept tiny: an
-/// image of at most 4 × 4, at most 3 samples or mutations per pixel, a bootstrap of at most
-/// 32 samples (0, the automatic size, is at least 2^16), short paths and ERPT chains, the
-/// process's shared pool (mostly: a pool of one's own costs a thread), and a time limit of
-/// 0 or a millisecond. Values outside what mlt accepts are still passed (they must be
-/// refused).
+/// The settings that scale a valid render's work, and the values drawn for them: an image of
+/// at most 4 × 4, at most 3 samples or mutations per pixel, a bootstrap of at most 32
+/// samples (0, the automatic size, is at least 2^16), short paths and ERPT chains, and
+/// (mostly: each takes its default, when inside, half the time) the process's shared pool
+/// and no time limit. Every other setting, a new one too, is drawn over its declared range.
+const WORK_LIMITS: &[(&str, f64, f64)] = &[
+    ("width", 1.0, 4.0),
+    ("height", 1.0, 4.0),
+    ("samples_per_pixel", 0.0, 3.0),
+    ("mutations_per_pixel", 0.0, 3.0),
+    ("max_depth", 0.0, 6.0),
+    ("threads", 0.0, 1.0),
+    ("time_limit_seconds", 0.0, 1e-3),
+    ("bootstrap_samples", 1.0, 32.0),
+    ("chains", 1.0, 16.0),
+    ("direct_samples_per_mutation", 0.0, 2.0),
+    ("erpt_chain_length", 1.0, 8.0),
+    // 0 is the automatic deposit energy, whose pre-pass traces at least 1024 BDPT samples
+    // (about 15 ms here; it was 2^14 until this target showed the cost): rare (one of the
+    // float's edge values), to keep executions short. A small one starts many chains (see
+    // `render`).
+    ("erpt_deposit_energy", 0.01, 10.0),
+    ("filter_buffers", 0.0, 8.0),
+    ("filter_radius", 1.0, 4.0),
+    ("mutation_weights", 0.0, 2.0),
+];
+
+/// A value of the declared setting `p`: sometimes one outside its range (it must be
+/// refused), else within its work limit or declared range.
+fn setting(u: &mut Unstructured, p: &Parameter<RenderSettings>) -> Result<Value> {
+    if let Some(bad) = p.outside_value()
+        && u.ratio(1, 32)?
+    {
+        return Ok(bad);
+    }
+    let limit = WORK_LIMITS
+        .iter()
+        .find(|&&(name, ..)| name == p.name)
+        .map(|&(_, lo, hi)| (lo, hi));
+    let (lo, hi) = limit
+        .or(p.range.map(|r| (r.min, r.max)))
+        .unwrap_or((0.0, 16.0));
+    let default = (p.default)();
+    let inside = match default {
+        Value::Int(v) => (lo..=hi).contains(&(v as f64)),
+        Value::Float(v) => (lo..=hi).contains(&v),
+        _ => true,
+    };
+    if inside && u.ratio(1, 2)? {
+        return Ok(default);
+    }
+    Ok(match p.kind {
+        Kind::U32 if p.range.is_none() && limit.is_none() => {
+            Value::Int(u.arbitrary::<u32>()?.into())
+        }
+        Kind::U64 if p.range.is_none() && limit.is_none() => {
+            Value::Int(u.arbitrary::<u64>()?.into())
+        }
+        Kind::U32 | Kind::U64 => Value::Int(u.int_in_range(lo as u64..=hi as u64)?.into()),
+        Kind::F32 | Kind::F64 => Value::Float(float(u, lo as f32, hi as f32)?.into()),
+        Kind::Bool => Value::Bool(u.arbitrary()?),
+        Kind::Choice(names) => Value::Choice(names[u.choose_index(names.len())?]),
+        Kind::F32x4 => Value::Floats([
+            float(u, lo as f32, hi as f32)?,
+            float(u, lo as f32, hi as f32)?,
+            float(u, lo as f32, hi as f32)?,
+            float(u, lo as f32, hi as f32)?,
+        ]),
+    })
+}
+
+/// Render settings, each declared setting drawn by `setting`, then as a C host may pass
+/// them: an older layout's `struct_size`, or values of the C types that Rust's types do not
+/// hold (an unknown algorithm, a boolean other than 0 and 1; refused).
 fn settings(u: &mut Unstructured) -> Result<MltRenderSettings> {
-    let mut s = initialized(mlt_render_settings_init);
+    let mut rust = RenderSettings::default();
+    for p in RenderSettings::parameters() {
+        let value = setting(u, p)?;
+        rust.set(p.name, value)
+            .expect("a value of the setting's type");
+    }
+    let mut s = MltRenderSettings::from(&rust);
     s.struct_size =
         struct_size::<MltRenderSettings>(u, &[offset_of!(MltRenderSettings, filter_buffers)])?;
-    s.algorithm = enum_int(u, 7)?;
-    s.width = if u.ratio(1, 32)? {
-        0
-    } else {
-        u.int_in_range(1..=MAX_IMAGE_SIDE)?
-    };
-    s.height = u.int_in_range(1..=MAX_IMAGE_SIDE)?;
-    s.samples_per_pixel = count(u, 3)?;
-    s.max_depth = match u.int_in_range(0u8..=31)? {
-        0..=29 => u.int_in_range(0..=6)?,
-        30 => 12,
-        _ => 1025,
-    };
-    s.threads = match u.int_in_range(0u8..=15)? {
-        0..=13 => 0,
-        14 => 1,
-        _ => 5000,
-    };
-    s.seed = u.arbitrary()?;
-    s.time_limit_seconds = match u.int_in_range(0u8..=15)? {
-        0..=11 => 0.0,
-        12 => 1e-3,
-        13 => -1.0,
-        14 => f64::NAN,
-        _ => 1e8,
-    };
-    s.mutations_per_pixel = count(u, 3)?;
-    s.bootstrap_samples = match u.int_in_range(0u8..=31)? {
-        0..=30 => u.int_in_range(1..=32)?,
-        _ => 1 << 29,
-    };
-    s.chains = match u.int_in_range(0u8..=15)? {
-        0..=13 => u.int_in_range(1..=s.bootstrap_samples.min(16))?,
-        14 => 0,
-        _ => s.bootstrap_samples + 1,
-    };
-    s.large_step_probability = float(u, 0.0, 1.0)?;
-    s.small_step_sigma = float(u, 0.0, 1.0)?;
-    s.direct_samples_per_mutation = count(u, 2)?;
-    for w in &mut s.mutation_weights {
-        *w = float(u, 0.0, 2.0)?;
+    if u.ratio(1, 16)? {
+        s.algorithm = enum_int(u, 7)?;
     }
-    s.erpt_chain_length = match u.int_in_range(0u8..=15)? {
-        0..=13 => u.int_in_range(1..=8)?,
-        14 => 0,
-        _ => (1 << 20) + 1,
-    };
-    // 0 is the automatic deposit energy, whose pre-pass traces at least 1024 BDPT samples
-    // (about 15 ms here; it was 2^14 until this target showed the cost): rare, to keep
-    // executions short. A small one starts many chains (see
-    // `render`).
-    s.erpt_deposit_energy = if u.ratio(1, 64)? {
-        0.0
-    } else {
-        float(u, 0.01, 10.0)?
-    };
-    s.adapt_mutation_weights = flag(u)?;
-    s.perturb_in_sample_space = flag(u)?;
-    s.filter_buffers = match u.int_in_range(0u8..=7)? {
-        0..=4 => 0,
-        5 | 6 => u.int_in_range(2..=8)?,
-        _ => u.int_in_range(0..=40)?,
-    };
-    s.filter_strength = float(u, 0.0, 2.0)?;
-    s.filter_radius = count(u, 4)?;
-    s.normalization_work_fraction = float(u, 0.0, 0.9)?;
-    s.spectral = flag(u)?;
+    if u.ratio(1, 16)? {
+        s.spectral = flag(u)?;
+    }
     Ok(s)
 }
 

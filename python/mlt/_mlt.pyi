@@ -27,6 +27,7 @@ __all__ = [
     "merge",
     "load_environment",
     "_defaults_mismatches",
+    "_settings_declarations",
     "__version__",
     "EMBREE_AVAILABLE",
 ]
@@ -242,3 +243,4 @@ def load_environment(path: _Path) -> _Image: ...
 def _defaults_mismatches(
     settings: RenderSettings, camera: Camera, material: Material
 ) -> list[Tuple[str, str, str]]: ...
+def _settings_declarations() -> list[Tuple[str, object, Optional[object], Optional[str]]]: ...

@@ -166,32 +166,69 @@ class RenderSettings:
     documentation of ``mlt::RenderSettings`` for every field.
     """
 
+    # BEGIN GENERATED render settings: tests/parameters.rs writes these lines from src/render/settings.rs
+    #: Image width in pixels.
     width: int = 256
+    #: Image height in pixels.
     height: int = 256
+    #: The light-transport algorithm.
     algorithm: Union[Algorithm, str] = Algorithm.MMLT
+    #: Path tracing, BDPT and ERPT: samples per pixel (0: until the time limit).
     samples_per_pixel: int = 64
+    #: Most scattering vertices between camera and light (0: emitters seen directly).
     max_depth: int = 5
-    seed: int = 0
+    #: Worker threads (0: a pool of one per core shared by such renders); the image does not depend
+    #: on it.
     threads: int = 0
+    #: Seed of every random number: equal seeds and settings give equal images.
+    seed: int = 0
+    #: Stop after this many seconds (0: no limit).
     time_limit_seconds: float = 0.0
+    #: Metropolis: mutations per pixel (0: until the time limit).
     mutations_per_pixel: int = 32
+    #: Metropolis: samples seeding the chains and the brightness estimate (0: one per 8 planned
+    #: mutations, at least 65536; 262144 for a render planned by time alone).
     bootstrap_samples: int = 0
+    #: Metropolis: number of Markov chains, at most the bootstrap samples.
     chains: int = 1024
+    #: PSSMLT: probability of a large (independent) step.
     large_step_probability: float = 0.3
+    #: PSSMLT: standard deviation of a small step in primary sample space.
     small_step_sigma: float = 0.01
+    #: Metropolis: path-traced samples of depths 0 and 1 per chain mutation (0: the chains render
+    #: every depth).
     direct_samples_per_mutation: int = 1
-    normalization_work_fraction: float = 0.05
-    #: Path-space MLT: bidirectional, lens, caustic and multi-chain weights.
+    #: Path-space MLT: relative probabilities of the bidirectional mutation and the lens, caustic
+    #: and multi-chain perturbations (the first positive).
     mutation_weights: Tuple[float, float, float, float] = (0.5, 0.25, 0.25, 0.25)
-    adapt_mutation_weights: bool = False
-    perturb_in_sample_space: bool = False
+    #: ERPT: perturbations per chain.
     erpt_chain_length: int = 10
+    #: ERPT: energy (luminance) each chain step deposits (0: one chain per camera sample on
+    #: average).
     erpt_deposit_energy: float = 0.0
-    #: 0: no post-process filter; else its partial images (2 to 32; 8 is a good start).
+    #: Path-space MLT: after a warm-up, weight each mutation by its acceptance rate there.
+    adapt_mutation_weights: bool = False
+    #: Path-space MLT and ERPT: perturb directions in the BSDF's sample space instead of within a
+    #: cone.
+    perturb_in_sample_space: bool = False
+    #: Metropolis and ERPT: partial images of the post-process noise filter (0: no filter; 8 is a
+    #: good start).
     filter_buffers: int = 0
+    #: The filter's strength (higher smooths more).
     filter_strength: float = 0.45
+    #: The filter's search radius in pixels.
     filter_radius: int = 7
+    #: Metropolis: share of the rays spent on samples that go on estimating the brightness (0: the
+    #: bootstrap and large steps alone).
+    normalization_work_fraction: float = 0.05
+    #: Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
     spectral: bool = False
+    #: Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.
+    roulette_start_depth: int = 3
+    #: Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    #: on.
+    roulette_max_survival: float = 0.95
+    # END GENERATED render settings
 
 
 @dataclass

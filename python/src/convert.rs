@@ -3,10 +3,11 @@
 
 use crate::arrays::{self, Array};
 use crate::errors::{invalid, with_context};
+use mlt::params::{ChoiceParameter, Kind, Parameters, Value};
 use mlt::{
-    Algorithm, AlphaMode, Backend, BuildQuality, Camera, Material, MaterialKind, MutationWeights,
-    PunctualLight, PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc,
-    TextureEncoding, TextureFilter, TextureRef, WrapMode,
+    Algorithm, AlphaMode, Backend, BuildQuality, Camera, Material, MaterialKind, PunctualLight,
+    PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc, TextureEncoding,
+    TextureFilter, TextureRef, WrapMode,
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -76,16 +77,6 @@ fn same_name(a: &str, b: &str) -> bool {
     a.len() == b.len() && a.chars().map(canonical).eq(b.chars().map(canonical))
 }
 
-const ALGORITHMS: [(&str, Algorithm); 7] = [
-    ("path", Algorithm::Path),
-    ("bdpt", Algorithm::Bdpt),
-    ("pssmlt", Algorithm::Pssmlt),
-    ("mmlt", Algorithm::Mmlt),
-    ("pssmlt-bdpt", Algorithm::PssmltBdpt),
-    ("path-space-mlt", Algorithm::PathSpaceMlt),
-    ("erpt", Algorithm::Erpt),
-];
-
 const MATERIAL_KINDS: [(&str, MaterialKind); 4] = [
     ("diffuse", MaterialKind::Diffuse),
     ("mirror", MaterialKind::Mirror),
@@ -121,35 +112,39 @@ pub fn camera(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {
     })
 }
 
+/// The settings of `obj`, one attribute per declared setting (`mlt::params`): a value of
+/// the wrong type or out of range is refused with the message every front end gives.
 pub fn settings(obj: &Bound<'_, PyAny>) -> PyResult<RenderSettings> {
+    let py = obj.py();
     let owner = "RenderSettings";
-    let algorithm = name_field(obj, owner, "algorithm")?;
-    Ok(RenderSettings {
-        width: field(obj, owner, "width")?,
-        height: field(obj, owner, "height")?,
-        algorithm: choose(obj.py(), owner, "algorithm", &algorithm, &ALGORITHMS)?,
-        samples_per_pixel: field(obj, owner, "samples_per_pixel")?,
-        max_depth: field(obj, owner, "max_depth")?,
-        seed: field(obj, owner, "seed")?,
-        threads: field(obj, owner, "threads")?,
-        time_limit_seconds: field(obj, owner, "time_limit_seconds")?,
-        mutations_per_pixel: field(obj, owner, "mutations_per_pixel")?,
-        bootstrap_samples: field(obj, owner, "bootstrap_samples")?,
-        chains: field(obj, owner, "chains")?,
-        large_step_probability: field(obj, owner, "large_step_probability")?,
-        small_step_sigma: field(obj, owner, "small_step_sigma")?,
-        direct_samples_per_mutation: field(obj, owner, "direct_samples_per_mutation")?,
-        normalization_work_fraction: field(obj, owner, "normalization_work_fraction")?,
-        mutation_weights: MutationWeights(field(obj, owner, "mutation_weights")?),
-        adapt_mutation_weights: field(obj, owner, "adapt_mutation_weights")?,
-        perturb_in_sample_space: field(obj, owner, "perturb_in_sample_space")?,
-        erpt_chain_length: field(obj, owner, "erpt_chain_length")?,
-        erpt_deposit_energy: field(obj, owner, "erpt_deposit_energy")?,
-        filter_buffers: field(obj, owner, "filter_buffers")?,
-        filter_strength: field(obj, owner, "filter_strength")?,
-        filter_radius: field(obj, owner, "filter_radius")?,
-        spectral: field(obj, owner, "spectral")?,
-    })
+    let mut settings = RenderSettings::default();
+    for p in RenderSettings::parameters() {
+        let name = p.name;
+        let value = match p.kind {
+            Kind::U32 | Kind::U64 => Value::Int(field::<i128>(obj, owner, name)?),
+            Kind::F32 | Kind::F64 => Value::Float(field::<f64>(obj, owner, name)?),
+            Kind::Bool => Value::Bool(field::<bool>(obj, owner, name)?),
+            Kind::F32x4 => Value::Floats(field::<[f32; 4]>(obj, owner, name)?),
+            Kind::Choice(names) => {
+                let given = name_field(obj, owner, name)?;
+                let choice = names.iter().find(|n| same_name(n, &given)).ok_or_else(|| {
+                    let names: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+                    invalid(
+                        py,
+                        &format!(
+                            "{owner}.{name} is {given:?}; expected one of {}",
+                            names.join(", ")
+                        ),
+                    )
+                })?;
+                Value::Choice(choice)
+            }
+        };
+        settings
+            .set(name, value)
+            .map_err(|e| crate::errors::from_mlt(py, &e))?;
+    }
+    Ok(settings)
 }
 
 /// The Python float that prints as `value` does (0.3f32 as 0.3, not 0.30000001192092896),
@@ -161,13 +156,31 @@ fn shortest(value: f32) -> f64 {
 
 /// The Python name of an algorithm (`mlt.Algorithm`'s value).
 pub fn algorithm_name(algorithm: Algorithm) -> &'static str {
-    ALGORITHMS
-        .iter()
-        .find(|&&(_, a)| a == algorithm)
-        .map_or("?", |&(name, _)| name)
+    algorithm.name()
 }
 
 static SETTINGS_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+/// A setting's value as `mlt.RenderSettings` holds it.
+pub fn setting_to_py<'py>(
+    py: Python<'py>,
+    kind: Kind,
+    value: Value,
+) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match (kind, value) {
+        (_, Value::Int(v)) => v.into_pyobject(py)?.into_any(),
+        (Kind::F32, Value::Float(v)) => shortest(v as f32).into_pyobject(py)?.into_any(),
+        (_, Value::Float(v)) => v.into_pyobject(py)?.into_any(),
+        (_, Value::Bool(v)) => v.into_pyobject(py)?.to_owned().into_any(),
+        (_, Value::Floats(v)) => {
+            let [a, b, c, d] = v.map(shortest);
+            (a, b, c, d).into_pyobject(py)?.into_any()
+        }
+        (_, Value::Choice(name)) => ALGORITHM_CLASS
+            .import(py, "mlt._types", "Algorithm")?
+            .call1((name,))?,
+    })
+}
 static ALGORITHM_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// An `mlt.RenderSettings`, the inverse of `settings`.
@@ -175,47 +188,11 @@ pub fn settings_to_py<'py>(
     py: Python<'py>,
     settings: &RenderSettings,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let algorithm = ALGORITHM_CLASS
-        .import(py, "mlt._types", "Algorithm")?
-        .call1((algorithm_name(settings.algorithm),))?;
     let kwargs = PyDict::new(py);
-    kwargs.set_item("width", settings.width)?;
-    kwargs.set_item("height", settings.height)?;
-    kwargs.set_item("algorithm", algorithm)?;
-    kwargs.set_item("samples_per_pixel", settings.samples_per_pixel)?;
-    kwargs.set_item("max_depth", settings.max_depth)?;
-    kwargs.set_item("seed", settings.seed)?;
-    kwargs.set_item("threads", settings.threads)?;
-    kwargs.set_item("time_limit_seconds", settings.time_limit_seconds)?;
-    kwargs.set_item("mutations_per_pixel", settings.mutations_per_pixel)?;
-    kwargs.set_item("bootstrap_samples", settings.bootstrap_samples)?;
-    kwargs.set_item("chains", settings.chains)?;
-    kwargs.set_item(
-        "large_step_probability",
-        shortest(settings.large_step_probability),
-    )?;
-    kwargs.set_item("small_step_sigma", shortest(settings.small_step_sigma))?;
-    kwargs.set_item(
-        "direct_samples_per_mutation",
-        settings.direct_samples_per_mutation,
-    )?;
-    kwargs.set_item(
-        "normalization_work_fraction",
-        shortest(settings.normalization_work_fraction),
-    )?;
-    let w = settings.mutation_weights.0.map(shortest);
-    kwargs.set_item("mutation_weights", (w[0], w[1], w[2], w[3]))?;
-    kwargs.set_item("adapt_mutation_weights", settings.adapt_mutation_weights)?;
-    kwargs.set_item("perturb_in_sample_space", settings.perturb_in_sample_space)?;
-    kwargs.set_item("erpt_chain_length", settings.erpt_chain_length)?;
-    kwargs.set_item(
-        "erpt_deposit_energy",
-        shortest(settings.erpt_deposit_energy),
-    )?;
-    kwargs.set_item("filter_buffers", settings.filter_buffers)?;
-    kwargs.set_item("filter_strength", shortest(settings.filter_strength))?;
-    kwargs.set_item("filter_radius", settings.filter_radius)?;
-    kwargs.set_item("spectral", settings.spectral)?;
+    for p in RenderSettings::parameters() {
+        let value = settings.get(p.name).expect("a declared setting");
+        kwargs.set_item(p.name, setting_to_py(py, p.kind, value)?)?;
+    }
     SETTINGS_CLASS
         .import(py, "mlt._types", "RenderSettings")?
         .call((), Some(&kwargs))

@@ -50,6 +50,39 @@ fn _defaults_mismatches(
     Ok(mismatches)
 }
 
+/// Each declared render setting as `(name, default, outside, message)`: its default as
+/// `mlt.RenderSettings` holds it, a value outside its range (or None) and the message
+/// Rust's validation gives for it, for the test that Python agrees.
+#[pyfunction]
+fn _settings_declarations(py: Python<'_>) -> PyResult<Vec<SettingDeclaration<'_>>> {
+    use mlt::params::Parameters;
+    mlt::RenderSettings::parameters()
+        .iter()
+        .map(|p| {
+            let default = convert::setting_to_py(py, p.kind, (p.default)())?;
+            let (outside, message) = match p.outside_value() {
+                Some(bad) => {
+                    let mut settings = mlt::RenderSettings::default();
+                    settings
+                        .set(p.name, bad)
+                        .map_err(|e| errors::from_mlt(py, &e))?;
+                    let message = settings.validate().err().map(|e| e.message);
+                    (Some(convert::setting_to_py(py, p.kind, bad)?), message)
+                }
+                None => (None, None),
+            };
+            Ok((p.name, default, outside, message))
+        })
+        .collect()
+}
+
+type SettingDeclaration<'py> = (
+    &'static str,
+    Bound<'py, PyAny>,
+    Option<Bound<'py, PyAny>>,
+    Option<String>,
+);
+
 #[pymodule]
 fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
@@ -69,6 +102,7 @@ fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(jobs::merge, m)?)?;
     m.add_function(wrap_pyfunction!(scene::load_environment, m)?)?;
     m.add_function(wrap_pyfunction!(_defaults_mismatches, m)?)?;
+    m.add_function(wrap_pyfunction!(_settings_declarations, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("EMBREE_AVAILABLE", mlt::Backend::Embree.is_available())?;
     Ok(())

@@ -4,7 +4,6 @@
 use crate::arrays;
 use crate::convert::{self, OwnedLights};
 use crate::errors::{self, invalid};
-use mlt::io::SceneData;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyFileNotFoundError;
 use pyo3::prelude::*;
@@ -218,18 +217,7 @@ impl Scene {
         let mut data = py
             .detach(|| mlt::io::load_scene(&path))
             .map_err(|e| errors::load_error(py, &e.message))?;
-        for material in &mut data.materials {
-            material.energy_compensation = energy_compensation;
-            let transmits = material.kind == mlt::MaterialKind::Dielectric
-                || (material.kind == mlt::MaterialKind::MetallicRoughness
-                    && material.transmission > 0.0);
-            if let Some(abbe_number) = abbe_number
-                && transmits
-                && material.abbe_number == 0.0
-            {
-                material.abbe_number = abbe_number;
-            }
-        }
+        data.override_materials(energy_compensation, abbe_number);
         // The file's punctual lights first, so their indices in errors are the file's.
         let mut punctual = std::mem::take(&mut data.punctual_lights);
         punctual.append(&mut lights.punctual);
@@ -238,7 +226,7 @@ impl Scene {
         desc.build_quality = build_quality;
         desc.lights = lights.desc();
         let scene = build(py, &desc).map_err(|e| {
-            let message = describe_scene_error(&e, &data);
+            let message = data.describe_error(&e);
             let message = format!("cannot build the scene from {}: {message}", path.display());
             errors::from_mlt(py, &mlt::Error::new(e.status, message))
         })?;
@@ -313,21 +301,6 @@ fn rgba(colors: &Bound<'_, PyAny>) -> PyResult<Vec<f32>> {
         .chunks_exact(3)
         .flat_map(|c| [c[0], c[1], c[2], 1.0])
         .collect())
-}
-
-/// The kernel names a material by index; add its name from the file (as `mlt-render`
-/// does).
-fn describe_scene_error(error: &mlt::Error, data: &SceneData) -> String {
-    let message = &error.message;
-    let named = message
-        .strip_prefix("desc.materials[")
-        .and_then(|rest| rest.split(']').next())
-        .and_then(|index| index.parse::<usize>().ok())
-        .and_then(|index| data.material_names.get(index));
-    match named {
-        Some(name) => format!("{message} (material '{name}')"),
-        None => message.clone(),
-    }
 }
 
 /// Reads an environment map (`.hdr` or `.exr`) as a float32 array of shape

@@ -33,7 +33,7 @@ def test_every_rust_settings_field_is_a_dataclass_field() -> None:
     names = {n.rsplit(" ", 1)[-1] for n in names}
     fields = {f.name for f in dataclasses.fields(mlt.RenderSettings)}
     assert names - fields == set()
-    assert len(fields) == 24
+    assert len(fields) == len(mlt._mlt._settings_declarations())
 
 
 def test_algorithm_enum_and_strings_are_interchangeable() -> None:

@@ -122,7 +122,7 @@ def test_bad_settings_and_camera() -> None:
         mlt.render(scene, CAMERA, mlt.RenderSettings(width=0))
     with invalid(r'RenderSettings.algorithm is "metropolis"; expected one of "path", "bdpt"'):
         mlt.render(scene, CAMERA, mlt.RenderSettings(algorithm="metropolis"))
-    with invalid("RenderSettings.height: "):
+    with invalid("settings.height is -1; it must be between 1 and 65536"):
         mlt.render(scene, CAMERA, mlt.RenderSettings(height=-1))
     with pytest.raises(TypeError, match="RenderSettings.seed: "):
         mlt.render(scene, CAMERA, mlt.RenderSettings(seed="seven"))  # type: ignore[arg-type]

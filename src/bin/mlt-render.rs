@@ -2,84 +2,121 @@
 //!
 //! Errors print one line, `mlt-render: <message>`, to stderr and exit with status 1.
 
-use clap::{Parser, ValueEnum};
+use clap::builder::{PossibleValuesParser, TypedValueParser, ValueParser};
+use clap::parser::ValueSource;
+use clap::{Arg, ArgAction, ArgMatches, Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use mlt::io::{CameraFile, ImageFormat, SceneData};
+use mlt::io::{CameraFile, ImageFormat};
+use mlt::params::{ChoiceParameter, Kind, Parameters, Value};
 use mlt::scene::{EnvironmentDesc, LightsDesc, SunDesc};
-use mlt::{MutationWeights, RenderSettings, RenderStats, Scene, StopReason};
+use mlt::{RenderSettings, RenderStats, Scene, StopReason};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum AlgorithmArg {
-    /// Path tracing with next-event estimation and MIS.
-    Path,
-    /// Bidirectional path tracing with MIS over every connection strategy.
-    Bdpt,
-    /// Primary-sample-space Metropolis light transport over the path tracer.
-    Pssmlt,
-    /// Multiplexed MLT: chains over BDPT that pick the path depth and one strategy.
-    Mmlt,
-    /// Primary-sample-space MLT over BDPT, all strategies of a sample summed.
-    PssmltBdpt,
-    /// Path-space MLT (Veach): chains over light paths, changed by Veach's mutations.
-    PathSpaceMlt,
-    /// Energy redistribution path tracing: BDPT samples spread by chains of perturbations.
-    Erpt,
+/// The render settings' flags, made from their declarations (`mlt::params`): each
+/// setting's flag, help line and default come from `src/render/settings.rs`.
+#[derive(Clone, Debug)]
+struct SettingsArgs {
+    /// The settings given on the command line, by name; the others keep their defaults.
+    given: Vec<(&'static str, Value)>,
 }
 
-// The kernel's `Algorithm` has no clap dependency; exhaustive matches keep the two in step.
-impl From<AlgorithmArg> for mlt::Algorithm {
-    fn from(arg: AlgorithmArg) -> Self {
-        match arg {
-            AlgorithmArg::Path => mlt::Algorithm::Path,
-            AlgorithmArg::Bdpt => mlt::Algorithm::Bdpt,
-            AlgorithmArg::Pssmlt => mlt::Algorithm::Pssmlt,
-            AlgorithmArg::Mmlt => mlt::Algorithm::Mmlt,
-            AlgorithmArg::PssmltBdpt => mlt::Algorithm::PssmltBdpt,
-            AlgorithmArg::PathSpaceMlt => mlt::Algorithm::PathSpaceMlt,
-            AlgorithmArg::Erpt => mlt::Algorithm::Erpt,
+/// Settings whose default is the camera's, not the declared one.
+const FROM_CAMERA: [&str; 2] = ["width", "height"];
+
+/// `value` as a flag takes it.
+fn flag_text(kind: Kind, value: Value) -> String {
+    match (kind, value) {
+        (Kind::F32, Value::Float(v)) => (v as f32).to_string(),
+        (_, v) => v.to_string(),
+    }
+}
+
+/// Parses a flag's text into a value of `kind` (the range is checked with the others).
+fn parse_setting(kind: Kind, text: &str) -> Result<Value, String> {
+    let text = text.trim();
+    let float = |t: &str| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}"));
+    match kind {
+        Kind::U32 | Kind::U64 => text
+            .parse::<i128>()
+            .map(Value::Int)
+            .map_err(|e| format!("{text:?}: {e}")),
+        Kind::F32 => float(text).map(|v| Value::Float(v.into())),
+        Kind::F64 => text
+            .parse::<f64>()
+            .map(Value::Float)
+            .map_err(|e| format!("{text:?}: {e}")),
+        Kind::F32x4 => {
+            let values: Vec<f32> = text.split(',').map(float).collect::<Result<_, _>>()?;
+            <[f32; 4]>::try_from(values.as_slice())
+                .map(Value::Floats)
+                .map_err(|_| format!("four numbers are needed, not {}", values.len()))
         }
+        Kind::Bool | Kind::Choice(_) => unreachable!("flags without a parser"),
     }
 }
 
-impl From<mlt::Algorithm> for AlgorithmArg {
-    fn from(algorithm: mlt::Algorithm) -> Self {
-        match algorithm {
-            mlt::Algorithm::Path => AlgorithmArg::Path,
-            mlt::Algorithm::Bdpt => AlgorithmArg::Bdpt,
-            mlt::Algorithm::Pssmlt => AlgorithmArg::Pssmlt,
-            mlt::Algorithm::Mmlt => AlgorithmArg::Mmlt,
-            mlt::Algorithm::PssmltBdpt => AlgorithmArg::PssmltBdpt,
-            mlt::Algorithm::PathSpaceMlt => AlgorithmArg::PathSpaceMlt,
-            mlt::Algorithm::Erpt => AlgorithmArg::Erpt,
+impl clap::Args for SettingsArgs {
+    fn augment_args(mut command: clap::Command) -> clap::Command {
+        for p in RenderSettings::parameters() {
+            let mut arg = Arg::new(p.name).long(p.flag).help(p.doc);
+            let full_name = p.name.replace('_', "-");
+            if full_name != p.flag {
+                arg = arg.visible_alias(full_name);
+            }
+            let kind = p.kind;
+            arg = match kind {
+                Kind::Bool => arg.action(ArgAction::SetTrue),
+                Kind::Choice(names) => arg.value_parser(
+                    PossibleValuesParser::new(names.iter().copied()).map(move |name| {
+                        Value::Choice(names.iter().find(|&&n| n == name).expect("a choice"))
+                    }),
+                ),
+                _ => arg
+                    .allow_hyphen_values(true)
+                    .value_name(match kind {
+                        Kind::U32 | Kind::U64 => "N",
+                        Kind::F32x4 => "B,L,C,M",
+                        _ => "X",
+                    })
+                    .value_parser(ValueParser::new(move |text: &str| {
+                        parse_setting(kind, text)
+                    })),
+            };
+            if !FROM_CAMERA.contains(&p.name) && kind != Kind::Bool {
+                arg = arg.default_value(flag_text(kind, (p.default)()));
+            }
+            if FROM_CAMERA.contains(&p.name) {
+                arg = arg.help(format!("{} Default: the camera's.", p.doc));
+            }
+            command = command.arg(arg);
         }
+        command
+    }
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        Self::augment_args(command)
     }
 }
 
-/// Four comma-separated mutation weights.
-#[derive(Clone, Copy, Debug)]
-struct WeightsArg([f32; 4]);
-
-impl std::str::FromStr for WeightsArg {
-    type Err = String;
-
-    fn from_str(text: &str) -> Result<Self, String> {
-        let values: Vec<f32> = text
-            .split(',')
-            .map(|v| v.trim().parse::<f32>().map_err(|e| format!("{v:?}: {e}")))
-            .collect::<Result<_, _>>()?;
-        <[f32; 4]>::try_from(values.as_slice())
-            .map(WeightsArg)
-            .map_err(|_| format!("four weights are needed, not {}", values.len()))
+impl clap::FromArgMatches for SettingsArgs {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
+        let given = RenderSettings::parameters()
+            .iter()
+            .filter(|p| matches.value_source(p.name) == Some(ValueSource::CommandLine))
+            .map(|p| {
+                let value = match p.kind {
+                    Kind::Bool => Value::Bool(matches.get_flag(p.name)),
+                    _ => *matches.get_one::<Value>(p.name).expect("a parsed value"),
+                };
+                (p.name, value)
+            })
+            .collect();
+        Ok(SettingsArgs { given })
     }
-}
-
-impl std::fmt::Display for WeightsArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        let [b, l, c, m] = self.0;
-        write!(f, "{b},{l},{c},{m}")
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        *self = Self::from_arg_matches(matches)?;
+        Ok(())
     }
 }
 
@@ -199,102 +236,23 @@ struct Args {
     /// Camera JSON (eye, target, up, fov_y_deg, width, height); overrides the scene's camera.
     #[arg(long, value_name = "FILE.json")]
     camera: Option<PathBuf>,
-    /// Light-transport algorithm.
-    #[arg(long, value_enum, default_value_t = AlgorithmArg::from(RenderSettings::default().algorithm))]
-    algorithm: AlgorithmArg,
-    /// Samples per pixel (0: until the time limit).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().samples_per_pixel)]
-    spp: u32,
-    /// Metropolis: mutations per pixel (0: until the time limit).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().mutations_per_pixel)]
-    mutations_per_pixel: u32,
-    /// Metropolis: bootstrap samples seeding the chains and starting the estimate of the
-    /// normalization (0: one per 8 planned mutations, at least 65536; 262144 with a time
-    /// limit alone).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().bootstrap_samples)]
-    bootstrap: u32,
-    /// Metropolis: number of Markov chains.
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().chains)]
-    chains: u32,
-    /// PSSMLT: probability of a large (independent) step.
-    #[arg(long, value_name = "P", default_value_t = RenderSettings::default().large_step_probability)]
-    large_step: f32,
-    /// PSSMLT: standard deviation of a small step in primary sample space.
-    #[arg(long, value_name = "SIGMA", default_value_t = RenderSettings::default().small_step_sigma)]
-    small_step: f32,
-    /// Metropolis: samples of the path-traced pass for paths of depth 0 and 1 (emitters
-    /// seen, direct lighting) per chain mutation (0: the chains render every depth).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().direct_samples_per_mutation)]
-    direct_per_mutation: u32,
-    /// Metropolis: the share of the rays spent on independent samples that go on estimating
-    /// the normalization, which sets the image's brightness (0 to 0.9; 0: the bootstrap
-    /// and the large steps alone).
-    #[arg(long, value_name = "F", default_value_t = RenderSettings::default().normalization_work_fraction)]
-    normalization_fraction: f32,
-    /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
-    /// lens, caustic and multi-chain perturbations.
-    #[arg(long, value_name = "B,L,C,M", default_value_t = WeightsArg(RenderSettings::default().mutation_weights.0))]
-    mutation_weights: WeightsArg,
-    /// Path-space MLT: after a warm-up of one mutation per pixel, weight each mutation by
-    /// its acceptance rate there (the summary lists the weights used).
-    #[arg(long)]
-    adapt_mutation_weights: bool,
-    /// Path-space MLT and ERPT: perturb directions by small steps in the BSDF's sample
-    /// space instead of within a cone.
-    #[arg(long)]
-    perturb_in_sample_space: bool,
+    #[command(flatten)]
+    settings: SettingsArgs,
     /// Compensate rough metals (glTF metallic-roughness) for the light that bounces between
     /// microfacets more than once, which glTF's model loses (Kulla-Conty): a white metal
     /// reflects all the light at every roughness instead of 31% at roughness 1.
     #[arg(long)]
     energy_compensation: bool,
-    /// Spectral transport: each path carries four wavelengths instead of RGB (the image is
-    /// CIE XYZ converted to linear sRGB); dispersive glass splits light into colours.
-    #[arg(long)]
-    spectral: bool,
     /// Make every dielectric (glass, and transmissive glTF materials) without a dispersion
     /// of its own dispersive with this Abbe number (crown glass ~60, flint ~36, lower is
     /// stronger). Seen in --spectral renders only.
     #[arg(long, value_name = "V")]
     abbe_number: Option<f32>,
     /// Metropolis and ERPT: filter the image's blotchy noise after the render (non-local
-    /// means guided by variances measured from partial images; keeps the total).
+    /// means guided by variances measured from partial images; keeps the total), with 8
+    /// partial images unless --filter-buffers says otherwise.
     #[arg(long)]
     filter: bool,
-    /// With --filter: partial images the deposits are split into (2 to 32).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::DEFAULT_FILTER_BUFFERS)]
-    filter_buffers: u32,
-    /// With --filter: its strength (higher smooths more).
-    #[arg(long, value_name = "K", default_value_t = RenderSettings::DEFAULT_FILTER_STRENGTH)]
-    filter_strength: f32,
-    /// With --filter: its search radius in pixels.
-    #[arg(long, value_name = "PIXELS", default_value_t = RenderSettings::DEFAULT_FILTER_RADIUS)]
-    filter_radius: u32,
-    /// ERPT: perturbations per chain.
-    #[arg(long, value_name = "L", default_value_t = RenderSettings::default().erpt_chain_length)]
-    erpt_chain_length: u32,
-    /// ERPT: energy (luminance) each chain step deposits (0: automatic, one chain per camera
-    /// sample on average).
-    #[arg(long, value_name = "E", default_value_t = RenderSettings::default().erpt_deposit_energy)]
-    erpt_deposit: f32,
-    /// Stop after this many seconds (0: no limit).
-    #[arg(long, value_name = "SECONDS", default_value_t = RenderSettings::default().time_limit_seconds)]
-    time_limit: f64,
-    /// Maximum number of scattering vertices on a path.
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().max_depth)]
-    max_depth: u32,
-    /// Random seed.
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().seed)]
-    seed: u64,
-    /// Worker threads (0: all cores).
-    #[arg(long, value_name = "N", default_value_t = RenderSettings::default().threads)]
-    threads: u32,
-    /// Image width in pixels; overrides the camera file's.
-    #[arg(long, value_name = "W")]
-    width: Option<u32>,
-    /// Image height in pixels; overrides the camera file's.
-    #[arg(long, value_name = "H")]
-    height: Option<u32>,
     /// Ray-intersection backend.
     #[arg(long, value_enum, default_value = "bvh")]
     backend: BackendArg,
@@ -373,18 +331,7 @@ fn run(args: &Args) -> Result<(), String> {
 
     let load_start = Instant::now();
     let mut data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
-    for material in &mut data.materials {
-        material.energy_compensation = args.energy_compensation;
-        let transmits = material.kind == mlt::MaterialKind::Dielectric
-            || (material.kind == mlt::MaterialKind::MetallicRoughness
-                && material.transmission > 0.0);
-        if let Some(abbe_number) = args.abbe_number
-            && transmits
-            && material.abbe_number == 0.0
-        {
-            material.abbe_number = abbe_number;
-        }
-    }
+    data.override_materials(args.energy_compensation, args.abbe_number);
     let framed = data.camera.is_none() && args.camera.is_none();
     let camera_file = match &args.camera {
         Some(path) => mlt::io::load_camera_json(path).map_err(|e| e.to_string())?,
@@ -432,12 +379,12 @@ fn run(args: &Args) -> Result<(), String> {
             "cannot build the scene from {}: {}: {}",
             args.scene.display(),
             e.status.description(),
-            describe_scene_error(&e, &data)
+            data.describe_error(&e)
         )
     })?;
     let load_seconds = load_start.elapsed().as_secs_f64();
 
-    let settings = settings(args, &camera_file);
+    let settings = settings(args, &camera_file)?;
     let mut rgb = vec![0.0f32; settings.output_len().map_err(|e| e.message)?];
     let bar = progress_bar();
     let mut on_progress = |fraction: f32| {
@@ -509,47 +456,25 @@ fn describe_lights(lights: &LightsDesc) -> String {
     parts.join(", ")
 }
 
-fn settings(args: &Args, camera: &CameraFile) -> RenderSettings {
-    RenderSettings {
-        width: args.width.unwrap_or(camera.width),
-        height: args.height.unwrap_or(camera.height),
-        algorithm: args.algorithm.into(),
-        samples_per_pixel: args.spp,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        threads: args.threads,
-        time_limit_seconds: args.time_limit,
-        mutations_per_pixel: args.mutations_per_pixel,
-        bootstrap_samples: args.bootstrap,
-        chains: args.chains,
-        large_step_probability: args.large_step,
-        small_step_sigma: args.small_step,
-        direct_samples_per_mutation: args.direct_per_mutation,
-        normalization_work_fraction: args.normalization_fraction,
-        mutation_weights: MutationWeights(args.mutation_weights.0),
-        erpt_chain_length: args.erpt_chain_length,
-        erpt_deposit_energy: args.erpt_deposit,
-        adapt_mutation_weights: args.adapt_mutation_weights,
-        perturb_in_sample_space: args.perturb_in_sample_space,
-        filter_buffers: if args.filter { args.filter_buffers } else { 0 },
-        filter_strength: args.filter_strength,
-        filter_radius: args.filter_radius,
-        spectral: args.spectral,
+/// The settings of the command line: the camera's size, then every flag given.
+fn settings(args: &Args, camera: &CameraFile) -> Result<RenderSettings, String> {
+    let mut settings = RenderSettings {
+        width: camera.width,
+        height: camera.height,
+        ..RenderSettings::default()
+    };
+    for &(name, value) in &args.settings.given {
+        settings.set(name, value).map_err(|e| e.message)?;
     }
-}
-
-/// The kernel names a material by index; add its name from the file.
-fn describe_scene_error(error: &mlt::Error, data: &SceneData) -> String {
-    let message = &error.message;
-    let named = message
-        .strip_prefix("desc.materials[")
-        .and_then(|rest| rest.split(']').next())
-        .and_then(|index| index.parse::<usize>().ok())
-        .and_then(|index| data.material_names.get(index));
-    match named {
-        Some(name) => format!("{message} (material '{name}')"),
-        None => message.clone(),
+    let buffers_given = args
+        .settings
+        .given
+        .iter()
+        .any(|(n, _)| *n == "filter_buffers");
+    if args.filter && !buffers_given {
+        settings.filter_buffers = RenderSettings::DEFAULT_FILTER_BUFFERS;
     }
+    Ok(settings)
 }
 
 fn check_output_directory(out: &Path) -> Result<(), String> {
@@ -613,10 +538,7 @@ fn print_summary(
             settings.time_limit_seconds
         ),
     };
-    let algorithm = args
-        .algorithm
-        .to_possible_value()
-        .map_or_else(String::new, |v| v.get_name().to_owned());
+    let algorithm = settings.algorithm.name();
     println!(
         "mlt-render: {} -> {} ({} x {}, {algorithm}, max depth {})",
         args.scene.display(),

@@ -238,50 +238,113 @@ pub(super) fn algorithm_to_c(algorithm: Algorithm) -> i32 {
     }
 }
 
+/// The host's settings as Rust's; every field a setting (see `CField`).
 pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
-    let algorithm = match s.algorithm {
-        MLT_ALGORITHM_PATH => Algorithm::Path,
-        MLT_ALGORITHM_BDPT => Algorithm::Bdpt,
-        MLT_ALGORITHM_PSSMLT => Algorithm::Pssmlt,
-        MLT_ALGORITHM_MMLT => Algorithm::Mmlt,
-        MLT_ALGORITHM_PSSMLT_BDPT => Algorithm::PssmltBdpt,
-        MLT_ALGORITHM_PATH_SPACE_MLT => Algorithm::PathSpaceMlt,
-        MLT_ALGORITHM_ERPT => Algorithm::Erpt,
-        other => {
-            return Err(Error::invalid(format!(
-                "settings.algorithm is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4), MLT_ALGORITHM_PATH_SPACE_MLT (5) or MLT_ALGORITHM_ERPT (6)"
-            )));
-        }
-    };
-    Ok(RenderSettings {
-        width: s.width,
-        height: s.height,
+    macro_rules! from_c {
+        ($($name:ident,)*) => {
+            // The defaults fill in a setting declared since the list was generated, so that
+            // the crate builds to run the generator (`tests/parameters.rs`).
+            #[allow(clippy::needless_update)]
+            Ok(RenderSettings {
+                $($name: CField::from_c(s.$name, concat!("settings.", stringify!($name)))?,)*
+                ..RenderSettings::default()
+            })
+        };
+    }
+    from_c! {
+        // BEGIN GENERATED settings from C: tests/parameters.rs writes these lines from src/render/settings.rs
+        width,
+        height,
         algorithm,
-        samples_per_pixel: s.samples_per_pixel,
-        max_depth: s.max_depth,
-        seed: s.seed,
-        threads: s.threads,
-        time_limit_seconds: s.time_limit_seconds,
-        mutations_per_pixel: s.mutations_per_pixel,
-        bootstrap_samples: s.bootstrap_samples,
-        chains: s.chains,
-        large_step_probability: s.large_step_probability,
-        small_step_sigma: s.small_step_sigma,
-        direct_samples_per_mutation: s.direct_samples_per_mutation,
-        mutation_weights: MutationWeights(s.mutation_weights),
-        erpt_chain_length: s.erpt_chain_length,
-        erpt_deposit_energy: s.erpt_deposit_energy,
-        adapt_mutation_weights: flag(s.adapt_mutation_weights, "settings.adapt_mutation_weights")?,
-        perturb_in_sample_space: flag(
-            s.perturb_in_sample_space,
-            "settings.perturb_in_sample_space",
-        )?,
-        filter_buffers: s.filter_buffers,
-        filter_strength: s.filter_strength,
-        filter_radius: s.filter_radius,
-        normalization_work_fraction: s.normalization_work_fraction,
-        spectral: flag(s.spectral, "settings.spectral")?,
-    })
+        samples_per_pixel,
+        max_depth,
+        threads,
+        seed,
+        time_limit_seconds,
+        mutations_per_pixel,
+        bootstrap_samples,
+        chains,
+        large_step_probability,
+        small_step_sigma,
+        direct_samples_per_mutation,
+        mutation_weights,
+        erpt_chain_length,
+        erpt_deposit_energy,
+        adapt_mutation_weights,
+        perturb_in_sample_space,
+        filter_buffers,
+        filter_strength,
+        filter_radius,
+        normalization_work_fraction,
+        spectral,
+        roulette_start_depth,
+        roulette_max_survival,
+        // END GENERATED settings from C
+    }
+}
+
+/// A setting's type in the C struct, and the conversions between the two (a C value Rust's
+/// type does not hold is refused with a message naming the field).
+pub(super) trait CField: Sized {
+    type C: Copy;
+    fn to_c(self) -> Self::C;
+    fn from_c(value: Self::C, name: &str) -> Result<Self>;
+}
+
+macro_rules! same_in_c {
+    ($($ty:ty),*) => {$(
+        impl CField for $ty {
+            type C = $ty;
+            fn to_c(self) -> $ty {
+                self
+            }
+            fn from_c(value: $ty, _: &str) -> Result<$ty> {
+                Ok(value)
+            }
+        }
+    )*};
+}
+same_in_c!(u32, u64, f32, f64);
+
+impl CField for bool {
+    type C = u32;
+    fn to_c(self) -> u32 {
+        self as u32
+    }
+    fn from_c(value: u32, name: &str) -> Result<bool> {
+        flag(value, name)
+    }
+}
+
+impl CField for MutationWeights {
+    type C = [f32; 4];
+    fn to_c(self) -> [f32; 4] {
+        self.0
+    }
+    fn from_c(value: [f32; 4], _: &str) -> Result<Self> {
+        Ok(MutationWeights(value))
+    }
+}
+
+impl CField for Algorithm {
+    type C = i32;
+    fn to_c(self) -> i32 {
+        algorithm_to_c(self)
+    }
+    fn from_c(value: i32, name: &str) -> Result<Algorithm> {
+        match value {
+            MLT_ALGORITHM_PATH => Ok(Algorithm::Path),
+            MLT_ALGORITHM_BDPT => Ok(Algorithm::Bdpt),
+            MLT_ALGORITHM_PSSMLT => Ok(Algorithm::Pssmlt),
+            MLT_ALGORITHM_MMLT => Ok(Algorithm::Mmlt),
+            MLT_ALGORITHM_PSSMLT_BDPT => Ok(Algorithm::PssmltBdpt),
+            MLT_ALGORITHM_PATH_SPACE_MLT => Ok(Algorithm::PathSpaceMlt),
+            MLT_ALGORITHM_ERPT => Ok(Algorithm::Erpt),
+            other => Err(Error::invalid(format!(
+                "{name} is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4), MLT_ALGORITHM_PATH_SPACE_MLT (5) or MLT_ALGORITHM_ERPT (6)"
+            ))),
+        }
+    }
 }
 
 /// What a render, a job or a merge did, as the host receives it (`struct_size` 0: the

@@ -11,7 +11,7 @@
 //! an explicit `_reserved` one), and its end goes into `EARLIER_LAYOUTS` of the previous
 //! layout. The unit tests check the sizes stay distinct.
 
-use super::convert::algorithm_to_c;
+use super::convert::CField;
 use super::marshal::check_pointer;
 use super::types::*;
 use crate::error::*;
@@ -366,36 +366,57 @@ impl Extensible for MltRenderSettings {
     /// The settings before the post-process filter's fields (mlt 0.1 had them without
     /// `struct_size`). `normalization_work_fraction`, added after the filter, fits the
     /// filter layout's tail padding, so that intermediate layout has today's size and is
-    /// not told apart: a host passes the filter fields with it or not at all.
-    const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltRenderSettings, filter_buffers)];
+    /// not told apart: a host passes the filter fields with it or not at all. Then the
+    /// settings before Russian roulette's.
+    const EARLIER_LAYOUTS: &'static [usize] = &[
+        offset_of!(MltRenderSettings, filter_buffers),
+        offset_of!(MltRenderSettings, roulette_start_depth),
+    ];
     fn defaults() -> Self {
-        let d = RenderSettings::default();
-        MltRenderSettings {
-            struct_size: size_of::<Self>() as u32,
-            width: d.width,
-            height: d.height,
-            algorithm: algorithm_to_c(d.algorithm),
-            samples_per_pixel: d.samples_per_pixel,
-            max_depth: d.max_depth,
-            threads: d.threads,
-            seed: d.seed,
-            time_limit_seconds: d.time_limit_seconds,
-            mutations_per_pixel: d.mutations_per_pixel,
-            bootstrap_samples: d.bootstrap_samples,
-            chains: d.chains,
-            large_step_probability: d.large_step_probability,
-            small_step_sigma: d.small_step_sigma,
-            direct_samples_per_mutation: d.direct_samples_per_mutation,
-            mutation_weights: d.mutation_weights.0,
-            erpt_chain_length: d.erpt_chain_length,
-            erpt_deposit_energy: d.erpt_deposit_energy,
-            adapt_mutation_weights: d.adapt_mutation_weights as u32,
-            perturb_in_sample_space: d.perturb_in_sample_space as u32,
-            filter_buffers: d.filter_buffers,
-            filter_strength: d.filter_strength,
-            filter_radius: d.filter_radius,
-            normalization_work_fraction: d.normalization_work_fraction,
-            spectral: d.spectral as u32,
+        (&RenderSettings::default()).into()
+    }
+}
+
+/// The C struct of Rust's settings, with today's `struct_size`.
+impl From<&RenderSettings> for MltRenderSettings {
+    fn from(d: &RenderSettings) -> Self {
+        macro_rules! to_c {
+            ($($name:ident,)*) => {
+                MltRenderSettings {
+                    struct_size: size_of::<Self>() as u32,
+                    $($name: d.$name.to_c(),)*
+                }
+            };
+        }
+        to_c! {
+            // BEGIN GENERATED settings to C: tests/parameters.rs writes these lines from src/render/settings.rs
+            width,
+            height,
+            algorithm,
+            samples_per_pixel,
+            max_depth,
+            threads,
+            seed,
+            time_limit_seconds,
+            mutations_per_pixel,
+            bootstrap_samples,
+            chains,
+            large_step_probability,
+            small_step_sigma,
+            direct_samples_per_mutation,
+            mutation_weights,
+            erpt_chain_length,
+            erpt_deposit_energy,
+            adapt_mutation_weights,
+            perturb_in_sample_space,
+            filter_buffers,
+            filter_strength,
+            filter_radius,
+            normalization_work_fraction,
+            spectral,
+            roulette_start_depth,
+            roulette_max_survival,
+            // END GENERATED settings to C
         }
     }
 }
@@ -481,13 +502,16 @@ mod tests {
     /// The layouts older headers have: mlt 0.2's material ends at `ior`, its scene
     /// description at `backend`; the one with lights but no surface attributes is 112 bytes,
     /// the one without the build quality 192; the scene info without the acceleration
-    /// structure's facts 64.
+    /// structure's facts 64; the settings without the filter 104, without Russian roulette
+    /// 128.
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
         assert_eq!(sizes::<MltMaterial>(), [36, 168]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
+        // Before the filter, before Russian roulette, today.
+        assert_eq!(sizes::<MltRenderSettings>(), [104, 128, 136]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);
     }

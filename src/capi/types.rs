@@ -447,99 +447,90 @@ pub struct MltCamera {
     pub focus_distance: f32,
 }
 
-/// How to render. Initialize with `mlt_render_settings_default`.
+/// How to render. Initialize with `mlt_render_settings_default`. Each field is a setting
+/// declared in mlt's `src/render/settings.rs`; `docs/settings.md` lists them with their
+/// defaults, valid values and command-line flags. Booleans are 0 or 1.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct MltRenderSettings {
     /// sizeof(MltRenderSettings) of the header the host was built with: set by `mlt_render_settings_default`, do not change
     /// it. An older header's smaller struct is read as far as it goes (the rest defaults).
     pub struct_size: u32,
-    /// Image size in pixels, each in [1, 65536].
+    // BEGIN GENERATED render settings: tests/parameters.rs writes these lines from src/render/settings.rs
+    /// Image width in pixels. It must be between 1 and 65536. Default 256.
     pub width: u32,
+    /// Image height in pixels. It must be between 1 and 65536. Default 256.
     pub height: u32,
-    /// One of `MLT_ALGORITHM_*`; the default is `MLT_ALGORITHM_MMLT`.
+    /// The light-transport algorithm. One of `MLT_ALGORITHM_*`. Default `MLT_ALGORITHM_MMLT`.
     pub algorithm: i32,
-    /// Path tracing and BDPT: samples per pixel, at most 2^24. 0 renders until
-    /// `time_limit_seconds`. The Metropolis algorithms use `mutations_per_pixel` instead.
+    /// Path tracing, BDPT and ERPT: samples per pixel (0: until the time limit). At most 16777216
+    /// are supported. Default 64.
     pub samples_per_pixel: u32,
-    /// Most scattering vertices between camera and light (0: only directly visible
-    /// emitters), at most 1024.
+    /// Most scattering vertices between camera and light (0: emitters seen directly). At most 1024
+    /// is supported. Default 5.
     pub max_depth: u32,
-    /// Worker threads; 0 runs on one pool of one thread per core that every such render in
-    /// the process shares (renders from several host threads at once then share the cores
-    /// instead of oversubscribing them); a count gives the render a pool of its own. The
-    /// image does not depend on it.
+    /// Worker threads (0: a pool of one per core shared by such renders); the image does not depend
+    /// on it. Use 0 for all cores or at most 4096. Default 0.
     pub threads: u32,
-    /// Seed of every random number; equal seeds and settings give bitwise equal images.
+    /// Seed of every random number: equal seeds and settings give equal images. Any value of its
+    /// type. Default 0.
     pub seed: u64,
-    /// Stop after this many seconds (0: no limit). Finite, at most 1e7.
+    /// Stop after this many seconds (0: no limit). It must be 0 (no limit) or a positive number of
+    /// seconds up to 10000000. Default 0.0.
     pub time_limit_seconds: f64,
-    /// Metropolis: mutations per pixel, at most 2^24; 0 renders until `time_limit_seconds`.
+    /// Metropolis: mutations per pixel (0: until the time limit). At most 16777216 are supported.
+    /// Default 32.
     pub mutations_per_pixel: u32,
-    /// Metropolis: independent samples that seed the chains and start the estimate of the
-    /// image normalization, at most 2^28. 0 (the default) sizes it to the render: one
-    /// sample per 8 planned mutations, at least 2^16 (2^18 for a render planned by its time
-    /// limit alone).
+    /// Metropolis: samples seeding the chains and the brightness estimate (0: one per 8 planned
+    /// mutations, at least 65536; 262144 for a render planned by time alone). It must be 0
+    /// (automatic) or at most 268435456. Default 0.
     pub bootstrap_samples: u32,
-    /// Metropolis: number of Markov chains, from 1 to the bootstrap samples. The image does
-    /// not depend on the thread count.
+    /// Metropolis: number of Markov chains, at most the bootstrap samples. It must be between 1 and
+    /// the bootstrap samples (262144). Default 1024.
     pub chains: u32,
-    /// PSSMLT: probability of a large (independent) step, in [0, 1].
+    /// PSSMLT: probability of a large (independent) step. It must be in [0, 1]. Default 0.3.
     pub large_step_probability: f32,
-    /// PSSMLT: standard deviation of a small step in primary sample space, in (0, 1].
+    /// PSSMLT: standard deviation of a small step in primary sample space. It must be in (0, 1].
+    /// Default 0.01.
     pub small_step_sigma: f32,
-    /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel);
-    /// mutations_per_pixel × this is at most 2^24. The direct pass path-traces the paths of
-    /// depth 0 and 1 (emitters seen directly, direct lighting) and leaves the longer ones to
-    /// the chains; the two alternate, so a render stopped early keeps the ratio. 0: no direct
-    /// pass, the chains render every depth.
+    /// Metropolis: path-traced samples of depths 0 and 1 per chain mutation (0: the chains render
+    /// every depth). Any value of its type. Default 1.
     pub direct_samples_per_mutation: u32,
-    /// `MLT_ALGORITHM_PATH_SPACE_MLT`: relative probabilities of the mutations, indexed by
-    /// `MLT_MUTATION_*` (bidirectional, lens, caustic, multi-chain). Each step picks among
-    /// those the current path admits. Finite, in [0, 1e6]; the bidirectional weight must be
-    /// positive.
+    /// Path-space MLT: relative probabilities of the bidirectional mutation and the lens, caustic
+    /// and multi-chain perturbations (the first positive). Weights must be finite, from 0 to 1e6.
+    /// Default 0.5, 0.25, 0.25, 0.25.
     pub mutation_weights: [f32; 4],
-    /// `MLT_ALGORITHM_ERPT`: perturbations per chain (L), in [1, 2^20]; default 10.
+    /// ERPT: perturbations per chain. It must be between 1 and 1048576. Default 10.
     pub erpt_chain_length: u32,
-    /// `MLT_ALGORITHM_ERPT`: the energy (luminance) each chain step deposits, e_d; a camera
-    /// sample's energy e starts floor(e / (L e_d) + uniform) chains. 0 (the default) picks
-    /// e_d so that a camera sample starts one chain on average. Finite, in [0, 1e30].
+    /// ERPT: energy (luminance) each chain step deposits (0: one chain per camera sample on
+    /// average). It must be 0 (automatic) or a positive number up to 1e30. Default 0.0.
     pub erpt_deposit_energy: f32,
-    /// `MLT_ALGORITHM_PATH_SPACE_MLT`, 0 or 1: run a warm-up of about one mutation per pixel
-    /// with `mutation_weights`, then weight each mutation by its acceptance rate there
-    /// (within a factor of 8) for the rest of the render, on chains seeded anew. The weights
-    /// used are reported in `MltRenderStats::mutation_weights`. Default 0.
+    /// Path-space MLT: after a warm-up, weight each mutation by its acceptance rate there. 0 or 1.
+    /// Default 0.
     pub adapt_mutation_weights: u32,
-    /// `MLT_ALGORITHM_PATH_SPACE_MLT` and `MLT_ALGORITHM_ERPT`, 0 or 1: perturb directions at
-    /// diffuse vertices and lights by small steps in their cosine-weighted sample space
-    /// instead of within a cone. Default 0.
+    /// Path-space MLT and ERPT: perturb directions in the BSDF's sample space instead of within a
+    /// cone. 0 or 1. Default 0.
     pub perturb_in_sample_space: u32,
-    /// Metropolis algorithms and `MLT_ALGORITHM_ERPT`: the post-process filter for blotchy
-    /// noise, non-local means guided by per-pixel variances measured from partial images.
-    /// 0 (the default) turns it off; otherwise the number of partial images the deposits are
-    /// split into, from `MLT_MIN_FILTER_BUFFERS` to `MLT_MAX_FILTER_BUFFERS` (8 is a good
-    /// start; each costs 12 bytes per pixel). The image keeps its total: the filter moves
-    /// energy between pixels (a local bias) to lower the error. `MltRenderStats` reports
-    /// what it did.
+    /// Metropolis and ERPT: partial images of the post-process noise filter (0: no filter; 8 is a
+    /// good start). It must be 0 (no filter) or from 2 to 32. Default 0.
     pub filter_buffers: u32,
-    /// The filter's strength, in (0, `MLT_MAX_FILTER_STRENGTH`]; default 0.45. Higher
-    /// smooths more.
+    /// The filter's strength (higher smooths more). It must be positive, up to 100. Default 0.45.
     pub filter_strength: f32,
-    /// The filter's search radius in pixels, in [1, `MLT_MAX_FILTER_RADIUS`]; default 7.
+    /// The filter's search radius in pixels. It must be from 1 to 32 pixels. Default 7.
     pub filter_radius: u32,
-    /// Metropolis: the share of the rays spent on independent samples of the chains' target,
-    /// drawn alongside the chains to go on estimating the normalization b, which sets the
-    /// image's brightness; in [0, 0.9], default 0.05. The image is scaled by the final
-    /// estimate (over the bootstrap, these samples and, for PSSMLT and PSSMLT over BDPT, the
-    /// large steps), so its brightness error shrinks as the render goes on. 0: no such
-    /// samples.
+    /// Metropolis: share of the rays spent on samples that go on estimating the brightness (0: the
+    /// bootstrap and large steps alone). It must be from 0 to 0.9. Default 0.05.
     pub normalization_work_fraction: f32,
-    /// 0 or 1: spectral transport. Each camera path carries four wavelengths (hero-wavelength
-    /// sampling) instead of RGB; colours given as RGB become smooth spectra, lights emit
-    /// them times D65, and the image is CIE XYZ converted to linear sRGB. Dielectrics with
-    /// an `MltMaterial.abbe_number` disperse light (a path through one goes on at one
-    /// wavelength). Default 0 (RGB).
+    /// Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.
+    /// 0 or 1. Default 0.
     pub spectral: u32,
+    /// Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path. It
+    /// must be at most 1024. Default 3.
+    pub roulette_start_depth: u32,
+    /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
+    /// on. It must be in (0, 1]. Default 0.95.
+    pub roulette_max_survival: f32,
+    // END GENERATED render settings
 }
 
 /// What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.

@@ -1087,6 +1087,7 @@ mod tests {
                 max_depth: bounces,
                 min_depth: bounces,
                 spectral: false,
+                roulette: crate::render::RenderSettings::default().roulette(),
             };
             let mut rng = Rng::new(3, 5);
             let (mut sum, mut sum2) = (0.0f64, 0.0f64);

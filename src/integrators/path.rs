@@ -13,10 +13,14 @@ use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 use glam::Vec3A;
 
-/// Bounces after which Russian roulette may end a path.
-const ROULETTE_START_DEPTH: u32 = 3;
-/// Highest survival probability: paths always carry some chance of ending.
-const ROULETTE_MAX_SURVIVAL: f32 = 0.95;
+/// When Russian roulette may end a path, and how likely it lets one go on at most.
+#[derive(Clone, Copy, Debug)]
+pub struct Roulette {
+    /// Bounces after which it may end a path.
+    pub start_depth: u32,
+    /// Highest survival probability: below 1, paths always carry some chance of ending.
+    pub max_survival: f32,
+}
 
 pub struct PathTracer<'a> {
     pub scene: &'a Scene,
@@ -27,6 +31,7 @@ pub struct PathTracer<'a> {
     /// Whether paths carry wavelengths (one more sampler coordinate, read first) instead
     /// of RGB.
     pub spectral: bool,
+    pub roulette: Roulette,
 }
 
 impl PathTracer<'_> {
@@ -124,9 +129,9 @@ impl PathTracer<'_> {
             radiance_scale *= sample.radiance_scale;
             depth += 1;
 
-            if depth >= ROULETTE_START_DEPTH {
+            if depth >= self.roulette.start_depth {
                 let survival =
-                    (throughput.max_component() / radiance_scale).min(ROULETTE_MAX_SURVIVAL);
+                    (throughput.max_component() / radiance_scale).min(self.roulette.max_survival);
                 if u_roulette >= survival {
                     break;
                 }

@@ -70,6 +70,34 @@ pub struct SceneData {
 }
 
 impl SceneData {
+    /// The error's message, with the file's name of the material it is about (the kernel
+    /// knows materials by index only).
+    pub fn describe_error(&self, error: &crate::Error) -> String {
+        match error.material.and_then(|i| self.material_names.get(i)) {
+            Some(name) => format!("{} (material '{name}')", error.message),
+            None => error.message.clone(),
+        }
+    }
+
+    /// Applies the loaders' material options to every material: `energy_compensation` for
+    /// all (rough metals keep their multiply scattered light), and `abbe_number` to each
+    /// transmissive one (a dielectric, or a metallic-roughness material with transmission)
+    /// that has no dispersion of its own.
+    pub fn override_materials(&mut self, energy_compensation: bool, abbe_number: Option<f32>) {
+        for material in &mut self.materials {
+            material.energy_compensation = energy_compensation;
+            let transmits = material.kind == crate::MaterialKind::Dielectric
+                || (material.kind == crate::MaterialKind::MetallicRoughness
+                    && material.transmission > 0.0);
+            if let Some(abbe_number) = abbe_number
+                && transmits
+                && material.abbe_number == 0.0
+            {
+                material.abbe_number = abbe_number;
+            }
+        }
+    }
+
     /// Borrows the arrays as a scene description for [`crate::Scene::new`], at the default
     /// build quality.
     pub fn desc(&self, backend: Backend) -> SceneDesc<'_> {

@@ -359,6 +359,7 @@ fn with_estimator<R>(
             max_depth: settings.max_depth.min(DIRECT_PASS_DEPTHS - 1),
             min_depth: 0,
             spectral: settings.spectral,
+            roulette: settings.roulette(),
         });
     let min_depth = if direct.is_some() {
         DIRECT_PASS_DEPTHS
@@ -370,6 +371,7 @@ fn with_estimator<R>(
         max_depth: settings.max_depth,
         min_depth,
         spectral: settings.spectral,
+        roulette: settings.roulette(),
     };
     let bdpt = Bdpt {
         scene,

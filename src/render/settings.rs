@@ -6,6 +6,10 @@ use crate::filter::{
     MLT_MAX_FILTER_BUFFERS, MLT_MAX_FILTER_RADIUS, MLT_MAX_FILTER_STRENGTH, MLT_MIN_FILTER_BUFFERS,
 };
 use crate::integrators::mlt::driver::MutationWeights;
+use crate::integrators::path::Roulette;
+use crate::params::{
+    ChoiceParameter, Kind, ParameterType, Range, Unfit, Value, declare_parameters,
+};
 /// The light-transport algorithm of a render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Algorithm {
@@ -64,123 +68,255 @@ pub const MLT_MAX_BOOTSTRAP_SAMPLES: u32 = 1 << 28;
 /// Largest accepted share of a Metropolis render's rays spent on its normalization pass.
 pub const MLT_MAX_NORMALIZATION_WORK_FRACTION: f32 = 0.9;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub algorithm: Algorithm,
-    /// Samples per pixel; 0 means "until the time limit" (which must then be set).
-    pub samples_per_pixel: u32,
-    /// At most this many scattering vertices between camera and light (0: emitters only).
-    pub max_depth: u32,
-    pub seed: u64,
-    /// Worker threads; 0 (the default) runs on one pool of one thread per core shared by
-    /// every such render in the process, so renders from several host threads at once share
-    /// the cores; a count gives the render a pool of its own. The image does not depend on it.
-    pub threads: u32,
-    /// Stop after this many seconds; 0 means no limit.
-    pub time_limit_seconds: f64,
-    /// Metropolis: mutations per pixel; 0 means "until the time limit".
-    pub mutations_per_pixel: u32,
-    /// Metropolis: independent samples that seed the chains and start the estimate of the
-    /// normalization b (see `normalization_work_fraction`). 0 (the default) sizes the
-    /// bootstrap to the render: one sample per `AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE`
-    /// planned mutations, at least `MIN_AUTO_BOOTSTRAP_SAMPLES`; a render planned by time
-    /// alone takes `TIME_LIMITED_BOOTSTRAP_SAMPLES`. `resolved_bootstrap_samples` says
-    /// what a render takes.
-    pub bootstrap_samples: u32,
-    /// Metropolis: number of Markov chains (independent of the thread count).
-    pub chains: u32,
-    /// PSSMLT: probability that a mutation is a large (independent) step.
-    pub large_step_probability: f32,
-    /// PSSMLT: standard deviation of a small step in primary sample space.
-    pub small_step_sigma: f32,
-    /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel).
-    /// The direct pass path-traces the paths of depth 0 and 1 (emitters seen directly,
-    /// direct lighting), which chains render poorly: they spend mutations in proportion to
-    /// brightness, on what stratified camera samples get right. The chains render the longer
-    /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
-    /// pass; the chains render every depth.
-    pub direct_samples_per_mutation: u32,
-    /// Metropolis: the share of the rays spent on independent samples of the chains' target
-    /// (path-tracer samples for PSSMLT, BDPT samples with all strategies for the others),
-    /// drawn alongside the chains to go on estimating the normalization b, which sets the
-    /// image's brightness. The image is scaled by the final estimate, over the bootstrap,
-    /// these samples and (PSSMLT, PSSMLT over BDPT) the chains' large steps, so its
-    /// brightness error shrinks with the render's length (`integrators::mlt::normalization`).
-    /// From 0 (no such samples: the bootstrap and the large steps alone) to 0.9.
-    /// `RenderStats::normalization` reports the estimate's own standard error.
-    pub normalization_work_fraction: f32,
-    /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
-    /// lens, caustic and multi-chain perturbations (`Mutation as usize` order). Each step
-    /// picks among those the current path admits. The bidirectional weight must be
-    /// positive: it alone makes every path reachable. ERPT uses the perturbations' weights
-    /// (its chains only perturb).
-    pub mutation_weights: MutationWeights,
-    /// Path-space MLT: run a warm-up of about one mutation per pixel with
-    /// `mutation_weights`, then adapt each weight to its mutation's acceptance rate there
-    /// (within a factor of 8) and run the rest of the render with those weights frozen, on
-    /// chains seeded anew (so every chain is a valid Metropolis chain; see
-    /// `path_space::chain::adapted_weights`). `RenderStats::mutation_weights` reports them.
-    pub adapt_mutation_weights: bool,
-    /// Path-space MLT and ERPT: perturb directions at diffuse vertices and lights by small
-    /// steps in their own (cosine-weighted) sample space instead of within a cone, so the
-    /// steps follow the BSDF's shape and its density cancels from the transfer ratio.
-    pub perturb_in_sample_space: bool,
-    /// ERPT: perturbations per chain (L). Each camera sample's energy e starts
-    /// ⌊e / (L·e_d) + ξ⌋ chains.
-    pub erpt_chain_length: u32,
-    /// ERPT: the energy (luminance) e_d each chain step deposits; 0 picks it so that a
-    /// camera sample starts one chain on average (from a pre-pass estimating the mean
-    /// energy of a sample: e_d = mean / L). Smaller values start more chains.
-    pub erpt_deposit_energy: f32,
-    /// Metropolis and ERPT: the post-process filter for blotchy noise (`crate::filter`):
-    /// non-local means guided by per-pixel variances measured from partial images. 0 turns
-    /// it off (the default); otherwise the number of partial images the deposits are split
-    /// into, from 2 to 32 (8 is a good start; each costs 12 bytes per pixel). The filter
-    /// moves energy between pixels, keeping the image's total: it trades a local bias (blur
-    /// of what the noise hides) for lower error. `RenderStats::filter` reports what it did.
-    pub filter_buffers: u32,
-    /// The filter's strength k: patch differences up to about k standard deviations count
-    /// as noise. Higher smooths more (more bias, less noise).
-    pub filter_strength: f32,
-    /// The filter's search radius in pixels: each pixel averages pixels up to this far.
-    pub filter_radius: u32,
-    /// Spectral transport: each camera path carries `WAVELENGTHS` (4) wavelengths drawn by
-    /// hero-wavelength sampling instead of RGB; RGB colours become smooth spectra (lights
-    /// times D65) and the film gets CIE XYZ converted to linear sRGB. Dispersive
-    /// dielectrics (`Material::abbe_number`) split light by wavelength only in this mode.
-    pub spectral: bool,
+impl ChoiceParameter for Algorithm {
+    /// The names of the command line, Python and the docs.
+    const NAMES: &'static [&'static str] = &[
+        "path",
+        "bdpt",
+        "pssmlt",
+        "mmlt",
+        "pssmlt-bdpt",
+        "path-space-mlt",
+        "erpt",
+    ];
+    const ALL: &'static [Algorithm] = &[
+        Algorithm::Path,
+        Algorithm::Bdpt,
+        Algorithm::Pssmlt,
+        Algorithm::Mmlt,
+        Algorithm::PssmltBdpt,
+        Algorithm::PathSpaceMlt,
+        Algorithm::Erpt,
+    ];
 }
 
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 256,
-            height: 256,
-            algorithm: Algorithm::default(),
-            samples_per_pixel: 64,
-            max_depth: 5,
-            seed: 0,
-            threads: 0,
-            time_limit_seconds: 0.0,
-            mutations_per_pixel: 32,
-            bootstrap_samples: 0,
-            chains: 1024,
-            large_step_probability: 0.3,
-            small_step_sigma: 0.01,
-            direct_samples_per_mutation: Self::DEFAULT_DIRECT_SAMPLES_PER_MUTATION,
-            normalization_work_fraction: Self::DEFAULT_NORMALIZATION_WORK_FRACTION,
-            mutation_weights: MutationWeights::default(),
-            erpt_chain_length: Self::DEFAULT_ERPT_CHAIN_LENGTH,
-            erpt_deposit_energy: 0.0,
-            adapt_mutation_weights: false,
-            perturb_in_sample_space: false,
-            filter_buffers: 0,
-            filter_strength: Self::DEFAULT_FILTER_STRENGTH,
-            filter_radius: Self::DEFAULT_FILTER_RADIUS,
-            spectral: false,
-        }
+impl ParameterType for MutationWeights {
+    const KIND: Kind = Kind::F32x4;
+    fn to_value(self) -> Value {
+        self.0.to_value()
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        <[f32; 4]>::from_value(value).map(MutationWeights)
+    }
+    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
+        self.0.outside(range)
+    }
+}
+
+// The render settings, each declared once: the C, C++ and Python fields, the command-line
+// flags, the range checks of `validate` and `docs/settings.md` follow from this table. The
+// order is the C struct's: append new settings at the end.
+declare_parameters! {
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct RenderSettings in "settings" {
+        width: u32 = 256 => {
+            doc: "Image width in pixels.",
+            flag: "width",
+            range: Range::closed(1.0, MLT_MAX_IMAGE_SIDE as f64),
+            rule: |_| format!("it must be between 1 and {MLT_MAX_IMAGE_SIDE}"),
+        },
+        height: u32 = 256 => {
+            doc: "Image height in pixels.",
+            flag: "height",
+            range: Range::closed(1.0, MLT_MAX_IMAGE_SIDE as f64),
+            rule: |_| format!("it must be between 1 and {MLT_MAX_IMAGE_SIDE}"),
+        },
+        algorithm: Algorithm = Algorithm::default() => {
+            doc: "The light-transport algorithm.",
+            flag: "algorithm",
+        },
+        /// Samples per pixel; 0 means "until the time limit" (which must then be set).
+        samples_per_pixel: u32 = 64 => {
+            doc: "Path tracing, BDPT and ERPT: samples per pixel (0: until the time limit).",
+            flag: "spp",
+            range: Range::closed(0.0, MLT_MAX_SAMPLES_PER_PIXEL as f64),
+            rule: |_| format!("at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported"),
+        },
+        /// At most this many scattering vertices between camera and light (0: emitters only).
+        max_depth: u32 = 5 => {
+            doc: "Most scattering vertices between camera and light (0: emitters seen directly).",
+            flag: "max-depth",
+            range: Range::closed(0.0, MLT_MAX_DEPTH_LIMIT as f64),
+            rule: |_| format!("at most {MLT_MAX_DEPTH_LIMIT} is supported"),
+        },
+        /// Worker threads; 0 (the default) runs on one pool of one thread per core shared by
+        /// every such render in the process, so renders from several host threads at once share
+        /// the cores; a count gives the render a pool of its own. The image does not depend on it.
+        threads: u32 = 0 => {
+            doc: "Worker threads (0: a pool of one per core shared by such renders); the image does not depend on it.",
+            flag: "threads",
+            range: Range::closed(0.0, MLT_MAX_THREADS as f64),
+            rule: |_| format!("use 0 for all cores or at most {MLT_MAX_THREADS}"),
+        },
+        seed: u64 = 0 => {
+            doc: "Seed of every random number: equal seeds and settings give equal images.",
+            flag: "seed",
+        },
+        /// Stop after this many seconds; 0 means no limit.
+        time_limit_seconds: f64 = 0.0 => {
+            doc: "Stop after this many seconds (0: no limit).",
+            flag: "time-limit",
+            range: Range::closed(0.0, MLT_MAX_TIME_LIMIT_SECONDS),
+            rule: |_| format!("it must be 0 (no limit) or a positive number of seconds up to {MLT_MAX_TIME_LIMIT_SECONDS}"),
+        },
+        /// Metropolis: mutations per pixel; 0 means "until the time limit".
+        mutations_per_pixel: u32 = 32 => {
+            doc: "Metropolis: mutations per pixel (0: until the time limit).",
+            flag: "mutations-per-pixel",
+            range: Range::closed(0.0, MLT_MAX_SAMPLES_PER_PIXEL as f64),
+            rule: |_| format!("at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported"),
+        },
+        /// Metropolis: independent samples that seed the chains and start the estimate of the
+        /// normalization b (see `normalization_work_fraction`). 0 (the default) sizes the
+        /// bootstrap to the render: one sample per `AUTO_BOOTSTRAP_MUTATIONS_PER_SAMPLE`
+        /// planned mutations, at least `MIN_AUTO_BOOTSTRAP_SAMPLES`; a render planned by time
+        /// alone takes `TIME_LIMITED_BOOTSTRAP_SAMPLES`. `resolved_bootstrap_samples` says
+        /// what a render takes.
+        bootstrap_samples: u32 = 0 => {
+            doc: "Metropolis: samples seeding the chains and the brightness estimate (0: one per 8 planned mutations, at least 65536; 262144 for a render planned by time alone).",
+            flag: "bootstrap",
+            range: Range::closed(0.0, MLT_MAX_BOOTSTRAP_SAMPLES as f64),
+            rule: |_| format!("it must be 0 (automatic) or at most {MLT_MAX_BOOTSTRAP_SAMPLES}"),
+        },
+        /// Metropolis: number of Markov chains (independent of the thread count).
+        chains: u32 = 1024 => {
+            doc: "Metropolis: number of Markov chains, at most the bootstrap samples.",
+            flag: "chains",
+            range: Range::closed(1.0, MLT_MAX_BOOTSTRAP_SAMPLES as f64),
+            rule: |s| format!(
+                "it must be between 1 and the bootstrap samples ({})",
+                s.resolved_bootstrap_samples()
+            ),
+        },
+        /// PSSMLT: probability that a mutation is a large (independent) step.
+        large_step_probability: f32 = 0.3 => {
+            doc: "PSSMLT: probability of a large (independent) step.",
+            flag: "large-step",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "it must be in [0, 1]".into(),
+        },
+        /// PSSMLT: standard deviation of a small step in primary sample space.
+        small_step_sigma: f32 = 0.01 => {
+            doc: "PSSMLT: standard deviation of a small step in primary sample space.",
+            flag: "small-step",
+            range: Range::above(0.0, 1.0),
+            rule: |_| "it must be in (0, 1]".into(),
+        },
+        /// Metropolis: camera samples of the direct pass per chain mutation (both per pixel).
+        /// The direct pass path-traces the paths of depth 0 and 1 (emitters seen directly,
+        /// direct lighting), which chains render poorly: they spend mutations in proportion to
+        /// brightness, on what stratified camera samples get right. The chains render the longer
+        /// paths. The two alternate, so a render stopped early keeps the ratio. 0: no direct
+        /// pass; the chains render every depth.
+        direct_samples_per_mutation: u32 = RenderSettings::DEFAULT_DIRECT_SAMPLES_PER_MUTATION => {
+            doc: "Metropolis: path-traced samples of depths 0 and 1 per chain mutation (0: the chains render every depth).",
+            flag: "direct-per-mutation",
+        },
+        /// Path-space MLT: relative probabilities of the bidirectional mutation and of the
+        /// lens, caustic and multi-chain perturbations (`Mutation as usize` order). Each step
+        /// picks among those the current path admits. The bidirectional weight must be
+        /// positive: it alone makes every path reachable. ERPT uses the perturbations' weights
+        /// (its chains only perturb).
+        mutation_weights: MutationWeights = MutationWeights::default() => {
+            doc: "Path-space MLT: relative probabilities of the bidirectional mutation and the lens, caustic and multi-chain perturbations (the first positive).",
+            flag: "mutation-weights",
+            range: Range::closed(0.0, 1e6),
+            rule: |_| "weights must be finite, from 0 to 1e6".into(),
+        },
+        /// ERPT: perturbations per chain (L). Each camera sample's energy e starts
+        /// ⌊e / (L·e_d) + ξ⌋ chains.
+        erpt_chain_length: u32 = RenderSettings::DEFAULT_ERPT_CHAIN_LENGTH => {
+            doc: "ERPT: perturbations per chain.",
+            flag: "erpt-chain-length",
+            range: Range::closed(1.0, MLT_MAX_ERPT_CHAIN_LENGTH as f64),
+            rule: |_| format!("it must be between 1 and {MLT_MAX_ERPT_CHAIN_LENGTH}"),
+        },
+        /// ERPT: the energy (luminance) e_d each chain step deposits; 0 picks it so that a
+        /// camera sample starts one chain on average (from a pre-pass estimating the mean
+        /// energy of a sample: e_d = mean / L). Smaller values start more chains.
+        erpt_deposit_energy: f32 = 0.0 => {
+            doc: "ERPT: energy (luminance) each chain step deposits (0: one chain per camera sample on average).",
+            flag: "erpt-deposit",
+            range: Range::closed(0.0, MLT_MAX_ERPT_DEPOSIT_ENERGY as f64),
+            rule: |_| format!("it must be 0 (automatic) or a positive number up to {MLT_MAX_ERPT_DEPOSIT_ENERGY:e}"),
+        },
+        /// Path-space MLT: run a warm-up of about one mutation per pixel with
+        /// `mutation_weights`, then adapt each weight to its mutation's acceptance rate there
+        /// (within a factor of 8) and run the rest of the render with those weights frozen, on
+        /// chains seeded anew (so every chain is a valid Metropolis chain; see
+        /// `path_space::chain::adapted_weights`). `RenderStats::mutation_weights` reports them.
+        adapt_mutation_weights: bool = false => {
+            doc: "Path-space MLT: after a warm-up, weight each mutation by its acceptance rate there.",
+            flag: "adapt-mutation-weights",
+        },
+        /// Path-space MLT and ERPT: perturb directions at diffuse vertices and lights by small
+        /// steps in their own (cosine-weighted) sample space instead of within a cone, so the
+        /// steps follow the BSDF's shape and its density cancels from the transfer ratio.
+        perturb_in_sample_space: bool = false => {
+            doc: "Path-space MLT and ERPT: perturb directions in the BSDF's sample space instead of within a cone.",
+            flag: "perturb-in-sample-space",
+        },
+        /// Metropolis and ERPT: the post-process filter for blotchy noise (`crate::filter`):
+        /// non-local means guided by per-pixel variances measured from partial images. 0 turns
+        /// it off (the default); otherwise the number of partial images the deposits are split
+        /// into, from 2 to 32 (8 is a good start; each costs 12 bytes per pixel). The filter
+        /// moves energy between pixels, keeping the image's total: it trades a local bias (blur
+        /// of what the noise hides) for lower error. `RenderStats::filter` reports what it did.
+        filter_buffers: u32 = 0 => {
+            doc: "Metropolis and ERPT: partial images of the post-process noise filter (0: no filter; 8 is a good start).",
+            flag: "filter-buffers",
+            range: Range::closed(MLT_MIN_FILTER_BUFFERS as f64, MLT_MAX_FILTER_BUFFERS as f64).or(0.0),
+            rule: |_| format!("it must be 0 (no filter) or from {MLT_MIN_FILTER_BUFFERS} to {MLT_MAX_FILTER_BUFFERS}"),
+        },
+        /// The filter's strength k: patch differences up to about k standard deviations count
+        /// as noise. Higher smooths more (more bias, less noise).
+        filter_strength: f32 = RenderSettings::DEFAULT_FILTER_STRENGTH => {
+            doc: "The filter's strength (higher smooths more).",
+            flag: "filter-strength",
+            range: Range::above(0.0, MLT_MAX_FILTER_STRENGTH as f64),
+            rule: |_| format!("it must be positive, up to {MLT_MAX_FILTER_STRENGTH}"),
+        },
+        /// The filter's search radius in pixels: each pixel averages pixels up to this far.
+        filter_radius: u32 = RenderSettings::DEFAULT_FILTER_RADIUS => {
+            doc: "The filter's search radius in pixels.",
+            flag: "filter-radius",
+            range: Range::closed(1.0, MLT_MAX_FILTER_RADIUS as f64),
+            rule: |_| format!("it must be from 1 to {MLT_MAX_FILTER_RADIUS} pixels"),
+        },
+        /// Metropolis: the share of the rays spent on independent samples of the chains' target
+        /// (path-tracer samples for PSSMLT, BDPT samples with all strategies for the others),
+        /// drawn alongside the chains to go on estimating the normalization b, which sets the
+        /// image's brightness. The image is scaled by the final estimate, over the bootstrap,
+        /// these samples and (PSSMLT, PSSMLT over BDPT) the chains' large steps, so its
+        /// brightness error shrinks with the render's length (`integrators::mlt::normalization`).
+        /// From 0 (no such samples: the bootstrap and the large steps alone) to 0.9.
+        /// `RenderStats::normalization` reports the estimate's own standard error.
+        normalization_work_fraction: f32 = RenderSettings::DEFAULT_NORMALIZATION_WORK_FRACTION => {
+            doc: "Metropolis: share of the rays spent on samples that go on estimating the brightness (0: the bootstrap and large steps alone).",
+            flag: "normalization-fraction",
+            range: Range::closed(0.0, MLT_MAX_NORMALIZATION_WORK_FRACTION as f64),
+            rule: |_| format!("it must be from 0 to {MLT_MAX_NORMALIZATION_WORK_FRACTION}"),
+        },
+        /// Spectral transport: each camera path carries `WAVELENGTHS` (4) wavelengths drawn by
+        /// hero-wavelength sampling instead of RGB; RGB colours become smooth spectra (lights
+        /// times D65) and the film gets CIE XYZ converted to linear sRGB. Dispersive
+        /// dielectrics (`Material::abbe_number`) split light by wavelength only in this mode.
+        spectral: bool = false => {
+            doc: "Spectral transport: four wavelengths per path instead of RGB; dispersive glass splits light.",
+            flag: "spectral",
+        },
+        roulette_start_depth: u32 = 3 => {
+            doc: "Path tracing and PSSMLT: scattering vertices after which Russian roulette may end a path.",
+            flag: "roulette-start-depth",
+            range: Range::closed(0.0, MLT_MAX_DEPTH_LIMIT as f64),
+            rule: |_| format!("it must be at most {MLT_MAX_DEPTH_LIMIT}"),
+        },
+        roulette_max_survival: f32 = 0.95 => {
+            doc: "Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go on.",
+            flag: "roulette-max-survival",
+            range: Range::above(0.0, 1.0),
+            rule: |_| "it must be in (0, 1]".into(),
+        },
     }
 }
 
@@ -242,38 +378,10 @@ impl RenderSettings {
     /// The default `filter_radius`: a 15 × 15 search window.
     pub const DEFAULT_FILTER_RADIUS: u32 = 7;
 
+    /// Checks every setting against its declared range, then the rules between settings.
     pub fn validate(&self) -> Result<()> {
-        for (name, side) in [("width", self.width), ("height", self.height)] {
-            if side == 0 || side > MLT_MAX_IMAGE_SIDE {
-                return Err(Error::invalid(format!(
-                    "settings.{name} is {side}; it must be between 1 and {MLT_MAX_IMAGE_SIDE}"
-                )));
-            }
-        }
-        if self.samples_per_pixel > MLT_MAX_SAMPLES_PER_PIXEL {
-            return Err(Error::invalid(format!(
-                "settings.samples_per_pixel is {}; at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported",
-                self.samples_per_pixel
-            )));
-        }
-        if self.max_depth > MLT_MAX_DEPTH_LIMIT {
-            return Err(Error::invalid(format!(
-                "settings.max_depth is {}; at most {MLT_MAX_DEPTH_LIMIT} is supported",
-                self.max_depth
-            )));
-        }
-        if self.threads > MLT_MAX_THREADS {
-            return Err(Error::invalid(format!(
-                "settings.threads is {}; use 0 for all cores or at most {MLT_MAX_THREADS}",
-                self.threads
-            )));
-        }
+        self.check_ranges()?;
         let t = self.time_limit_seconds;
-        if !(t.is_finite() && (0.0..=MLT_MAX_TIME_LIMIT_SECONDS).contains(&t)) {
-            return Err(Error::invalid(format!(
-                "settings.time_limit_seconds is {t}; it must be 0 (no limit) or a positive number of seconds up to {MLT_MAX_TIME_LIMIT_SECONDS}"
-            )));
-        }
         if self.algorithm.is_metropolis() {
             if self.mutations_per_pixel == 0 && t == 0.0 {
                 return Err(Error::invalid(
@@ -288,104 +396,39 @@ impl RenderSettings {
                     self.mutations_per_pixel
                 )));
             }
-            if self.mutations_per_pixel > MLT_MAX_SAMPLES_PER_PIXEL {
-                return Err(Error::invalid(format!(
-                    "settings.mutations_per_pixel is {}; at most {MLT_MAX_SAMPLES_PER_PIXEL} are supported",
-                    self.mutations_per_pixel
-                )));
-            }
         } else if self.samples_per_pixel == 0 && t == 0.0 {
             return Err(Error::invalid(
                 "settings.samples_per_pixel is 0 and there is no time limit; the render would never end",
             ));
         }
-        if self.bootstrap_samples > MLT_MAX_BOOTSTRAP_SAMPLES {
-            return Err(Error::invalid(format!(
-                "settings.bootstrap_samples is {}; it must be 0 (automatic) or at most {MLT_MAX_BOOTSTRAP_SAMPLES}",
-                self.bootstrap_samples
-            )));
-        }
         let bootstrap = self.resolved_bootstrap_samples();
-        if self.chains == 0 || self.chains > bootstrap {
+        if self.chains > bootstrap {
             return Err(Error::invalid(format!(
                 "settings.chains is {}; it must be between 1 and the bootstrap samples ({bootstrap})",
                 self.chains
             )));
         }
-        let fraction = self.normalization_work_fraction;
-        if !(fraction.is_finite()
-            && (0.0..=MLT_MAX_NORMALIZATION_WORK_FRACTION).contains(&fraction))
-        {
-            return Err(Error::invalid(format!(
-                "settings.normalization_work_fraction is {fraction}; it must be from 0 to {MLT_MAX_NORMALIZATION_WORK_FRACTION}"
-            )));
-        }
-        let p = self.large_step_probability;
-        if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
-            return Err(Error::invalid(format!(
-                "settings.large_step_probability is {p}; it must be in [0, 1]"
-            )));
-        }
-        let sigma = self.small_step_sigma;
-        if !(sigma.is_finite() && sigma > 0.0 && sigma <= 1.0) {
-            return Err(Error::invalid(format!(
-                "settings.small_step_sigma is {sigma}; it must be in (0, 1]"
-            )));
-        }
-        let weights = self.mutation_weights.0;
-        if let Some((i, w)) = weights
-            .iter()
-            .enumerate()
-            .find(|&(_, &w)| !(w.is_finite() && (0.0..=1e6).contains(&w)))
-        {
-            return Err(Error::invalid(format!(
-                "settings.mutation_weights[{i}] is {w}; weights must be finite, from 0 to 1e6"
-            )));
-        }
-        if weights[0] <= 0.0 {
+        if self.mutation_weights.0[0] <= 0.0 {
             return Err(Error::invalid(
                 "settings.mutation_weights[0] (the bidirectional mutation) is 0; it must be positive, or the chains cannot reach every path",
             ));
         }
-        let length = self.erpt_chain_length;
-        if length == 0 || length > MLT_MAX_ERPT_CHAIN_LENGTH {
-            return Err(Error::invalid(format!(
-                "settings.erpt_chain_length is {length}; it must be between 1 and {MLT_MAX_ERPT_CHAIN_LENGTH}"
-            )));
-        }
-        let e_d = self.erpt_deposit_energy;
-        if !(e_d.is_finite() && (0.0..=MLT_MAX_ERPT_DEPOSIT_ENERGY).contains(&e_d)) {
-            return Err(Error::invalid(format!(
-                "settings.erpt_deposit_energy is {e_d}; it must be 0 (automatic) or a positive number up to {MLT_MAX_ERPT_DEPOSIT_ENERGY:e}"
-            )));
-        }
         let buffers = self.filter_buffers;
-        if buffers != 0 {
-            if !(MLT_MIN_FILTER_BUFFERS..=MLT_MAX_FILTER_BUFFERS).contains(&buffers) {
-                return Err(Error::invalid(format!(
-                    "settings.filter_buffers is {buffers}; it must be 0 (no filter) or from {MLT_MIN_FILTER_BUFFERS} to {MLT_MAX_FILTER_BUFFERS}"
-                )));
-            }
-            if !(self.algorithm.is_metropolis() || self.algorithm == Algorithm::Erpt) {
-                return Err(Error::invalid(format!(
-                    "settings.filter_buffers is {buffers} but the algorithm is {:?}; the filter is for Metropolis and ERPT images (set it to 0)",
-                    self.algorithm
-                )));
-            }
-        }
-        let k = self.filter_strength;
-        if !(k.is_finite() && k > 0.0 && k <= MLT_MAX_FILTER_STRENGTH) {
+        if buffers != 0 && !(self.algorithm.is_metropolis() || self.algorithm == Algorithm::Erpt) {
             return Err(Error::invalid(format!(
-                "settings.filter_strength is {k}; it must be positive, up to {MLT_MAX_FILTER_STRENGTH}"
-            )));
-        }
-        let radius = self.filter_radius;
-        if radius == 0 || radius > MLT_MAX_FILTER_RADIUS {
-            return Err(Error::invalid(format!(
-                "settings.filter_radius is {radius}; it must be from 1 to {MLT_MAX_FILTER_RADIUS} pixels"
+                "settings.filter_buffers is {buffers} but the algorithm is {:?}; the filter is for Metropolis and ERPT images (set it to 0)",
+                self.algorithm
             )));
         }
         Ok(())
+    }
+
+    /// The path tracer's Russian roulette.
+    pub(crate) fn roulette(&self) -> Roulette {
+        Roulette {
+            start_depth: self.roulette_start_depth,
+            max_survival: self.roulette_max_survival,
+        }
     }
 
     /// Floats the RGB output of this image holds, or an error if it overflows.

@@ -748,11 +748,14 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
     }
     desc.vertex_arrays().validate(vertex_count)?;
     for (i, material) in desc.materials.iter().enumerate() {
-        material.validate(i, desc.textures.len())?;
+        material
+            .validate(i, desc.textures.len())
+            .map_err(|e| e.about_material(i))?;
         if material.has_textures() && desc.texcoords.is_empty() && !desc.indices.is_empty() {
             return Err(Error::invalid(format!(
                 "desc.materials[{i}] has textures but desc.texcoords is empty; textured materials need texture coordinates"
-            )));
+            ))
+            .about_material(i));
         }
     }
     Ok(())

@@ -561,6 +561,7 @@ mod tests {
             max_depth: 5,
             min_depth: 2,
             spectral: false,
+            roulette: crate::render::RenderSettings::default().roulette(),
         };
         check_pass_points(&BdptMultiplexed(bdpt(2)), &camera);
         check_pass_points(&BdptMultiplexed(bdpt(0)), &camera);

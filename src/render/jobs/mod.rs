@@ -29,7 +29,7 @@ use crate::integrators::mlt::driver::{
     ChainStart, ChainTally, MutationCounts, MutationWeights, finish,
 };
 use crate::integrators::mlt::normalization::{Moments, NormalizationEstimate, NormalizationStats};
-use crate::render::Algorithm;
+use crate::params::{Kind, Parameters, Value};
 use crate::scene::{Camera, Scene};
 use crate::wire::{Reader, Writer};
 
@@ -449,105 +449,50 @@ fn add_stats(total: &mut RenderStats, job: &RenderStats) {
     total.mutation_counts.add(&job.mutation_counts);
 }
 
+/// Every declared setting in declaration order (`render::settings`), so a new setting is
+/// encoded with no code here.
 fn write_settings(w: &mut Writer, settings: &RenderSettings) {
-    // Destructured, so a new setting does not compile until it is written here.
-    let RenderSettings {
-        width,
-        height,
-        algorithm,
-        samples_per_pixel,
-        max_depth,
-        seed,
-        threads,
-        time_limit_seconds,
-        mutations_per_pixel,
-        bootstrap_samples,
-        chains,
-        large_step_probability,
-        small_step_sigma,
-        direct_samples_per_mutation,
-        normalization_work_fraction,
-        mutation_weights,
-        adapt_mutation_weights,
-        perturb_in_sample_space,
-        erpt_chain_length,
-        erpt_deposit_energy,
-        filter_buffers,
-        filter_strength,
-        filter_radius,
-        spectral,
-    } = *settings;
-    w.u32(width);
-    w.u32(height);
-    w.u32(algorithm as u32);
-    w.u32(samples_per_pixel);
-    w.u32(max_depth);
-    w.u64(seed);
-    w.u32(threads);
-    w.f64(time_limit_seconds);
-    w.u32(mutations_per_pixel);
-    w.u32(bootstrap_samples);
-    w.u32(chains);
-    w.f32(large_step_probability);
-    w.f32(small_step_sigma);
-    w.u32(direct_samples_per_mutation);
-    w.f32(normalization_work_fraction);
-    for weight in mutation_weights.0 {
-        w.f32(weight);
+    for p in RenderSettings::parameters() {
+        match (p.kind, settings.get(p.name).expect("a declared setting")) {
+            (Kind::U64, Value::Int(v)) => w.u64(v as u64),
+            (_, Value::Int(v)) => w.u32(v as u32),
+            (Kind::F64, Value::Float(v)) => w.f64(v),
+            (_, Value::Float(v)) => w.f32(v as f32),
+            (_, Value::Bool(v)) => w.bool(v),
+            (Kind::Choice(names), Value::Choice(name)) => w.u32(
+                names
+                    .iter()
+                    .position(|&n| n == name)
+                    .expect("a declared name") as u32,
+            ),
+            (_, Value::Choice(_)) => unreachable!("a choice's kind names its choices"),
+            (_, Value::Floats(values)) => values.into_iter().for_each(|v| w.f32(v)),
+        }
     }
-    w.bool(adapt_mutation_weights);
-    w.bool(perturb_in_sample_space);
-    w.u32(erpt_chain_length);
-    w.f32(erpt_deposit_energy);
-    w.u32(filter_buffers);
-    w.f32(filter_strength);
-    w.u32(filter_radius);
-    w.bool(spectral);
 }
 
 fn read_settings(r: &mut Reader) -> Result<RenderSettings> {
-    const ALGORITHMS: [Algorithm; 7] = [
-        Algorithm::Path,
-        Algorithm::Bdpt,
-        Algorithm::Pssmlt,
-        Algorithm::Mmlt,
-        Algorithm::PssmltBdpt,
-        Algorithm::PathSpaceMlt,
-        Algorithm::Erpt,
-    ];
-    let width = r.u32()?;
-    let height = r.u32()?;
-    let code = r.u32()?;
-    let algorithm = *ALGORITHMS
-        .iter()
-        .find(|&&a| a as u32 == code)
-        .ok_or_else(|| r.malformed("an unknown algorithm"))?;
-    Ok(RenderSettings {
-        width,
-        height,
-        algorithm,
-        samples_per_pixel: r.u32()?,
-        max_depth: r.u32()?,
-        seed: r.u64()?,
-        threads: r.u32()?,
-        time_limit_seconds: r.f64()?,
-        mutations_per_pixel: r.u32()?,
-        bootstrap_samples: r.u32()?,
-        chains: r.u32()?,
-        large_step_probability: r.f32()?,
-        small_step_sigma: r.f32()?,
-        direct_samples_per_mutation: r.u32()?,
-        normalization_work_fraction: r.f32()?,
-        mutation_weights: MutationWeights([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
-        adapt_mutation_weights: r.bool()?,
-        perturb_in_sample_space: r.bool()?,
-        erpt_chain_length: r.u32()?,
-        erpt_deposit_energy: r.f32()?,
-        filter_buffers: r.u32()?,
-        filter_strength: r.f32()?,
-        filter_radius: r.u32()?,
-        spectral: r.bool()?,
-    })
+    let mut settings = RenderSettings::default();
+    for p in RenderSettings::parameters() {
+        let value = match p.kind {
+            Kind::U32 => Value::Int(r.u32()?.into()),
+            Kind::U64 => Value::Int(r.u64()?.into()),
+            Kind::F32 => Value::Float(r.f32()?.into()),
+            Kind::F64 => Value::Float(r.f64()?),
+            Kind::Bool => Value::Bool(r.bool()?),
+            Kind::Choice(names) => {
+                let code = r.u32()?;
+                Value::Choice(
+                    names
+                        .get(code as usize)
+                        .ok_or_else(|| r.malformed(&format!("an unknown {}", p.name)))?,
+                )
+            }
+            Kind::F32x4 => Value::Floats([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
+        };
+        settings.set(p.name, value)?;
+    }
+    Ok(settings)
 }
 
 fn write_camera(w: &mut Writer, camera: &Camera) {

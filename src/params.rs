@@ -1,0 +1,459 @@
+//! Parameters declared once. A struct of parameters (the render settings) is written as one
+//! `declare_parameters!` table: each field with its type, default, valid range, the rule
+//! its error message states, a one-line doc and its command-line flag. The macro makes the
+//! struct, its `Default`, the range checks of its validation, access by name
+//! ([`Parameters::get`], [`Parameters::set`]) and the metadata ([`Parameter`]) every front end
+//! reads: the C header's struct and conversions, the C++ and Python wrappers and
+//! `docs/settings.md` are generated from it (`tests/parameters.rs` checks them and rewrites
+//! them with `MLT_BLESS=1`), the command line builds its flags from it at run time, the job
+//! plan encodes by it and the fuzz generator draws from it.
+
+use crate::error::{Error, Result};
+
+/// The type of a parameter's value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    U32,
+    U64,
+    F32,
+    F64,
+    Bool,
+    /// One of these names.
+    Choice(&'static [&'static str]),
+    /// Four floats, each in the range.
+    F32x4,
+}
+
+/// A parameter's value, as a front end passes it by name.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    /// Any integer: one outside the parameter's type is refused with its rule.
+    Int(i128),
+    Float(f64),
+    Bool(bool),
+    Choice(&'static str),
+    Floats([f32; 4]),
+}
+
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Int(v) => write!(f, "{v}"),
+            Value::Float(v) => write!(f, "{v}"),
+            Value::Bool(v) => write!(f, "{v}"),
+            Value::Choice(v) => write!(f, "{v}"),
+            Value::Floats([a, b, c, d]) => write!(f, "{a},{b},{c},{d}"),
+        }
+    }
+}
+
+/// The values a numeric parameter accepts: `[min, max]` (or `(min, max]`), plus `off`, a
+/// value outside it with a meaning of its own (0: "automatic", "no limit", "no filter").
+/// NaN and infinities are never inside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    pub min: f64,
+    pub max: f64,
+    /// `min` itself is outside.
+    pub min_exclusive: bool,
+    pub off: Option<f64>,
+}
+
+impl Range {
+    /// `[min, max]`.
+    pub const fn closed(min: f64, max: f64) -> Range {
+        Range {
+            min,
+            max,
+            min_exclusive: false,
+            off: None,
+        }
+    }
+    /// `(min, max]`.
+    pub const fn above(min: f64, max: f64) -> Range {
+        Range {
+            min_exclusive: true,
+            ..Range::closed(min, max)
+        }
+    }
+    /// The range, plus `off`.
+    pub const fn or(self, off: f64) -> Range {
+        Range {
+            off: Some(off),
+            ..self
+        }
+    }
+    pub fn contains(&self, x: f64) -> bool {
+        let above_min = if self.min_exclusive {
+            x > self.min
+        } else {
+            x >= self.min
+        };
+        self.off == Some(x) || (above_min && x <= self.max)
+    }
+}
+
+/// What is known of one parameter of the struct `S`.
+pub struct Parameter<S> {
+    /// The field's name: the C field, C++ member, Python keyword and `set`/`get` name.
+    pub name: &'static str,
+    pub kind: Kind,
+    /// One line, for `--help`, the docs table and the headers.
+    pub doc: &'static str,
+    /// The command-line flag, without `--`.
+    pub flag: &'static str,
+    pub default: fn() -> Value,
+    /// The values it accepts; `None`: every value of its kind.
+    pub range: Option<Range>,
+    /// What an out-of-range value's message says after `"<prefix>.<name> is <value>; "`.
+    pub rule: Option<fn(&S) -> String>,
+}
+
+impl<S> Parameter<S> {
+    /// A value of its kind outside its range, if it has one: what tests give every front
+    /// end to see that each refuses it with the same message, and the fuzz generator's
+    /// mistakes.
+    pub fn outside_value(&self) -> Option<Value> {
+        let range = self.range?;
+        let below = if range.min_exclusive {
+            Some(range.min)
+        } else if range.min >= 1.0 && range.off != Some(range.min - 1.0) {
+            Some(range.min - 1.0)
+        } else {
+            None
+        };
+        let bad = below.unwrap_or(match self.kind {
+            Kind::U32 | Kind::U64 => range.max + 1.0,
+            _ => range.max * 2.0,
+        });
+        Some(match self.kind {
+            Kind::U32 | Kind::U64 => Value::Int(bad as i128),
+            Kind::F32 | Kind::F64 => Value::Float(bad),
+            Kind::F32x4 => match (self.default)() {
+                Value::Floats([_, rest @ ..]) => {
+                    let [b, c, d] = rest;
+                    Value::Floats([bad as f32, b, c, d])
+                }
+                _ => Value::Floats([bad as f32; 4]),
+            },
+            Kind::Bool | Kind::Choice(_) => return None,
+        })
+    }
+}
+
+/// A struct made by `declare_parameters!`.
+pub trait Parameters: Default + Sized + 'static {
+    /// What messages name the struct by: `settings` in `settings.width is 0; …`.
+    const PREFIX: &'static str;
+    /// Every parameter, in declaration order (the C struct's field order).
+    fn parameters() -> &'static [Parameter<Self>];
+    /// The value of the parameter `name`, or `None` if there is none of that name.
+    fn get(&self, name: &str) -> Option<Value>;
+    /// Sets the parameter `name`: an unknown name, a value of another kind or an integer
+    /// its type cannot hold is refused with a message. The range is checked later, by the
+    /// struct's validation.
+    fn set(&mut self, name: &str, value: Value) -> Result<()>;
+    /// The parameter called `name`.
+    fn parameter(name: &str) -> Option<&'static Parameter<Self>> {
+        Self::parameters().iter().find(|p| p.name == name)
+    }
+}
+
+/// Why a [`Value`] is not one of a type.
+#[doc(hidden)]
+pub enum Unfit {
+    Kind,
+    /// An integer outside the type.
+    Domain,
+}
+
+/// A Rust type a parameter may have.
+pub trait ParameterType: Copy {
+    const KIND: Kind;
+    fn to_value(self) -> Value;
+    #[doc(hidden)]
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit>;
+    /// The first value outside `range` (with its index, for arrays), as messages print it.
+    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)>;
+}
+
+macro_rules! integer_parameter {
+    ($($ty:ty => $kind:ident),*) => {$(
+        impl ParameterType for $ty {
+            const KIND: Kind = Kind::$kind;
+            fn to_value(self) -> Value {
+                Value::Int(self as i128)
+            }
+            fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+                match value {
+                    Value::Int(v) => <$ty>::try_from(v).map_err(|_| Unfit::Domain),
+                    _ => Err(Unfit::Kind),
+                }
+            }
+            fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
+                (!range.contains(*self as f64)).then(|| (None, self.to_string()))
+            }
+        }
+    )*};
+}
+integer_parameter!(u32 => U32, u64 => U64);
+
+macro_rules! float_parameter {
+    ($($ty:ty => $kind:ident),*) => {$(
+        impl ParameterType for $ty {
+            const KIND: Kind = Kind::$kind;
+            fn to_value(self) -> Value {
+                Value::Float(self as f64)
+            }
+            fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+                match value {
+                    Value::Float(v) => Ok(v as $ty),
+                    Value::Int(v) => Ok(v as $ty),
+                    _ => Err(Unfit::Kind),
+                }
+            }
+            fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
+                (!range.contains(*self as f64)).then(|| (None, self.to_string()))
+            }
+        }
+    )*};
+}
+float_parameter!(f32 => F32, f64 => F64);
+
+impl ParameterType for bool {
+    const KIND: Kind = Kind::Bool;
+    fn to_value(self) -> Value {
+        Value::Bool(self)
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        match value {
+            Value::Bool(v) => Ok(v),
+            _ => Err(Unfit::Kind),
+        }
+    }
+    fn outside(&self, _: &Range) -> Option<(Option<usize>, String)> {
+        None
+    }
+}
+
+impl ParameterType for [f32; 4] {
+    const KIND: Kind = Kind::F32x4;
+    fn to_value(self) -> Value {
+        Value::Floats(self)
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        match value {
+            Value::Floats(v) => Ok(v),
+            _ => Err(Unfit::Kind),
+        }
+    }
+    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
+        self.iter()
+            .enumerate()
+            .find(|(_, w)| !range.contains(**w as f64))
+            .map(|(i, w)| (Some(i), w.to_string()))
+    }
+}
+
+/// A parameter whose value is one of a few names (an enum): `NAMES[i]` is `ALL[i]`'s.
+pub trait ChoiceParameter: Copy + PartialEq + 'static {
+    const NAMES: &'static [&'static str];
+    const ALL: &'static [Self];
+    fn name(self) -> &'static str {
+        let i = Self::ALL.iter().position(|&v| v == self);
+        Self::NAMES[i.expect("ALL holds every value")]
+    }
+    /// The value of `name` (case, and `-` against `_`, do not matter).
+    fn from_name(name: &str) -> Option<Self> {
+        let canonical = |c: char| match c {
+            '_' => '-',
+            c => c.to_ascii_lowercase(),
+        };
+        Self::NAMES
+            .iter()
+            .position(|n| n.len() == name.len() && n.chars().eq(name.chars().map(canonical)))
+            .map(|i| Self::ALL[i])
+    }
+}
+
+impl<T: ChoiceParameter> ParameterType for T {
+    const KIND: Kind = Kind::Choice(T::NAMES);
+    fn to_value(self) -> Value {
+        Value::Choice(self.name())
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        match value {
+            Value::Choice(name) => T::from_name(name).ok_or(Unfit::Domain),
+            _ => Err(Unfit::Kind),
+        }
+    }
+    fn outside(&self, _: &Range) -> Option<(Option<usize>, String)> {
+        None
+    }
+}
+
+/// Checks one field against its range, with the message every front end shows.
+#[doc(hidden)]
+pub fn check<S, T: ParameterType>(
+    settings: &S,
+    prefix: &str,
+    name: &str,
+    value: T,
+    range: Range,
+    rule: fn(&S) -> String,
+) -> Result<()> {
+    match value.outside(&range) {
+        None => Ok(()),
+        Some((index, shown)) => {
+            let index = index.map_or_else(String::new, |i| format!("[{i}]"));
+            Err(Error::invalid(format!(
+                "{prefix}.{name}{index} is {shown}; {}",
+                rule(settings)
+            )))
+        }
+    }
+}
+
+/// Converts a value given by name to the field's type, or the message that refuses it.
+#[doc(hidden)]
+pub fn convert<S, T: ParameterType>(
+    settings: &S,
+    prefix: &str,
+    name: &str,
+    value: Value,
+    rule: Option<fn(&S) -> String>,
+) -> Result<T> {
+    T::from_value(value).map_err(|unfit| match (unfit, rule) {
+        (Unfit::Domain, Some(rule)) => {
+            Error::invalid(format!("{prefix}.{name} is {value}; {}", rule(settings)))
+        }
+        (Unfit::Domain, None) => match T::KIND {
+            Kind::Choice(names) => Error::invalid(format!(
+                "{prefix}.{name} is {value:?}; expected one of {}",
+                names
+                    .iter()
+                    .map(|n| format!("{n:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+            _ => Error::invalid(format!("{prefix}.{name} is {value}; out of its type")),
+        },
+        (Unfit::Kind, _) => Error::invalid(format!(
+            "{prefix}.{name} is {value}; it takes {}",
+            kind_noun(T::KIND)
+        )),
+    })
+}
+
+/// "an integer", "a number", … for messages.
+pub fn kind_noun(kind: Kind) -> &'static str {
+    match kind {
+        Kind::U32 | Kind::U64 => "an integer",
+        Kind::F32 | Kind::F64 => "a number",
+        Kind::Bool => "a boolean",
+        Kind::Choice(_) => "one of its names",
+        Kind::F32x4 => "four numbers",
+    }
+}
+
+/// Declares a struct of parameters (see the module's documentation). Each field:
+///
+/// ```text
+/// /// Rust documentation of the field.
+/// name: Type = default {
+///     doc: "One line.",
+///     flag: "command-line-flag",
+///     // Optional, for numbers: the values it accepts and the message's rule.
+///     range: Range::closed(1.0, 8.0),
+///     rule: |settings| format!("it must be between 1 and 8"),
+/// },
+/// ```
+macro_rules! declare_parameters {
+    (
+        $(#[$struct_attr:meta])*
+        pub struct $Struct:ident in $prefix:literal {
+            $(
+                $(#[$attr:meta])*
+                $name:ident: $ty:ty = $default:expr => {
+                    doc: $doc:literal,
+                    flag: $flag:literal,
+                    $(range: $range:expr, rule: $rule:expr,)?
+                }
+            ),* $(,)?
+        }
+    ) => {
+        $(#[$struct_attr])*
+        pub struct $Struct {
+            $( $(#[$attr])* pub $name: $ty, )*
+        }
+
+        impl Default for $Struct {
+            fn default() -> Self {
+                $Struct { $( $name: $default, )* }
+            }
+        }
+
+        impl $Struct {
+            /// Checks every field against its declared range, in declaration order.
+            fn check_ranges(&self) -> $crate::error::Result<()> {
+                $($({
+                    let rule: fn(&Self) -> String = $rule;
+                    $crate::params::check(self, $prefix, stringify!($name), self.$name, $range, rule)?;
+                })?)*
+                Ok(())
+            }
+        }
+
+        impl $crate::params::Parameters for $Struct {
+            const PREFIX: &'static str = $prefix;
+            fn parameters() -> &'static [$crate::params::Parameter<Self>] {
+                static PARAMETERS: &[$crate::params::Parameter<$Struct>] = &[$(
+                    $crate::params::Parameter {
+                        name: stringify!($name),
+                        kind: <$ty as $crate::params::ParameterType>::KIND,
+                        doc: $doc,
+                        flag: $flag,
+                        default: || {
+                            <$ty as $crate::params::ParameterType>::to_value($default)
+                        },
+                        range: {
+                            #[allow(unused_variables)]
+                            let range: Option<$crate::params::Range> = None;
+                            $( let range = Some($range); )?
+                            range
+                        },
+                        rule: {
+                            #[allow(unused_variables)]
+                            let rule: Option<fn(&$Struct) -> String> = None;
+                            $( let rule: Option<fn(&$Struct) -> String> = Some($rule); )?
+                            rule
+                        },
+                    },
+                )*];
+                PARAMETERS
+            }
+            fn get(&self, name: &str) -> Option<$crate::params::Value> {
+                match name {
+                    $( stringify!($name) => {
+                        Some($crate::params::ParameterType::to_value(self.$name))
+                    } )*
+                    _ => None,
+                }
+            }
+            fn set(&mut self, name: &str, value: $crate::params::Value) -> $crate::error::Result<()> {
+                match name {
+                    $( stringify!($name) => {
+                        let rule = <Self as $crate::params::Parameters>::parameter(name)
+                            .and_then(|p| p.rule);
+                        self.$name = $crate::params::convert(self, $prefix, name, value, rule)?;
+                        Ok(())
+                    } )*
+                    _ => Err($crate::error::Error::invalid(format!(
+                        "{} has no parameter {name:?}", $prefix
+                    ))),
+                }
+            }
+        }
+    };
+}
+pub(crate) use declare_parameters;
