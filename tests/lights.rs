@@ -6,6 +6,8 @@
 //! small window) and the Cornell box lit by a spot light and the sun through its open
 //! front. Tolerances come from the spread of independent renders (Student's t with their
 //! degrees of freedom), and each check also asserts that a 2% brightness error would fail.
+//!
+//! Runs in about 64 s on 2 cores (`cargo test --test lights`).
 
 mod common {
     pub mod obj_text;
