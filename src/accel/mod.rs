@@ -19,7 +19,7 @@ pub mod embree;
 mod ray;
 
 pub use bvh::BvhAccel;
-#[doc(hidden)]
+#[cfg(any(test, feature = "internals"))]
 pub use bvh::{BvhWidth, with_bvh_width};
 #[cfg(feature = "embree")]
 pub use embree::EmbreeAccel;

@@ -90,7 +90,7 @@ thread_local! {
 
 /// Runs `f` with the BVHs built on this thread `width` wide (if the CPU supports it) instead
 /// of the widest it supports: for tests and benches of the fallback.
-#[doc(hidden)]
+#[cfg(any(test, feature = "internals"))]
 pub fn with_bvh_width<R>(width: BvhWidth, f: impl FnOnce() -> R) -> R {
     struct Restore(Option<BvhWidth>);
     impl Drop for Restore {
