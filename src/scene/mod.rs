@@ -23,7 +23,13 @@ use crate::texture::{Texture, TextureDesc};
 use glam::Vec3A;
 
 /// A ray query a render made, with the answer it got (see `Scene::record_queries`).
-#[doc(hidden)]
+#[cfg_attr(
+    not(any(test, feature = "internals")),
+    expect(
+        dead_code,
+        reason = "the recording is read by the overhead bench and its test"
+    )
+)]
 #[derive(Clone, Copy, Debug)]
 pub enum RecordedQuery {
     /// A closest-hit query (`Accel::intersect`).
@@ -522,7 +528,7 @@ impl Scene {
     /// each); renders without a recording pay nothing. Queries from several threads are
     /// recorded in the order they take the lock. For the overhead bench
     /// (`benches/overhead.rs`), which replays a render's rays through `accel`.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn record_queries(&mut self) {
         self.recording = Some(Box::default());
         self.slow_queries = true;
@@ -530,7 +536,7 @@ impl Scene {
 
     /// Stops the recording `record_queries` started and returns its queries in order (empty
     /// when none was on).
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn take_recorded_queries(&mut self) -> Vec<RecordedQuery> {
         self.slow_queries = self.has_cutouts;
         self.recording
@@ -545,14 +551,14 @@ impl Scene {
 
     /// The acceleration structure renders query (`Accel::intersect` and `Accel::occluded`
     /// directly, in a scene without alpha cut-outs), in internal triangle ids.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn accel(&self) -> &Accel {
         &self.accel
     }
 
     /// Whether some material is an alpha cut-out: then queries are filtered, and a replay
     /// through `accel`'s unfiltered queries would not answer as renders did.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn has_cutouts(&self) -> bool {
         self.has_cutouts
     }

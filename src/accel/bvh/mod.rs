@@ -165,8 +165,7 @@ impl BvhAccel {
 
     /// Built 8-wide (or as wide as the CPU supports) over Embree's own binary SAH tree
     /// instead of obvhs's: the traversal bench's diagnostic of tree against traversal.
-    #[cfg(feature = "embree")]
-    #[doc(hidden)]
+    #[cfg(all(feature = "embree", any(test, feature = "internals")))]
     pub fn build_over_embree_tree(vertices: &[[Vec3A; 3]]) -> Result<Self> {
         fn over<const W: usize, N: layout::WideNode<W> + Copy + Send>(
             vertices: &[[Vec3A; 3]],
@@ -188,7 +187,7 @@ impl BvhAccel {
     }
 
     /// Children per node.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn width(&self) -> BvhWidth {
         match self.tree {
             Tree::Four(_) => BvhWidth::Four,
