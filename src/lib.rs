@@ -1,8 +1,21 @@
 //! # mlt — an embeddable Metropolis Light Transport kernel
 //!
-//! Hand it triangles, materials and a camera; get back a linear HDR image. The Rust API is
-//! [`Scene::new`] and [`render()`]; C and C++ hosts use the same kernel through `include/mlt.h`
-//! (see [`capi`]).
+//! Hand it triangles, materials and a camera; get back a linear HDR image. C and C++ hosts use
+//! the same kernel through `include/mlt.h` (the exports are in [`capi`]).
+//!
+//! The Rust API is what the crate root exports, plus three modules:
+//! - the scene: a [`SceneDesc`] (positions, indices, [`Material`]s, [`TextureDesc`]s,
+//!   [`LightsDesc`] with its [`EnvironmentDesc`], [`SunDesc`] and [`PunctualLight`]s) that
+//!   [`Scene::new`] validates and builds;
+//! - the render: a [`Camera`] and [`RenderSettings`] (an [`Algorithm`], its
+//!   [`MutationWeights`], …) that [`render()`] turns into an image and [`RenderStats`] (with
+//!   [`NormalizationStats`], [`FilterStats`], a [`StopReason`]);
+//! - [`jobs`]: a render planned, split into jobs for many machines and merged;
+//! - [`error`]: the [`Error`] every call returns, with the [`MltStatus`] C hosts get;
+//! - `io` (the `cli` feature, on by default): scene files, camera files, images.
+//!
+//! The `internals` feature makes the kernel's modules public for this crate's tests, benches
+//! and fuzz targets; they are not part of the API and change without notice.
 //!
 //! ```
 //! use mlt::{Camera, Material, RenderSettings, Scene, SceneDesc};

@@ -115,7 +115,7 @@ pub struct SceneInfo {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     /// The acceleration structure's build quality, the bytes it holds
-    /// ([`Accel::memory_bytes`]) and the seconds its build took.
+    /// (`Accel::memory_bytes`) and the seconds its build took.
     pub build_quality: BuildQuality,
     pub accel_memory_bytes: usize,
     pub accel_build_seconds: f64,
@@ -660,6 +660,8 @@ impl Scene {
     }
 
     /// Closest hit in the host's triangle ids, through alpha cut-outs; `None` on a miss.
+    /// Hidden: `Ray` and `Hit` are internal (C hosts call `mlt_intersect`).
+    #[doc(hidden)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.closest_hit(ray).map(|hit| Hit {
             triangle: self.internal_to_input[hit.triangle as usize],
@@ -668,7 +670,8 @@ impl Scene {
     }
 
     /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax], through
-    /// alpha cut-outs.
+    /// alpha cut-outs. Hidden, as `intersect`.
+    #[doc(hidden)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.blocked(ray)
     }
