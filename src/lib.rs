@@ -15,7 +15,7 @@
 //! - `io` (the `cli` feature, on by default): scene files, camera files, images.
 //!
 //! The `internals` feature makes the kernel's modules public for this crate's tests, benches
-//! and fuzz targets; they are not part of the API and change without notice.
+//! and examples; they are not part of the API and change without notice.
 //!
 //! ```
 //! use mlt::{Camera, Material, RenderSettings, Scene, SceneDesc};
@@ -42,8 +42,8 @@
 
 // The kernel's internals are crate-private. The `internals` feature (unstable, for this
 // crate's tests, benches and examples) makes some of them public and hides them from the
-// docs; cbindgen reads the private declaration only (it skips `cbindgen:ignore`), so the
-// header's constants are found once.
+// docs. cbindgen reads the private declaration only (it skips `cbindgen:ignore`), so it finds
+// the header's constants once.
 #[cfg(feature = "internals")]
 #[doc(hidden)]
 /// cbindgen:ignore
