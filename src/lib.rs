@@ -3,13 +3,15 @@
 //! Hand it triangles, materials and a camera; get back a linear HDR image. C and C++ hosts use
 //! the same kernel through `include/mlt.h` (the exports are in [`capi`]).
 //!
-//! The Rust API is what the crate root exports, plus three modules:
+//! The Rust API is what the crate root exports:
 //! - the scene: a [`SceneDesc`] (positions, indices, [`Material`]s, [`TextureDesc`]s,
 //!   [`LightsDesc`] with its [`EnvironmentDesc`], [`SunDesc`] and [`PunctualLight`]s) that
 //!   [`Scene::new`] validates and builds;
 //! - the render: a [`Camera`] and [`RenderSettings`] (an [`Algorithm`], its
 //!   [`MutationWeights`], …) that [`render()`] turns into an image and [`RenderStats`] (with
 //!   [`NormalizationStats`], [`FilterStats`], a [`StopReason`]);
+//! - [`params`]: the settings by name, with each one's type, default, range and doc (what
+//!   the command line and the Python package are built from);
 //! - [`jobs`]: a render planned, split into jobs for many machines and merged;
 //! - [`error`]: the [`Error`] every call returns, with the [`MltStatus`] C hosts get;
 //! - `io` (the `cli` feature, on by default): scene files, camera files, images.
