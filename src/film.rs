@@ -149,7 +149,6 @@ pub struct Film {
 /// A horizontal band of rows, the unit of parallel work: its pixels are contiguous.
 pub struct FilmBand<'a> {
     pub first_row: u32,
-    pub width: u32,
     units: FixedPoint,
     sums: &'a mut [FixedRgb],
     counts: &'a mut [u32],
@@ -157,12 +156,8 @@ pub struct FilmBand<'a> {
 
 impl FilmBand<'_> {
     /// The band's pixels.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.counts.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.counts.is_empty()
     }
 
     /// Adds the sum of `count` samples to the band's pixel `i`.
@@ -372,7 +367,6 @@ impl Film {
             .enumerate()
             .map(move |(band, (sums, counts))| FilmBand {
                 first_row: band as u32 * rows,
-                width,
                 units,
                 sums,
                 counts,

@@ -1,8 +1,23 @@
 //! # mlt — an embeddable Metropolis Light Transport kernel
 //!
-//! Hand it triangles, materials and a camera; get back a linear HDR image. The Rust API is
-//! [`Scene::new`] and [`render()`]; C and C++ hosts use the same kernel through `include/mlt.h`
-//! (see [`capi`]).
+//! Hand it triangles, materials and a camera; get back a linear HDR image. C and C++ hosts use
+//! the same kernel through `include/mlt.h` (the exports are in [`capi`]).
+//!
+//! The Rust API is what the crate root exports:
+//! - the scene: a [`SceneDesc`] (positions, indices, [`Material`]s, [`TextureDesc`]s,
+//!   [`LightsDesc`] with its [`EnvironmentDesc`], [`SunDesc`] and [`PunctualLight`]s) that
+//!   [`Scene::new`] validates and builds;
+//! - the render: a [`Camera`] and [`RenderSettings`] (an [`Algorithm`], its
+//!   [`MutationWeights`], …) that [`render()`] turns into an image and [`RenderStats`] (with
+//!   [`NormalizationStats`], [`FilterStats`], a [`StopReason`]);
+//! - [`params`]: the settings by name, with each one's type, default, range and doc (what
+//!   the command line and the Python package are built from);
+//! - [`jobs`]: a render planned, split into jobs for many machines and merged;
+//! - [`error`]: the [`Error`] every call returns, with the [`MltStatus`] C hosts get;
+//! - `io` (the `cli` feature, on by default): scene files, camera files, images.
+//!
+//! The `internals` feature makes the kernel's modules public for this crate's tests, benches
+//! and examples; they are not part of the API and change without notice.
 //!
 //! ```
 //! use mlt::{Camera, Material, RenderSettings, Scene, SceneDesc};
@@ -27,21 +42,65 @@
 //! assert!((image[(4 * 8 + 4) * 3] - 1.0).abs() < 1e-6);
 //! ```
 
+// The kernel's internals are crate-private. The `internals` feature (unstable, for this
+// crate's tests, benches and examples) makes some of them public and hides them from the
+// docs. cbindgen reads the private declaration only (it skips `cbindgen:ignore`), so it finds
+// the header's constants once.
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod accel;
+#[cfg(not(feature = "internals"))]
+mod accel;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod bsdf;
+#[cfg(not(feature = "internals"))]
+mod bsdf;
 pub mod capi;
 mod control;
 pub mod error;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod film;
-pub mod filter;
+#[cfg(not(feature = "internals"))]
+mod film;
+mod filter;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod integrators;
+#[cfg(not(feature = "internals"))]
+mod integrators;
 mod interaction;
 pub mod params;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod render;
+#[cfg(not(feature = "internals"))]
+mod render;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod sampling;
+#[cfg(not(feature = "internals"))]
+mod sampling;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod scene;
+#[cfg(not(feature = "internals"))]
+mod scene;
 mod spectral;
+#[cfg(feature = "internals")]
+#[doc(hidden)]
+/// cbindgen:ignore
 pub mod spectrum;
+#[cfg(not(feature = "internals"))]
+mod spectrum;
 mod texture;
 mod wire;
 
@@ -50,15 +109,22 @@ pub mod io;
 
 pub use accel::{Backend, BuildQuality};
 pub use error::{Error, MltStatus, Result};
-pub use filter::FilterStats;
+pub use filter::{
+    FilterStats, MLT_MAX_FILTER_BUFFERS, MLT_MAX_FILTER_RADIUS, MLT_MAX_FILTER_STRENGTH,
+    MLT_MIN_FILTER_BUFFERS,
+};
 pub use integrators::mlt::driver::{Mutation, MutationCounts, MutationWeights};
 pub use integrators::mlt::normalization::NormalizationStats;
 pub use render::jobs;
 pub use render::{
-    Algorithm, RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
+    Algorithm, MLT_MAX_BOOTSTRAP_SAMPLES, MLT_MAX_DEPTH_LIMIT, MLT_MAX_ERPT_CHAIN_LENGTH,
+    MLT_MAX_ERPT_DEPOSIT_ENERGY, MLT_MAX_IMAGE_SIDE, MLT_MAX_NORMALIZATION_WORK_FRACTION,
+    MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS, MLT_MAX_TIME_LIMIT_SECONDS, Progress,
+    RenderSettings, RenderStats, StopReason, render, render_with_unfiltered,
 };
 pub use scene::{
-    AlphaMode, Camera, EnvironmentDesc, LightsDesc, Material, MaterialKind, PunctualLight,
+    AlphaMode, Camera, EnvironmentDesc, LightsDesc, MLT_MAX_ENVIRONMENT_SIDE,
+    MLT_MAX_ENVIRONMENT_TEXELS, MLT_MAX_PUNCTUAL_LIGHTS, Material, MaterialKind, PunctualLight,
     PunctualLightKind, Scene, SceneDesc, SceneInfo, SunDesc, TextureRef,
 };
 pub use spectral::white_light_srgb_per_nm;

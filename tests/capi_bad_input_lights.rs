@@ -13,7 +13,7 @@ mod common {
 use common::capi::*;
 use mlt::capi::*;
 use mlt::error::*;
-use mlt::scene::{MLT_MAX_ENVIRONMENT_SIDE, MLT_MAX_PUNCTUAL_LIGHTS};
+use mlt::{MLT_MAX_ENVIRONMENT_SIDE, MLT_MAX_PUNCTUAL_LIGHTS};
 use std::ptr::{null, null_mut};
 
 /// A scene with every kind of light: `HostScene::floor_and_light` under a 2 × 1

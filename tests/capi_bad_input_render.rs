@@ -13,7 +13,7 @@ mod common {
 use common::capi::*;
 use mlt::capi::*;
 use mlt::error::*;
-use mlt::render::{
+use mlt::{
     MLT_MAX_DEPTH_LIMIT, MLT_MAX_ERPT_CHAIN_LENGTH, MLT_MAX_IMAGE_SIDE, MLT_MAX_SAMPLES_PER_PIXEL,
     MLT_MAX_THREADS, MLT_MAX_TIME_LIMIT_SECONDS,
 };

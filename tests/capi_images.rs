@@ -122,12 +122,12 @@ fn a_quad_under_a_point_light_follows_the_inverse_square_law() {
     let image = render_lit(&desc, &camera, &small_settings(width, height, 16));
     assert_valid_image(&image, "point-lit quad");
 
-    let model = mlt::scene::Camera {
+    let model = mlt::Camera {
         eye: camera.eye,
         target: camera.target,
         up: camera.up,
         fov_y_deg: camera.fov_y_deg,
-        ..mlt::scene::Camera::default()
+        ..mlt::Camera::default()
     }
     .model(width, height);
     let radiance_at = |x: f32, y: f32| -> f64 {

@@ -19,7 +19,7 @@ use common::capi::{
 use mlt::capi::*;
 use mlt::error::*;
 use mlt::jobs::MLT_MAX_JOBS;
-use mlt::render::{MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS};
+use mlt::{MLT_MAX_SAMPLES_PER_PIXEL, MLT_MAX_THREADS};
 use std::ffi::c_void;
 use std::ptr::{null, null_mut};
 

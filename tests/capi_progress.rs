@@ -12,9 +12,9 @@ mod common {
 }
 
 use common::capi::*;
+use mlt::MLT_MAX_SAMPLES_PER_PIXEL;
 use mlt::capi::*;
 use mlt::error::*;
-use mlt::render::MLT_MAX_SAMPLES_PER_PIXEL;
 use std::ffi::c_void;
 use std::ptr::null_mut;
 

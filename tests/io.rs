@@ -977,7 +977,7 @@ fn assert_close(got: [f32; 3], expected: [f32; 3], what: &str) {
 /// intensities `color × intensity / 683` (candela and lux to W/sr and W/m²).
 #[test]
 fn gltf_punctual_lights_are_placed_by_the_node_hierarchy() {
-    use mlt::scene::PunctualLightKind;
+    use mlt::PunctualLightKind;
     let data = io::load_scene(&scenes().join("lights-punctual.gltf")).unwrap();
     let lights = &data.punctual_lights;
     assert_eq!(lights.len(), 4, "{lights:?}");

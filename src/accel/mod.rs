@@ -19,7 +19,7 @@ pub mod embree;
 mod ray;
 
 pub use bvh::BvhAccel;
-#[doc(hidden)]
+#[cfg(any(test, feature = "internals"))]
 pub use bvh::{BvhWidth, with_bvh_width};
 #[cfg(feature = "embree")]
 pub use embree::EmbreeAccel;
@@ -50,9 +50,9 @@ impl Backend {
 }
 
 /// How much work the build spends for faster rays, as Embree's build qualities. Every quality
-/// answers the same queries (the agreement of [`Accel`]'s contract); only the speeds and the
+/// answers the same queries (the agreement of `Accel`'s contract); only the speeds and the
 /// memory differ. The traversal bench (`benches/traversal.rs`) reports build time, memory and
-/// ray rates per quality; README "Benchmarks" has the figures.
+/// ray rates per quality; docs/benchmarks.md has the figures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BuildQuality {
     /// The quickest build, for scenes rebuilt often (an editor's preview, a baking tool's

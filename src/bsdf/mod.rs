@@ -15,7 +15,6 @@ mod microfacet;
 mod multiple_scattering;
 mod scattering;
 
-pub use dielectric::fresnel_dielectric;
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};

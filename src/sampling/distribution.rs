@@ -46,17 +46,8 @@ impl Distribution1D {
         }
     }
 
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.weights.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.weights.is_empty()
-    }
-
-    /// Sum of the weights it was built from.
-    pub fn total(&self) -> f32 {
-        self.total
     }
 
     /// Probability of choosing bin `i` when sampling discretely.

@@ -80,7 +80,7 @@ impl OrthonormalBasis {
     }
 
     #[inline]
-    pub fn to_world(&self, v: Vec3A) -> Vec3A {
+    pub fn to_world(self, v: Vec3A) -> Vec3A {
         self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
     }
 }

@@ -120,7 +120,9 @@ impl Camera {
         Ok(())
     }
 
-    /// The frame for an image of `width` × `height` pixels. Call `validate` first.
+    /// The frame for an image of `width` × `height` pixels. Call `validate` first. Hidden:
+    /// `CameraModel` is internal.
+    #[doc(hidden)]
     pub fn model(&self, width: u32, height: u32) -> CameraModel {
         let eye = Vec3A::from(self.eye);
         let view = Vec3A::from(self.target) - eye;

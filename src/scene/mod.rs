@@ -23,7 +23,13 @@ use crate::texture::{Texture, TextureDesc};
 use glam::Vec3A;
 
 /// A ray query a render made, with the answer it got (see `Scene::record_queries`).
-#[doc(hidden)]
+#[cfg_attr(
+    not(any(test, feature = "internals")),
+    expect(
+        dead_code,
+        reason = "the recording is read by the overhead bench and its test"
+    )
+)]
 #[derive(Clone, Copy, Debug)]
 pub enum RecordedQuery {
     /// A closest-hit query (`Accel::intersect`).
@@ -109,7 +115,7 @@ pub struct SceneInfo {
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
     /// The acceleration structure's build quality, the bytes it holds
-    /// ([`Accel::memory_bytes`]) and the seconds its build took.
+    /// (`Accel::memory_bytes`) and the seconds its build took.
     pub build_quality: BuildQuality,
     pub accel_memory_bytes: usize,
     pub accel_build_seconds: f64,
@@ -522,7 +528,7 @@ impl Scene {
     /// each); renders without a recording pay nothing. Queries from several threads are
     /// recorded in the order they take the lock. For the overhead bench
     /// (`benches/overhead.rs`), which replays a render's rays through `accel`.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn record_queries(&mut self) {
         self.recording = Some(Box::default());
         self.slow_queries = true;
@@ -530,7 +536,7 @@ impl Scene {
 
     /// Stops the recording `record_queries` started and returns its queries in order (empty
     /// when none was on).
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn take_recorded_queries(&mut self) -> Vec<RecordedQuery> {
         self.slow_queries = self.has_cutouts;
         self.recording
@@ -545,14 +551,14 @@ impl Scene {
 
     /// The acceleration structure renders query (`Accel::intersect` and `Accel::occluded`
     /// directly, in a scene without alpha cut-outs), in internal triangle ids.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn accel(&self) -> &Accel {
         &self.accel
     }
 
     /// Whether some material is an alpha cut-out: then queries are filtered, and a replay
     /// through `accel`'s unfiltered queries would not answer as renders did.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn has_cutouts(&self) -> bool {
         self.has_cutouts
     }
@@ -654,6 +660,8 @@ impl Scene {
     }
 
     /// Closest hit in the host's triangle ids, through alpha cut-outs; `None` on a miss.
+    /// Hidden: `Ray` and `Hit` are internal (C hosts call `mlt_intersect`).
+    #[doc(hidden)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.closest_hit(ray).map(|hit| Hit {
             triangle: self.internal_to_input[hit.triangle as usize],
@@ -662,7 +670,8 @@ impl Scene {
     }
 
     /// Whether any non-degenerate triangle lies on the ray within [tmin, tmax], through
-    /// alpha cut-outs.
+    /// alpha cut-outs. Hidden, as `intersect`.
+    #[doc(hidden)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.blocked(ray)
     }

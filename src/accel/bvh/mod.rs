@@ -90,7 +90,7 @@ thread_local! {
 
 /// Runs `f` with the BVHs built on this thread `width` wide (if the CPU supports it) instead
 /// of the widest it supports: for tests and benches of the fallback.
-#[doc(hidden)]
+#[cfg(any(test, feature = "internals"))]
 pub fn with_bvh_width<R>(width: BvhWidth, f: impl FnOnce() -> R) -> R {
     struct Restore(Option<BvhWidth>);
     impl Drop for Restore {
@@ -165,8 +165,7 @@ impl BvhAccel {
 
     /// Built 8-wide (or as wide as the CPU supports) over Embree's own binary SAH tree
     /// instead of obvhs's: the traversal bench's diagnostic of tree against traversal.
-    #[cfg(feature = "embree")]
-    #[doc(hidden)]
+    #[cfg(all(feature = "embree", any(test, feature = "internals")))]
     pub fn build_over_embree_tree(vertices: &[[Vec3A; 3]]) -> Result<Self> {
         fn over<const W: usize, N: layout::WideNode<W> + Copy + Send>(
             vertices: &[[Vec3A; 3]],
@@ -188,7 +187,7 @@ impl BvhAccel {
     }
 
     /// Children per node.
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn width(&self) -> BvhWidth {
         match self.tree {
             Tree::Four(_) => BvhWidth::Four,

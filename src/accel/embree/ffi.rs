@@ -8,6 +8,13 @@
 //! fails if the installed header differs.
 
 #![allow(non_camel_case_types, non_snake_case)]
+#![cfg_attr(
+    not(any(test, feature = "internals")),
+    expect(
+        dead_code,
+        reason = "the builder API and some flags serve only the traversal bench and the layout test"
+    )
+)]
 
 use std::ffi::{c_char, c_int, c_uint, c_void};
 

@@ -24,6 +24,8 @@
 
 #[doc(hidden)]
 pub mod ffi;
+// Embree's own binary tree, for the traversal bench's diagnostic of tree against traversal.
+#[cfg(any(test, feature = "internals"))]
 pub(crate) mod tree;
 
 use super::ray::{Hit, Ray};
@@ -352,7 +354,7 @@ impl EmbreeAccel {
     }
 
     /// The committed scene, for calling Embree directly (the traversal benchmark's baseline).
-    #[doc(hidden)]
+    #[cfg(any(test, feature = "internals"))]
     pub fn raw_scene(&self) -> RTCScene {
         self.scene
     }

@@ -3,6 +3,9 @@
 
 pub(crate) mod direct_pass;
 pub mod driver;
+// The textbook example of Metropolis sampling, for the tests and the example that show the
+// shared acceptance rule converges.
+#[cfg(any(test, feature = "internals"))]
 pub mod image_chain;
 pub mod normalization;
 pub mod path_space;
