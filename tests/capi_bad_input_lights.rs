@@ -12,7 +12,6 @@ mod common {
 
 use common::capi::*;
 use mlt::capi::*;
-use mlt::error::*;
 use mlt::{MLT_MAX_ENVIRONMENT_SIDE, MLT_MAX_PUNCTUAL_LIGHTS};
 use std::ptr::{null, null_mut};
 
@@ -118,9 +117,8 @@ fn light_defaults_are_valid_and_documented() {
 
 #[test]
 fn light_initializers_refuse_null_and_unknown_sizes() {
-    type Init = fn(*mut u8, usize) -> MltStatus;
     // SAFETY (each closure): forwards the pointer and size to the initializer under test.
-    let initializers: [(&str, usize, Init); 3] = [
+    let initializers: [(&str, usize, Initializer); 3] = [
         (
             "mlt_environment_default",
             size_of::<MltEnvironment>(),
@@ -135,32 +133,7 @@ fn light_initializers_refuse_null_and_unknown_sizes() {
             |p, n| unsafe { mlt_punctual_light_init(p.cast(), n) },
         ),
     ];
-    let mut results = Vec::new();
-    for (name, size, init) in initializers {
-        let mut storage = [0xABu8; 256];
-        let aligned = storage
-            .as_mut_ptr()
-            .wrapping_add(storage.as_ptr().align_offset(8));
-        let status = init(null_mut(), size);
-        results.push((
-            format!("{name}: out NULL"),
-            check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
-        ));
-        for bad in [0, 3, size - 4, size + 8] {
-            let status = init(aligned, bad);
-            let needles = ["out.struct_size", &bad.to_string(), name];
-            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
-                .and_then(|()| ensure(storage.iter().all(|&b| b == 0xAB), "out written"));
-            results.push((format!("{name}: struct_size {bad}"), result));
-        }
-        let status = init(aligned, size);
-        // SAFETY: 4 aligned bytes of `storage`, initialized.
-        let written = unsafe { aligned.cast::<u32>().read() };
-        let result =
-            check_ok(status).and_then(|()| ensure(written as usize == size, "struct_size not set"));
-        results.push((format!("{name}: its own size {size}"), result));
-    }
-    assert_all("light initializers", results);
+    assert_initializers_refuse_null_and_unknown_sizes("light initializers", &initializers);
 }
 
 /// Every bad value of the environment, the sun and the punctual lights, and bad pointers

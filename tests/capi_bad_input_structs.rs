@@ -117,10 +117,9 @@ fn backend_supported() {
 /// initializer, with `out` untouched; the struct's own size is taken and written.
 #[test]
 fn initializers_refuse_null_and_unknown_sizes() {
-    type Init = fn(*mut u8, usize) -> MltStatus;
     // Each takes its own struct; `storage` below is large and aligned enough for any.
     // SAFETY (each closure): forwards the pointer and size to the initializer under test.
-    let initializers: [(&str, usize, Init); 6] = [
+    let initializers: [(&str, usize, Initializer); 6] = [
         (
             "mlt_material_default",
             size_of::<MltMaterial>(),
@@ -152,33 +151,7 @@ fn initializers_refuse_null_and_unknown_sizes() {
             |p, n| unsafe { mlt_scene_info_init(p.cast(), n) },
         ),
     ];
-    let mut results = Vec::new();
-    for (name, size, init) in initializers {
-        let mut storage = [0xABu8; 512];
-        let aligned = storage
-            .as_mut_ptr()
-            .wrapping_add(storage.as_ptr().align_offset(8));
-        let status = init(null_mut(), size);
-        results.push((
-            format!("{name}: out NULL"),
-            check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
-        ));
-        // The storage holds any size tried (< 512 - 8); as `unknown_sizes`.
-        for bad in [0, 3, size - 4, size + 8] {
-            let status = init(aligned, bad);
-            let needles = ["out.struct_size", &bad.to_string(), name];
-            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
-                .and_then(|()| ensure(storage.iter().all(|&b| b == 0xAB), "out written"));
-            results.push((format!("{name}: struct_size {bad}"), result));
-        }
-        let status = init(aligned, size);
-        // SAFETY: 4 aligned bytes of `storage`, initialized.
-        let written = unsafe { aligned.cast::<u32>().read() };
-        let result =
-            check_ok(status).and_then(|()| ensure(written as usize == size, "struct_size not set"));
-        results.push((format!("{name}: its own size {size}"), result));
-    }
-    assert_all("initializers", results);
+    assert_initializers_refuse_null_and_unknown_sizes("initializers", &initializers);
 }
 
 /// Each struct mlt reads or writes, with each size no header had, where the call reads it.

@@ -618,3 +618,41 @@ pub fn slot(texture: i32) -> MltTextureRef {
         ..default_material().base_color_texture
     }
 }
+
+/// A C initializer under test (`mlt_*_init`), through a closure that forwards its arguments.
+pub type Initializer = fn(*mut u8, usize) -> MltStatus;
+
+/// Each initializer (its default's name, its struct's size, the call): refuses NULL and
+/// every size no header had without writing, and writes its own size into `struct_size`.
+pub fn assert_initializers_refuse_null_and_unknown_sizes(
+    table: &str,
+    initializers: &[(&str, usize, Initializer)],
+) {
+    let mut results = Vec::new();
+    for &(name, size, init) in initializers {
+        // Holds any size tried (size + 8 < 512 - 8 for every struct).
+        let mut storage = [0xABu8; 512];
+        let aligned = storage
+            .as_mut_ptr()
+            .wrapping_add(storage.as_ptr().align_offset(8));
+        let status = init(null_mut(), size);
+        results.push((
+            format!("{name}: out NULL"),
+            check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
+        ));
+        for bad in [0, 3, size - 4, size + 8] {
+            let status = init(aligned, bad);
+            let needles = ["out.struct_size", &bad.to_string(), name];
+            let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
+                .and_then(|()| ensure(storage.iter().all(|&b| b == 0xAB), "out written"));
+            results.push((format!("{name}: struct_size {bad}"), result));
+        }
+        let status = init(aligned, size);
+        // SAFETY: 4 aligned bytes of `storage`, initialized.
+        let written = unsafe { aligned.cast::<u32>().read() };
+        let result =
+            check_ok(status).and_then(|()| ensure(written as usize == size, "struct_size not set"));
+        results.push((format!("{name}: its own size {size}"), result));
+    }
+    assert_all(table, results);
+}
