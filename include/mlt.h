@@ -453,98 +453,88 @@ typedef struct MltMaterial {
    */
   uint32_t struct_size;
   /**
-   * One of `MLT_MATERIAL_*`.
+   * The scattering model: diffuse (Lambertian), mirror, dielectric (smooth glass) or
+   * metallic-roughness (glTF 2.0's). One of `MLT_MATERIAL_*`. Default `MLT_MATERIAL_DIFFUSE`.
    */
   int32_t kind;
   /**
-   * Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour;
-   * linear RGB, each in [0, 1].
+   * Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour, linear
+   * RGB. A reflectance must be in [0, 1]; above 1 would create energy. Default 0.8, 0.8, 0.8.
    */
   float color[3];
   /**
-   * Radiance emitted from the front (counter-clockwise) side; linear RGB, each >= 0.
-   * Any material may emit: its triangles become area lights.
+   * Radiance emitted from the front (counter-clockwise) side, linear RGB; emissive triangles are
+   * area lights. Emission must not be negative. Default 0.0, 0.0, 0.0.
    */
   float emission[3];
   /**
-   * Index of refraction of a dielectric and of a metallic-roughness material's
-   * dielectric part (> 0; the outside is vacuum). Must be finite for every kind; only
-   * those two use it.
+   * Index of refraction of a dielectric and of the metallic-roughness model's dielectric part
+   * (there > 0). Any finite number. Default 1.5.
    */
   float ior;
   /**
-   * Metalness in [0, 1]: 0 a dielectric, 1 a metal whose reflectance is `color`. Used by
-   * `MLT_MATERIAL_METALLIC_ROUGHNESS` only, but this field and the ones below are
-   * validated for every kind. Default 0.
+   * Metallic-roughness: metalness, 0 a dielectric, 1 a metal whose reflectance is the colour. It
+   * must be in [0, 1]. Default 0.0.
    */
   float metallic;
   /**
-   * Perceptual roughness in [0, 1] (GGX alpha = roughness^2); metallic-roughness only.
-   * Default 1.
+   * Metallic-roughness: perceptual roughness (GGX alpha = roughness squared; 0 is the exact
+   * specular lobe). It must be in [0, 1]. Default 1.0.
    */
   float roughness;
   /**
-   * The fraction of the non-metallic base that is transmitted rather than diffusely
-   * reflected, in [0, 1] (`KHR_materials_transmission`); metallic-roughness only.
-   * Default 0.
+   * Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely
+   * reflected (KHR_materials_transmission). It must be in [0, 1]. Default 0.0.
    */
   float transmission;
   /**
-   * Coverage in [0, 1], multiplied by the base colour texture's alpha and the vertex
-   * colour's; used by `MLT_ALPHA_MASK`. Default 1.
+   * Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
+   * alpha mode. It must be in [0, 1]. Default 1.0.
    */
   float alpha;
   /**
-   * One of `MLT_ALPHA_*`, for every kind. Default `MLT_ALPHA_OPAQUE`.
+   * What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
+   * (glTF's MASK). One of `MLT_ALPHA_*`. Default `MLT_ALPHA_OPAQUE`.
    */
   int32_t alpha_mode;
   /**
-   * `MLT_ALPHA_MASK` cuts the surface out where alpha < `alpha_cutoff`; finite, >= 0.
-   * Default 0.5 (glTF's).
+   * The mask alpha mode's threshold (glTF's alphaCutoff). It must not be negative. Default 0.5.
    */
   float alpha_cutoff;
   /**
-   * Linear RGBA: multiplies `color` and `alpha`. Its texture is usually 8-bit sRGB
-   * (glTF's base colour images are); its alpha is linear.
+   * Multiplies the colour (RGB) and alpha (A), for every kind; usually 8-bit sRGB. An index into
+   * `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef base_color_texture;
   /**
-   * Green multiplies `roughness`, blue multiplies `metallic` (glTF's packing; usually an
-   * `MLT_TEXTURE_LINEAR` texture).
+   * Green multiplies the roughness, blue the metalness (glTF's packing); usually linear. An
+   * index into `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef metallic_roughness_texture;
   /**
-   * A tangent-space normal map (glTF's convention): RGB in [0, 1] encodes the normal as
-   * 2 × value − 1, with x along the tangent (+u), y along the bitangent, pointing to
-   * +Y up in the image (towards decreasing v), and z along the surface normal. Usually
-   * an `MLT_TEXTURE_LINEAR` texture. The tangents are `MltSceneDesc.tangents`, or computed
-   * with MikkTSpace when that is empty.
+   * A tangent-space normal map (glTF's convention: +Y up in the image); usually linear. An index
+   * into `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef normal_texture;
   /**
-   * Linear RGB: multiplies `emission` (an sRGB texture, in glTF). A triangle with
-   * emission emits only where the texture is not black.
+   * Multiplies the emission; usually 8-bit sRGB. An index into `MltSceneDesc.textures` and its
+   * transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef emission_texture;
   /**
-   * Scales the normal map's x and y (glTF's `normalTexture.scale`); finite. Default 1.
+   * Scales the normal map's x and y (glTF's normalTexture.scale). Any finite number. Default
+   * 1.0.
    */
   float normal_scale;
   /**
-   * 0 or 1; metallic-roughness only: compensate the metal's reflection for the light
-   * that bounces between microfacets more than once, which glTF's single-scattering
-   * model loses (Kulla and Conty 2017): a white metal then reflects all the light at
-   * every roughness, instead of 92% at roughness 0.5 and 31% at 1 (normal incidence).
-   * Default 0, glTF's model as its specification defines it.
+   * Metallic-roughness: give rough metals the light glTF's single-scattering model loses (Kulla
+   * and Conty 2017). 0 or 1. Default 0.
    */
   uint32_t energy_compensation;
   /**
-   * Dispersion of a dielectric or of the metallic-roughness model's dielectric part, as
-   * the Abbe number V_d: `ior` holds at 587.56 nm and the index at wavelength λ is
-   * n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168), the Cauchy form of glTF's
-   * `KHR_materials_dispersion` (whose `dispersion` is 20 / V_d). 0 (the default) is no
-   * dispersion; otherwise finite and positive. Only `MltSettings.spectral` renders
-   * disperse light.
+   * Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 /
+   * V_d); spectral renders only. An Abbe number must be positive (0: no dispersion). Default
+   * 0.0.
    */
   float abbe_number;
 } MltMaterial;

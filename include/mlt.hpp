@@ -439,23 +439,52 @@ struct TextureRef {
 /// A material (MltMaterial; mlt.h documents each field). The defaults are
 /// mlt_material_default's: a light grey (0.8) diffuse surface.
 struct Material {
+    // BEGIN GENERATED material members: tests/parameters.rs writes these lines from src/scene/material.rs
+    /// The scattering model: diffuse (Lambertian), mirror, dielectric (smooth glass) or
+    /// metallic-roughness (glTF 2.0's).
     MaterialKind kind = MaterialKind::Diffuse;
-    Rgb color{0.8f, 0.8f, 0.8f};
-    Rgb emission{0.0f, 0.0f, 0.0f};
+    /// Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour, linear
+    /// RGB.
+    std::array<float, 3> color{0.8f, 0.8f, 0.8f};
+    /// Radiance emitted from the front (counter-clockwise) side, linear RGB; emissive triangles are
+    /// area lights.
+    std::array<float, 3> emission{0.0f, 0.0f, 0.0f};
+    /// Index of refraction of a dielectric and of the metallic-roughness model's dielectric part
+    /// (there > 0).
     float ior = 1.5f;
+    /// Metallic-roughness: metalness, 0 a dielectric, 1 a metal whose reflectance is the colour.
     float metallic = 0.0f;
+    /// Metallic-roughness: perceptual roughness (GGX alpha = roughness squared; 0 is the exact
+    /// specular lobe).
     float roughness = 1.0f;
+    /// Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely
+    /// reflected (KHR_materials_transmission).
     float transmission = 0.0f;
+    /// Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
+    /// alpha mode.
     float alpha = 1.0f;
+    /// What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
+    /// (glTF's MASK).
     AlphaMode alpha_mode = AlphaMode::Opaque;
+    /// The mask alpha mode's threshold (glTF's alphaCutoff).
     float alpha_cutoff = 0.5f;
+    /// Multiplies the colour (RGB) and alpha (A), for every kind; usually 8-bit sRGB.
     TextureRef base_color_texture;
+    /// Green multiplies the roughness, blue the metalness (glTF's packing); usually linear.
     TextureRef metallic_roughness_texture;
+    /// A tangent-space normal map (glTF's convention: +Y up in the image); usually linear.
     TextureRef normal_texture;
+    /// Multiplies the emission; usually 8-bit sRGB.
     TextureRef emission_texture;
+    /// Scales the normal map's x and y (glTF's normalTexture.scale).
     float normal_scale = 1.0f;
+    /// Metallic-roughness: give rough metals the light glTF's single-scattering model loses (Kulla
+    /// and Conty 2017).
     bool energy_compensation = false;
+    /// Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 /
+    /// V_d); spectral renders only.
     float abbe_number = 0.0f;
+    // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
         Material m;
@@ -494,6 +523,7 @@ struct Material {
     MltMaterial to_c() const {
         MltMaterial c;
         detail::check(mlt_material_default(&c), "mlt_material_default");
+        // BEGIN GENERATED material to C
         c.kind = detail::c_value(kind);
         detail::copy_to(c.color, color);
         detail::copy_to(c.emission, emission);
@@ -511,10 +541,12 @@ struct Material {
         c.normal_scale = normal_scale;
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
+        // END GENERATED material to C
         return c;
     }
     static Material from_c(const MltMaterial &c) noexcept {
         Material m;
+        // BEGIN GENERATED material from C
         m.kind = detail::from_c<MaterialKind>(c.kind);
         m.color = detail::to_array(c.color);
         m.emission = detail::to_array(c.emission);
@@ -532,6 +564,7 @@ struct Material {
         m.normal_scale = c.normal_scale;
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
+        // END GENERATED material from C
         return m;
     }
     /// The linked library's defaults (equal to a default-constructed Material).
@@ -856,7 +889,7 @@ struct Camera {
 /// defaults are mlt_render_settings_default's: 256 × 256, multiplexed MLT with 32
 /// mutations per pixel. The library validates the values when rendering.
 struct RenderSettings {
-    // BEGIN GENERATED members: tests/parameters.rs writes these lines from src/render/settings.rs
+    // BEGIN GENERATED settings members: tests/parameters.rs writes these lines from src/render/settings.rs
     /// Image width in pixels.
     std::uint32_t width = 256;
     /// Image height in pixels.
@@ -918,13 +951,13 @@ struct RenderSettings {
     /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
     /// on.
     float roulette_max_survival = 0.95f;
-    // END GENERATED members
+    // END GENERATED settings members
 
     /// The C struct: mlt_render_settings_default, then every field of this struct.
     MltRenderSettings to_c() const {
         MltRenderSettings c;
         detail::check(mlt_render_settings_default(&c), "mlt_render_settings_default");
-        // BEGIN GENERATED to C
+        // BEGIN GENERATED settings to C
         c.width = width;
         c.height = height;
         c.algorithm = detail::c_value(algorithm);
@@ -951,12 +984,12 @@ struct RenderSettings {
         c.spectral = spectral ? 1u : 0u;
         c.roulette_start_depth = roulette_start_depth;
         c.roulette_max_survival = roulette_max_survival;
-        // END GENERATED to C
+        // END GENERATED settings to C
         return c;
     }
     static RenderSettings from_c(const MltRenderSettings &c) noexcept {
         RenderSettings s;
-        // BEGIN GENERATED from C
+        // BEGIN GENERATED settings from C
         s.width = c.width;
         s.height = c.height;
         s.algorithm = detail::from_c<Algorithm>(c.algorithm);
@@ -983,7 +1016,7 @@ struct RenderSettings {
         s.spectral = c.spectral != 0;
         s.roulette_start_depth = c.roulette_start_depth;
         s.roulette_max_survival = c.roulette_max_survival;
-        // END GENERATED from C
+        // END GENERATED settings from C
         return s;
     }
     /// The linked library's defaults (equal to a default-constructed RenderSettings when

@@ -9,6 +9,7 @@
 //! plan encodes by it and the fuzz generator draws from it.
 
 use crate::error::{Error, Result};
+use crate::texture::TextureRef;
 
 /// The type of a parameter's value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,9 +20,36 @@ pub enum Kind {
     F64,
     Bool,
     /// One of these names.
-    Choice(&'static [&'static str]),
+    Choice(&'static Choices),
+    /// Three floats (a colour or a vector), each in the range.
+    F32x3,
     /// Four floats, each in the range.
     F32x4,
+    /// A material's texture slot: none, or a texture with its coordinate transform.
+    Texture,
+}
+
+/// The names of a choice parameter's values, and what the C and C++ APIs call them.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Choices {
+    /// The names of the command line, Python and the docs, in the order of the C values
+    /// (0, 1, …).
+    pub names: &'static [&'static str],
+    /// The C++ `enum class` (and, where there is one, the Python enum).
+    pub type_name: &'static str,
+    /// The C constants' common prefix: `MLT_ALGORITHM` for `MLT_ALGORITHM_PATH`.
+    pub c_prefix: &'static str,
+}
+
+impl Choices {
+    /// The C constant of `name`: `MLT_ALGORITHM_PATH_SPACE_MLT` for `path-space-mlt`.
+    pub fn c_constant(&self, name: &str) -> String {
+        format!(
+            "{}_{}",
+            self.c_prefix,
+            name.replace('-', "_").to_uppercase()
+        )
+    }
 }
 
 /// A parameter's value, as a front end passes it by name.
@@ -32,7 +60,9 @@ pub enum Value {
     Float(f64),
     Bool(bool),
     Choice(&'static str),
+    Vec3([f32; 3]),
     Floats([f32; 4]),
+    Texture(Option<TextureRef>),
 }
 
 impl std::fmt::Display for Value {
@@ -42,7 +72,10 @@ impl std::fmt::Display for Value {
             Value::Float(v) => write!(f, "{v}"),
             Value::Bool(v) => write!(f, "{v}"),
             Value::Choice(v) => write!(f, "{v}"),
+            Value::Vec3([a, b, c]) => write!(f, "{a},{b},{c}"),
             Value::Floats([a, b, c, d]) => write!(f, "{a},{b},{c},{d}"),
+            Value::Texture(None) => write!(f, "none"),
+            Value::Texture(Some(t)) => write!(f, "texture {}", t.texture),
         }
     }
 }
@@ -93,6 +126,10 @@ impl Range {
     }
 }
 
+/// What an out-of-range value's message says after `"<prefix>.<name> is <value>; "`, given
+/// the whole struct (a limit may depend on another parameter).
+pub type Rule<S> = fn(&S) -> String;
+
 /// What is known of one parameter of the struct `S`.
 pub struct Parameter<S> {
     /// The field's name: the C field, C++ member, Python keyword and `set`/`get` name.
@@ -100,13 +137,13 @@ pub struct Parameter<S> {
     pub kind: Kind,
     /// One line, for `--help`, the docs table and the headers.
     pub doc: &'static str,
-    /// The command-line flag, without `--`.
-    pub flag: &'static str,
+    /// The command-line flag, without `--`; `None` for a material's parameters, which the
+    /// command line sets by name (`--material NAME=VALUE`).
+    pub flag: Option<&'static str>,
     pub default: fn() -> Value,
     /// The values it accepts; `None`: every value of its kind.
     pub range: Option<Range>,
-    /// What an out-of-range value's message says after `"<prefix>.<name> is <value>; "`.
-    pub rule: Option<fn(&S) -> String>,
+    pub rule: Option<Rule<S>>,
 }
 
 impl<S> Parameter<S> {
@@ -115,35 +152,44 @@ impl<S> Parameter<S> {
     /// mistakes.
     pub fn outside_value(&self) -> Option<Value> {
         let range = self.range?;
-        let below = if range.min_exclusive {
-            Some(range.min)
-        } else if range.min >= 1.0 && range.off != Some(range.min - 1.0) {
-            Some(range.min - 1.0)
-        } else {
-            None
-        };
-        let bad = below.unwrap_or(match self.kind {
+        let is_f32 = matches!(self.kind, Kind::F32 | Kind::F32x3 | Kind::F32x4);
+        let above = match self.kind {
             Kind::U32 | Kind::U64 => range.max + 1.0,
             _ => range.max * 2.0,
-        });
+        };
+        let representable = !is_f32 || above <= f32::MAX as f64;
+        let below = range.min - 1.0;
+        let bad = if range.min_exclusive {
+            range.min
+        } else if range.min >= 1.0 && range.off != Some(below) {
+            below
+        } else if representable {
+            above
+        } else {
+            below
+        };
         Some(match self.kind {
             Kind::U32 | Kind::U64 => Value::Int(bad as i128),
             Kind::F32 | Kind::F64 => Value::Float(bad),
+            // The first component outside, the others their defaults.
+            Kind::F32x3 => match (self.default)() {
+                Value::Vec3([_, b, c]) => Value::Vec3([bad as f32, b, c]),
+                _ => Value::Vec3([bad as f32; 3]),
+            },
             Kind::F32x4 => match (self.default)() {
-                Value::Floats([_, rest @ ..]) => {
-                    let [b, c, d] = rest;
-                    Value::Floats([bad as f32, b, c, d])
-                }
+                Value::Floats([_, b, c, d]) => Value::Floats([bad as f32, b, c, d]),
                 _ => Value::Floats([bad as f32; 4]),
             },
-            Kind::Bool | Kind::Choice(_) => return None,
+            Kind::Bool | Kind::Choice(_) | Kind::Texture => return None,
         })
     }
 }
 
 /// A struct made by `declare_parameters!`.
 pub trait Parameters: Default + Sized + 'static {
-    /// What messages name the struct by: `settings` in `settings.width is 0; …`.
+    /// What messages name the struct by: `settings` in `settings.width is 0; …` (a
+    /// struct that is one of many, a material, is named by its place instead when it is
+    /// validated: `desc.materials[2]`).
     const PREFIX: &'static str;
     /// Every parameter, in declaration order (the C struct's field order).
     fn parameters() -> &'static [Parameter<Self>];
@@ -173,8 +219,18 @@ pub trait ParameterType: Copy {
     fn to_value(self) -> Value;
     #[doc(hidden)]
     fn from_value(value: Value) -> std::result::Result<Self, Unfit>;
-    /// The first value outside `range` (with its index, for arrays), as messages print it.
-    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)>;
+    /// The first value outside `range`, as messages print it, after the suffix that names
+    /// it within the field (`[1]`, `.y`; empty for a single value).
+    fn outside(&self, range: &Range) -> Option<(String, String)> {
+        self.first(|x| !range.contains(x))
+    }
+    /// The first value that is not a finite number (NaN, an infinity), as `outside`.
+    fn non_finite(&self) -> Option<(String, String)> {
+        self.first(|x| !x.is_finite())
+    }
+    #[doc(hidden)]
+    /// The first of the numbers the value holds for which `bad` is true, as `outside`.
+    fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)>;
 }
 
 macro_rules! integer_parameter {
@@ -190,8 +246,8 @@ macro_rules! integer_parameter {
                     _ => Err(Unfit::Kind),
                 }
             }
-            fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
-                (!range.contains(*self as f64)).then(|| (None, self.to_string()))
+            fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)> {
+                bad(*self as f64).then(|| (String::new(), self.to_string()))
             }
         }
     )*};
@@ -212,8 +268,8 @@ macro_rules! float_parameter {
                     _ => Err(Unfit::Kind),
                 }
             }
-            fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
-                (!range.contains(*self as f64)).then(|| (None, self.to_string()))
+            fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)> {
+                bad(*self as f64).then(|| (String::new(), self.to_string()))
             }
         }
     )*};
@@ -231,7 +287,46 @@ impl ParameterType for bool {
             _ => Err(Unfit::Kind),
         }
     }
-    fn outside(&self, _: &Range) -> Option<(Option<usize>, String)> {
+    fn first(&self, _: impl Fn(f64) -> bool) -> Option<(String, String)> {
+        None
+    }
+}
+
+impl ParameterType for [f32; 3] {
+    const KIND: Kind = Kind::F32x3;
+    fn to_value(self) -> Value {
+        Value::Vec3(self)
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        match value {
+            Value::Vec3(v) => Ok(v),
+            _ => Err(Unfit::Kind),
+        }
+    }
+    /// Components are named `.x`, `.y`, `.z`, as the C API's vectors.
+    fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)> {
+        ["x", "y", "z"]
+            .iter()
+            .zip(self)
+            .find(|(_, w)| bad(**w as f64))
+            .map(|(axis, w)| (format!(".{axis}"), w.to_string()))
+    }
+}
+
+impl ParameterType for Option<TextureRef> {
+    const KIND: Kind = Kind::Texture;
+    fn to_value(self) -> Value {
+        Value::Texture(self)
+    }
+    fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
+        match value {
+            Value::Texture(v) => Ok(v),
+            _ => Err(Unfit::Kind),
+        }
+    }
+    /// The slot's index and transform are checked by the material, which knows the
+    /// textures.
+    fn first(&self, _: impl Fn(f64) -> bool) -> Option<(String, String)> {
         None
     }
 }
@@ -247,18 +342,28 @@ impl ParameterType for [f32; 4] {
             _ => Err(Unfit::Kind),
         }
     }
-    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
+    fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)> {
         self.iter()
             .enumerate()
-            .find(|(_, w)| !range.contains(**w as f64))
-            .map(|(i, w)| (Some(i), w.to_string()))
+            .find(|(_, w)| bad(**w as f64))
+            .map(|(i, w)| (format!("[{i}]"), w.to_string()))
     }
 }
 
 /// A parameter whose value is one of a few names (an enum): `NAMES[i]` is `ALL[i]`'s.
 pub trait ChoiceParameter: Copy + PartialEq + 'static {
     const NAMES: &'static [&'static str];
+    /// The values, in the order of their C constants (0, 1, …).
     const ALL: &'static [Self];
+    /// [`Choices::type_name`].
+    const TYPE_NAME: &'static str;
+    /// [`Choices::c_prefix`].
+    const C_PREFIX: &'static str;
+    const CHOICES: Choices = Choices {
+        names: Self::NAMES,
+        type_name: Self::TYPE_NAME,
+        c_prefix: Self::C_PREFIX,
+    };
     fn name(self) -> &'static str {
         let i = Self::ALL.iter().position(|&v| v == self);
         Self::NAMES[i.expect("ALL holds every value")]
@@ -277,7 +382,7 @@ pub trait ChoiceParameter: Copy + PartialEq + 'static {
 }
 
 impl<T: ChoiceParameter> ParameterType for T {
-    const KIND: Kind = Kind::Choice(T::NAMES);
+    const KIND: Kind = Kind::Choice(&T::CHOICES);
     fn to_value(self) -> Value {
         Value::Choice(self.name())
     }
@@ -287,30 +392,32 @@ impl<T: ChoiceParameter> ParameterType for T {
             _ => Err(Unfit::Kind),
         }
     }
-    fn outside(&self, _: &Range) -> Option<(Option<usize>, String)> {
+    fn first(&self, _: impl Fn(f64) -> bool) -> Option<(String, String)> {
         None
     }
 }
 
-/// Checks one field against its range, with the message every front end shows.
+/// Checks one field, with the message every front end shows: every number must be finite,
+/// then within the field's range, if it has one.
 #[doc(hidden)]
 pub fn check<S, T: ParameterType>(
     settings: &S,
     prefix: &str,
     name: &str,
     value: T,
-    range: Range,
-    rule: fn(&S) -> String,
+    range: Option<(Range, Rule<S>)>,
 ) -> Result<()> {
-    match value.outside(&range) {
+    if let Some((part, shown)) = value.non_finite() {
+        return Err(Error::invalid(format!(
+            "{prefix}.{name}{part} is {shown}; it must be a finite number"
+        )));
+    }
+    match range.and_then(|(range, rule)| Some((value.outside(&range)?, rule))) {
         None => Ok(()),
-        Some((index, shown)) => {
-            let index = index.map_or_else(String::new, |i| format!("[{i}]"));
-            Err(Error::invalid(format!(
-                "{prefix}.{name}{index} is {shown}; {}",
-                rule(settings)
-            )))
-        }
+        Some(((part, shown), rule)) => Err(Error::invalid(format!(
+            "{prefix}.{name}{part} is {shown}; {}",
+            rule(settings)
+        ))),
     }
 }
 
@@ -321,16 +428,17 @@ pub fn convert<S, T: ParameterType>(
     prefix: &str,
     name: &str,
     value: Value,
-    rule: Option<fn(&S) -> String>,
+    rule: Option<Rule<S>>,
 ) -> Result<T> {
     T::from_value(value).map_err(|unfit| match (unfit, rule) {
         (Unfit::Domain, Some(rule)) => {
             Error::invalid(format!("{prefix}.{name} is {value}; {}", rule(settings)))
         }
         (Unfit::Domain, None) => match T::KIND {
-            Kind::Choice(names) => Error::invalid(format!(
+            Kind::Choice(choices) => Error::invalid(format!(
                 "{prefix}.{name} is {value:?}; expected one of {}",
-                names
+                choices
+                    .names
                     .iter()
                     .map(|n| format!("{n:?}"))
                     .collect::<Vec<_>>()
@@ -352,7 +460,9 @@ pub fn kind_noun(kind: Kind) -> &'static str {
         Kind::F32 | Kind::F64 => "a number",
         Kind::Bool => "a boolean",
         Kind::Choice(_) => "one of its names",
+        Kind::F32x3 => "three numbers",
         Kind::F32x4 => "four numbers",
+        Kind::Texture => "a texture slot",
     }
 }
 
@@ -362,6 +472,7 @@ pub fn kind_noun(kind: Kind) -> &'static str {
 /// /// Rust documentation of the field.
 /// name: Type = default {
 ///     doc: "One line.",
+///     // Optional: the command-line flag.
 ///     flag: "command-line-flag",
 ///     // Optional, for numbers: the values it accepts and the message's rule.
 ///     range: Range::closed(1.0, 8.0),
@@ -376,7 +487,7 @@ macro_rules! declare_parameters {
                 $(#[$attr:meta])*
                 $name:ident: $ty:ty = $default:expr => {
                     doc: $doc:literal,
-                    flag: $flag:literal,
+                    $(flag: $flag:literal,)?
                     $(range: $range:expr, rule: $rule:expr,)?
                 }
             ),* $(,)?
@@ -394,12 +505,16 @@ macro_rules! declare_parameters {
         }
 
         impl $Struct {
-            /// Checks every field against its declared range, in declaration order.
-            fn check_ranges(&self) -> $crate::error::Result<()> {
-                $($({
-                    let rule: fn(&Self) -> String = $rule;
-                    $crate::params::check(self, $prefix, stringify!($name), self.$name, $range, rule)?;
-                })?)*
+            /// Checks every field, in declaration order: its numbers finite and within its
+            /// declared range. Messages name the struct `prefix`.
+            fn check_ranges(&self, prefix: &str) -> $crate::error::Result<()> {
+                $({
+                    #[allow(unused_variables)]
+                    let range: Option<($crate::params::Range, $crate::params::Rule<Self>)> = None;
+                    $( let range: Option<($crate::params::Range, $crate::params::Rule<Self>)> =
+                        Some(($range, $rule)); )?
+                    $crate::params::check(self, prefix, stringify!($name), self.$name, range)?;
+                })*
                 Ok(())
             }
         }
@@ -412,7 +527,12 @@ macro_rules! declare_parameters {
                         name: stringify!($name),
                         kind: <$ty as $crate::params::ParameterType>::KIND,
                         doc: $doc,
-                        flag: $flag,
+                        flag: {
+                            #[allow(unused_variables)]
+                            let flag: Option<&'static str> = None;
+                            $( let flag = Some($flag); )?
+                            flag
+                        },
                         default: || {
                             <$ty as $crate::params::ParameterType>::to_value($default)
                         },
@@ -424,8 +544,8 @@ macro_rules! declare_parameters {
                         },
                         rule: {
                             #[allow(unused_variables)]
-                            let rule: Option<fn(&$Struct) -> String> = None;
-                            $( let rule: Option<fn(&$Struct) -> String> = Some($rule); )?
+                            let rule: Option<$crate::params::Rule<$Struct>> = None;
+                            $( let rule: Option<$crate::params::Rule<$Struct>> = Some($rule); )?
                             rule
                         },
                     },

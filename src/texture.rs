@@ -9,7 +9,7 @@
 
 use std::sync::OnceLock;
 
-use crate::error::{Error, MLT_STATUS_OUT_OF_MEMORY, Result};
+use crate::error::{Error, MLT_STATUS_OUT_OF_MEMORY, Result, check_finite};
 use std::borrow::Cow;
 
 /// Largest width or height of a texture, in texels.
@@ -363,6 +363,58 @@ fn wrap(mode: WrapMode, index: i64, size: u32) -> u32 {
 #[inline]
 fn lerp4(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
     std::array::from_fn(|c| a[c] + (b[c] - a[c]) * t)
+}
+
+/// A material's use of a texture: which one, and the affine map applied to the surface's
+/// texture coordinates before the lookup (glTF `KHR_texture_transform`: scale, then
+/// rotate, then offset).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into `SceneDesc::textures`.
+    pub texture: u32,
+    pub offset: [f32; 2],
+    /// Radians, counter-clockwise in uv space as `KHR_texture_transform` defines it.
+    pub rotation: f32,
+    pub scale: [f32; 2],
+}
+
+impl TextureRef {
+    /// Texture `texture` at the surface's own coordinates.
+    pub const fn new(texture: u32) -> Self {
+        TextureRef {
+            texture,
+            offset: [0.0; 2],
+            rotation: 0.0,
+            scale: [1.0; 2],
+        }
+    }
+
+    /// The transform as the rows of a 2×3 matrix applied to (u, v, 1).
+    #[allow(dead_code)] // Until textures are looked up.
+    pub(crate) fn matrix(&self) -> [[f32; 3]; 2] {
+        let (sin, cos) = self.rotation.sin_cos();
+        let [sx, sy] = self.scale;
+        [
+            [cos * sx, sin * sy, self.offset[0]],
+            [-sin * sx, cos * sy, self.offset[1]],
+        ]
+    }
+
+    pub(crate) fn validate(&self, name: &str, texture_count: usize) -> Result<()> {
+        if self.texture as usize >= texture_count {
+            return Err(Error::invalid(format!(
+                "{name}.texture is {}, but there are only {texture_count} textures",
+                self.texture
+            )));
+        }
+        check_finite(&format_args!("{name}.rotation"), self.rotation)?;
+        for (field, value) in [("offset", self.offset), ("scale", self.scale)] {
+            for (axis, v) in ["u", "v"].iter().zip(value) {
+                check_finite(&format_args!("{name}.{field}.{axis}"), v)?;
+            }
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]

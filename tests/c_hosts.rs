@@ -374,55 +374,83 @@ fn cornell_cpp_renders_and_answers_ray_queries() {
 }
 
 /// Every declared render setting reaches C (`MltRenderSettings`) and C++
-/// (`mlt::RenderSettings`) with its declared default, and a value outside its range, set in
-/// either, is refused with the message Rust's validation gives (`c_examples/parameters.cpp`,
-/// generated from the declarations by `tests/parameters.rs`).
+/// (`mlt::RenderSettings`), and every material parameter `MltMaterial` and `mlt::Material`,
+/// with its declared default, and a value outside its range, set in either, is refused with
+/// the message Rust's validation gives (`c_examples/parameters.cpp`, generated from the
+/// declarations by `tests/parameters.rs`).
 #[test]
-fn every_setting_reaches_c_and_cpp_with_its_default_and_message() {
-    use mlt::params::{Kind, Parameters, Value};
+fn every_parameter_reaches_c_and_cpp_with_its_default_and_message() {
     let exe = build("parameters.cpp", "parameters", true, &["-std=c++17"]);
     let output = Command::new(&exe).output().unwrap();
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{stdout}");
+    check_parameters::<mlt::RenderSettings>(&stdout, "", |s| s.validate());
+    // The program's material is the scene's only one.
+    check_parameters::<mlt::Material>(&stdout, "material.", |m| m.validate(0, 0));
+}
+
+/// The lines of `parameters.cpp` about `S`'s parameters (named `label` + name) against the
+/// declarations; `validate` gives the message of an out-of-range value.
+fn check_parameters<S: mlt::params::Parameters>(
+    stdout: &str,
+    label: &str,
+    validate: fn(&S) -> mlt::Result<()>,
+) {
+    use mlt::params::{Kind, Value};
     // A printed value ("%.9g" for floats, "%.17g" for doubles, 0 or 1 for booleans, the
-    // MLT_* code of a choice) and the declared one are the same number.
+    // MLT_* code of a choice, a texture slot's index) and the declared one are the same.
     let same = |kind: Kind, text: &str, value: Value| -> bool {
         let words: Vec<&str> = text.split(' ').collect();
+        let floats = |v: &[f32]| {
+            words
+                .iter()
+                .map(|w| w.parse::<f32>().ok())
+                .eq(v.iter().map(|&x| Some(x)))
+        };
         match (kind, value) {
             (_, Value::Int(v)) => words == [v.to_string()],
             (Kind::F32, Value::Float(v)) => words[0].parse::<f32>() == Ok(v as f32),
             (_, Value::Float(v)) => words[0].parse::<f64>() == Ok(v),
             (_, Value::Bool(v)) => words == [(v as u32).to_string()],
-            (Kind::Choice(names), Value::Choice(name)) => {
-                words == [names.iter().position(|&n| n == name).unwrap().to_string()]
+            (Kind::Choice(choices), Value::Choice(name)) => {
+                words
+                    == [choices
+                        .names
+                        .iter()
+                        .position(|&n| n == name)
+                        .unwrap()
+                        .to_string()]
             }
-            (_, Value::Floats(v)) => words.iter().map(|w| w.parse::<f32>().ok()).eq(v.map(Some)),
-            _ => false,
+            (_, Value::Vec3(v)) => floats(&v),
+            (_, Value::Floats(v)) => floats(&v),
+            (_, Value::Texture(None)) => words == ["-1"],
+            (_, Value::Texture(Some(t))) => words == [t.texture.to_string()],
+            (_, Value::Choice(_)) => false,
         }
     };
-    for p in mlt::RenderSettings::parameters() {
+    for p in S::parameters() {
+        let name = format!("{label}{}", p.name);
         for language in ["c", "c++"] {
-            let prefix = format!("{language} {} ", p.name);
+            let prefix = format!("{language} {name} ");
             let shown = stdout
                 .lines()
                 .find_map(|l| {
                     l.strip_prefix(&prefix)
                         .filter(|v| !v.starts_with("message"))
                 })
-                .unwrap_or_else(|| panic!("no default of {} in {language}:\n{stdout}", p.name));
+                .unwrap_or_else(|| panic!("no default of {name} in {language}:\n{stdout}"));
             assert!(
                 same(p.kind, shown, (p.default)()),
-                "{language}'s default of {} is {shown}, declared {:?}",
-                p.name,
+                "{language}'s default of {name} is {shown}, declared {:?}",
                 (p.default)()
             );
             let Some(bad) = p.outside_value() else {
                 continue;
             };
-            let mut settings = mlt::RenderSettings::default();
-            settings.set(p.name, bad).unwrap();
-            let expected = settings.validate().unwrap_err().message;
-            let line = format!("{language} {} message {expected}", p.name);
+            let mut value = S::default();
+            value.set(p.name, bad).unwrap();
+            let expected = validate(&value).unwrap_err().message;
+            let line = format!("{language} {name} message {expected}");
             assert!(
                 stdout.lines().any(|l| l == line),
                 "no {line:?} in:\n{stdout}"

@@ -764,7 +764,7 @@ fn every_setting_has_its_flag_default_and_message() {
         (_, v) => v.to_string(),
     };
     for p in RenderSettings::parameters() {
-        let flag = format!("--{}", p.flag);
+        let flag = format!("--{}", p.flag.unwrap());
         // The flag's entry: its line and the indented help lines below it.
         let lines: Vec<&str> = help.lines().collect();
         let first = lines
@@ -812,7 +812,110 @@ fn every_setting_has_its_flag_default_and_message() {
         assert!(
             line.contains(&expected),
             "--{} {value}: {line}, not {expected}",
-            p.flag
+            p.flag.unwrap()
+        );
+    }
+}
+
+/// Every declared material parameter can be set with `--material NAME=VALUE`, its default
+/// is in the long help, and a value outside its range is refused with the message every
+/// front end gives.
+#[test]
+fn every_material_parameter_is_an_override_with_its_default_and_message() {
+    use mlt::Material;
+    use mlt::params::{Kind, Parameters, Value};
+    let help = String::from_utf8(mlt_render(&[&"--help"]).stdout).unwrap();
+    let text = |kind: Kind, value: Value| match (kind, value) {
+        (Kind::F32, Value::Float(v)) => (v as f32).to_string(),
+        (_, v) => v.to_string(),
+    };
+    for p in Material::parameters() {
+        let entry = format!(
+            "{}  {} [default: {}]",
+            p.name,
+            p.doc,
+            text(p.kind, (p.default)())
+        );
+        assert!(help.contains(&entry), "no {entry:?} in:\n{help}");
+        let Some(bad) = p.outside_value() else {
+            continue;
+        };
+        let mut material = Material::default();
+        material.set(p.name, bad).unwrap();
+        let expected = material.validate(0, 0).unwrap_err().message;
+        let out = temp_path("never-written.pfm");
+        let setting = format!("{}={}", p.name, text(p.kind, bad));
+        let output = mlt_render(&[
+            &scene("cornell-box.obj"),
+            &"--material",
+            &setting,
+            &"--out",
+            &out,
+        ]);
+        let line = assert_one_line_error(&output);
+        assert!(
+            line.contains(&expected),
+            "--material {setting}: {line}, not {expected}"
+        );
+    }
+    // A name that is not a parameter, and a value of another kind, are refused by name.
+    for (setting, message) in [
+        (
+            "sheen=1",
+            "\"sheen\" is not a material parameter; they are kind, color",
+        ),
+        ("kind=velvet", "\"velvet\": expected one of diffuse, mirror"),
+        ("color=1,1", "3 numbers are needed, not 2"),
+        ("normal_texture=-2", "expected none or a texture's index"),
+    ] {
+        let output = mlt_render(&[
+            &scene("cornell-box.obj"),
+            &"--material",
+            &setting,
+            &"--out",
+            &temp_path("never-written.pfm"),
+        ]);
+        let line = assert_one_line_error(&output);
+        assert!(line.contains(message), "--material {setting}: {line}");
+    }
+}
+
+/// `--material` overrides what the file says: a clay render of the Cornell box is grey
+/// where the file's walls are red and green.
+#[test]
+fn material_overrides_make_a_clay_render() {
+    let out = temp_path("clay.pfm");
+    let output = mlt_render(&[
+        &scene("cornell-box.obj"),
+        &"--algorithm",
+        &"path",
+        &"--spp",
+        &"4",
+        &"--width",
+        &"16",
+        &"--height",
+        &"16",
+        &"--material",
+        &"kind=diffuse",
+        &"--material",
+        &"color=0.5,0.5,0.5",
+        &"--out",
+        &out,
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let (_, _, pixels) = mlt::io::read_pfm(&out).unwrap();
+    // Grey walls: every pixel has the light's colour (Ke 17 12 4), whose ratios the file's
+    // red and green walls would change.
+    assert!(pixels.iter().any(|&v| v > 0.0));
+    for px in pixels.chunks_exact(3) {
+        let [r, g, b] = [px[0] / 17.0, px[1] / 12.0, px[2] / 4.0];
+        assert!(
+            (r - g).abs() <= 1e-5 * r && (g - b).abs() <= 1e-5 * g,
+            "{px:?}"
         );
     }
 }

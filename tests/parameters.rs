@@ -1,26 +1,33 @@
-//! Each render setting is declared once, in `src/render/settings.rs`. This test proves that
-//! what the other languages hold follows from the declarations: the C struct and its
-//! conversions, the C++ wrapper, the Python dataclass, `docs/settings.md` and the C++ check
-//! program `c_examples/parameters.cpp` are generated from them, and must equal what is
-//! committed. `MLT_BLESS=1 cargo test --test parameters` rewrites them (then build, to
+//! Each render setting is declared once, in `src/render/settings.rs`, and each material
+//! parameter in `src/scene/material.rs`. This test proves that what the other languages hold
+//! follows from the declarations: the C structs and their conversions, the C++ wrappers, the
+//! Python dataclasses, `docs/settings.md` and the C++ check program
+//! `c_examples/parameters.cpp` are generated from them, and must equal what is committed. `MLT_BLESS=1 cargo test --test parameters` rewrites them (then build, to
 //! regenerate `include/mlt.h`). The values every front end sees are checked where each
 //! front end is run: `c_hosts.rs` (C and C++), `cli.rs` (the command line) and
 //! `python/tests/test_parameters.py`. Takes under a second.
 
-use mlt::RenderSettings;
 use mlt::params::{Kind, Parameter, Parameters, Value};
+use mlt::{Material, RenderSettings};
 use std::path::{Path, PathBuf};
 
 fn settings() -> &'static [Parameter<RenderSettings>] {
     RenderSettings::parameters()
 }
 
+fn materials() -> &'static [Parameter<Material>] {
+    Material::parameters()
+}
+
+/// The choices that have a Python enum (`python/mlt/_types.py`); the others are strings.
+const PYTHON_ENUMS: [&str; 1] = ["Algorithm"];
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// The default of `p`.
-fn default(p: &Parameter<RenderSettings>) -> Value {
+fn default<S>(p: &Parameter<S>) -> Value {
     (p.default)()
 }
 
@@ -37,7 +44,9 @@ fn float_literal(text: String) -> String {
 fn number(kind: Kind, v: &Value) -> String {
     match (kind, v) {
         (_, Value::Int(i)) => i.to_string(),
-        (Kind::F32 | Kind::F32x4, Value::Float(f)) => float_literal(short_f32(*f as f32)),
+        (Kind::F32 | Kind::F32x3 | Kind::F32x4, Value::Float(f)) => {
+            float_literal(short_f32(*f as f32))
+        }
         (_, Value::Float(f)) => float_literal(format!("{f:?}")),
         _ => unreachable!("not a number: {v:?}"),
     }
@@ -71,17 +80,29 @@ fn camel(name: &str) -> String {
         .collect()
 }
 
+/// The numbers of a value of several, as `number` writes each.
+fn numbers(kind: Kind, v: &Value) -> Vec<String> {
+    let each = |x: &f32| number(kind, &Value::Float((*x).into()));
+    match v {
+        Value::Vec3(v) => v.iter().map(each).collect(),
+        Value::Floats(v) => v.iter().map(each).collect(),
+        v => vec![number(kind, v)],
+    }
+}
+
 /// What values `p` accepts, as a sentence.
-fn valid(p: &Parameter<RenderSettings>) -> String {
+fn valid<S: Parameters>(p: &Parameter<S>) -> String {
     match (p.kind, p.rule) {
         (_, Some(rule)) => {
-            let text = rule(&RenderSettings::default());
+            let text = rule(&S::default());
             let mut c = text.chars();
             let first = c.next().map(|f| f.to_uppercase().collect::<String>());
             first.unwrap_or_default() + c.as_str()
         }
         (Kind::Bool, None) => "True or false".into(),
-        (Kind::Choice(names), None) => format!("One of {}", names.join(", ")),
+        (Kind::Choice(choices), None) => format!("One of {}", choices.names.join(", ")),
+        (Kind::Texture, None) => "None, or a texture with its transform".into(),
+        (Kind::F32 | Kind::F64 | Kind::F32x3 | Kind::F32x4, None) => "Any finite number".into(),
         _ => "Any value of its type".into(),
     }
 }
@@ -102,7 +123,7 @@ fn wrapped(prefix: &str, text: &str) -> String {
     out + &line + "\n"
 }
 
-// --- C: the struct (src/capi/types.rs) and its conversions ---
+// --- C: the structs (src/capi/types.rs) and their conversions ---
 
 fn c_type(kind: Kind) -> &'static str {
     match kind {
@@ -111,26 +132,29 @@ fn c_type(kind: Kind) -> &'static str {
         Kind::F32 => "f32",
         Kind::F64 => "f64",
         Kind::Choice(_) => "i32",
+        Kind::F32x3 => "[f32; 3]",
         Kind::F32x4 => "[f32; 4]",
+        Kind::Texture => "MltTextureRef",
     }
 }
 
 /// The C default as the header's reader writes it.
-fn c_default(p: &Parameter<RenderSettings>) -> String {
+fn c_default<S>(p: &Parameter<S>) -> String {
     match (p.kind, default(p)) {
         (_, Value::Bool(b)) => (b as u32).to_string(),
-        (_, Value::Choice(c)) => format!("`MLT_{}_{}`", upper(p.name), upper(c)),
-        (kind, Value::Floats(v)) => v.map(|x| number(kind, &Value::Float(x.into()))).join(", "),
-        (kind, v) => number(kind, &v),
+        (Kind::Choice(choices), Value::Choice(c)) => format!("`{}`", choices.c_constant(c)),
+        (_, Value::Texture(None)) => "`MLT_NO_TEXTURE` (-1)".into(),
+        (kind, v) => numbers(kind, &v).join(", "),
     }
 }
 
-fn c_struct_fields() -> String {
+fn c_struct_fields<S: Parameters>() -> String {
     let mut out = String::new();
-    for p in settings() {
+    for p in S::parameters() {
         let valid = match p.kind {
             Kind::Bool => "0 or 1".into(),
-            Kind::Choice(_) => format!("One of `MLT_{}_*`", upper(p.name)),
+            Kind::Choice(choices) => format!("One of `{}_*`", choices.c_prefix),
+            Kind::Texture => "An index into `MltSceneDesc.textures` and its transform".into(),
             _ => valid(p),
         };
         out += &wrapped(
@@ -142,49 +166,57 @@ fn c_struct_fields() -> String {
     out
 }
 
-fn names_list(indent: &str) -> String {
-    settings()
+fn names_list<S: Parameters>(indent: &str) -> String {
+    S::parameters()
         .iter()
         .map(|p| format!("{indent}{},\n", p.name))
         .collect()
 }
 
-// --- C++: include/mlt.hpp's RenderSettings ---
+// --- C++: include/mlt.hpp's RenderSettings and Material ---
 
-fn cpp_type(p: &Parameter<RenderSettings>) -> String {
+fn cpp_type<S>(p: &Parameter<S>) -> String {
     match p.kind {
         Kind::U32 => "std::uint32_t".into(),
         Kind::U64 => "std::uint64_t".into(),
         Kind::F32 => "float".into(),
         Kind::F64 => "double".into(),
         Kind::Bool => "bool".into(),
-        Kind::Choice(_) => camel(p.name),
+        Kind::Choice(choices) => choices.type_name.into(),
+        Kind::F32x3 => "std::array<float, 3>".into(),
         Kind::F32x4 => "std::array<float, 4>".into(),
+        Kind::Texture => "TextureRef".into(),
     }
 }
 
 /// `v` as a C++ expression of `p`'s type.
-fn cpp_value(p: &Parameter<RenderSettings>, v: &Value) -> String {
-    let f32_literal = |x: f32| number(Kind::F32, &Value::Float(x.into())) + "f";
-    match v {
-        Value::Bool(b) => b.to_string(),
-        Value::Choice(c) => format!("{}::{}", camel(p.name), camel(c)),
-        Value::Floats(v) => format!("{{{}}}", v.map(f32_literal).join(", ")),
-        Value::Float(x) if p.kind == Kind::F32 => f32_literal(*x as f32),
-        v => number(p.kind, v),
+fn cpp_value<S>(p: &Parameter<S>, v: &Value) -> String {
+    match (p.kind, v) {
+        (_, Value::Bool(b)) => b.to_string(),
+        (Kind::Choice(choices), Value::Choice(c)) => format!("{}::{}", choices.type_name, camel(c)),
+        (_, Value::Texture(_)) => "{}".into(),
+        (Kind::F32 | Kind::F32x3 | Kind::F32x4, v) => {
+            let floats: Vec<String> = numbers(Kind::F32, v).into_iter().map(|x| x + "f").collect();
+            match v {
+                Value::Float(_) => floats.join(""),
+                _ => format!("{{{}}}", floats.join(", ")),
+            }
+        }
+        (kind, v) => number(kind, v),
     }
 }
 
-fn cpp_members() -> String {
+fn cpp_members<S: Parameters>() -> String {
     let mut out = String::new();
-    for p in settings() {
+    for p in S::parameters() {
         out += &wrapped("    ///", p.doc);
         out += &format!(
             "    {} {}{};\n",
             cpp_type(p),
             p.name,
             match p.kind {
-                Kind::F32x4 => cpp_value(p, &default(p)),
+                Kind::Texture => String::new(),
+                Kind::F32x3 | Kind::F32x4 => cpp_value(p, &default(p)),
                 _ => format!(" = {}", cpp_value(p, &default(p))),
             }
         );
@@ -192,102 +224,144 @@ fn cpp_members() -> String {
     out
 }
 
-fn cpp_to_c() -> String {
-    settings()
+fn cpp_to_c<S: Parameters>() -> String {
+    S::parameters()
         .iter()
         .map(|p| {
             let n = p.name;
             match p.kind {
                 Kind::Bool => format!("        c.{n} = {n} ? 1u : 0u;\n"),
                 Kind::Choice(_) => format!("        c.{n} = detail::c_value({n});\n"),
-                Kind::F32x4 => format!("        detail::copy_to(c.{n}, {n});\n"),
+                Kind::F32x3 | Kind::F32x4 => format!("        detail::copy_to(c.{n}, {n});\n"),
+                Kind::Texture => format!("        c.{n} = {n}.to_c();\n"),
                 _ => format!("        c.{n} = {n};\n"),
             }
         })
         .collect()
 }
 
-fn cpp_from_c() -> String {
-    settings()
+/// The assignments of `from_c` to the C++ value `var`.
+fn cpp_from_c<S: Parameters>(var: &str) -> String {
+    S::parameters()
         .iter()
         .map(|p| {
             let n = p.name;
             match p.kind {
-                Kind::Bool => format!("        s.{n} = c.{n} != 0;\n"),
-                Kind::Choice(_) => {
-                    format!("        s.{n} = detail::from_c<{}>(c.{n});\n", camel(n))
+                Kind::Bool => format!("        {var}.{n} = c.{n} != 0;\n"),
+                Kind::Choice(choices) => format!(
+                    "        {var}.{n} = detail::from_c<{}>(c.{n});\n",
+                    choices.type_name
+                ),
+                Kind::F32x3 | Kind::F32x4 => {
+                    format!("        {var}.{n} = detail::to_array(c.{n});\n")
                 }
-                Kind::F32x4 => format!("        s.{n} = detail::to_array(c.{n});\n"),
-                _ => format!("        s.{n} = c.{n};\n"),
+                Kind::Texture => format!("        {var}.{n} = TextureRef::from_c(c.{n});\n"),
+                _ => format!("        {var}.{n} = c.{n};\n"),
             }
         })
         .collect()
 }
 
-/// The check program's body: each setting's defaults as C and C++ see them, then the
-/// message mlt gives for an out-of-range value set through each.
-fn cpp_checks() -> String {
+/// The check program's constants: every choice's C values are 0, 1, … in the declared
+/// order, which the C conversions rely on.
+fn cpp_constants() -> String {
+    let kinds = settings()
+        .iter()
+        .map(|p| p.kind)
+        .chain(materials().iter().map(|p| p.kind));
     let mut out = String::new();
-    for p in settings() {
+    for kind in kinds {
+        let Kind::Choice(choices) = kind else {
+            continue;
+        };
+        let values: Vec<String> = choices
+            .names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("{} == {i}", choices.c_constant(n)))
+            .collect();
         out += &format!(
-            "    show(\"c\", \"{n}\", c.{n});\n    show(\"c++\", \"{n}\", cpp.{n});\n",
+            "static_assert({}, \"{}_* are 0, 1, ... in the declared order\");\n",
+            values.join(" && "),
+            choices.c_prefix
+        );
+    }
+    out
+}
+
+/// The check program's body for one struct: each parameter's default as C (`c`) and C++
+/// (`cpp`) see it, then the message mlt gives for an out-of-range value set through each
+/// (`message(language, name, C struct)` prints it). Names are prefixed with `label`.
+fn cpp_checks<S: Parameters>(label: &str, cpp_struct: &str, c_struct: &str) -> String {
+    let mut out = String::new();
+    for p in S::parameters() {
+        out += &format!(
+            "    show(\"c\", \"{label}{n}\", c.{n});\n    show(\"c++\", \"{label}{n}\", cpp.{n});\n",
             n = p.name
         );
     }
-    for p in settings() {
+    for p in S::parameters() {
         let Some(bad) = p.outside_value() else {
             continue;
         };
         let n = p.name;
         let value = cpp_value(p, &bad);
-        out += &format!("    {{\n        mlt::RenderSettings s;\n        s.{n} = {value};\n");
-        out += &format!("        message(\"c++\", \"{n}\", scene, s.to_c());\n");
-        out += "        MltRenderSettings cs = c;\n";
+        out += &format!("    {{\n        mlt::{cpp_struct} s;\n        s.{n} = {value};\n");
+        out += &format!("        message(\"c++\", \"{label}{n}\", s.to_c());\n");
+        out += &format!("        {c_struct} cs = c;\n");
         out += &match p.kind {
-            Kind::F32x4 => format!(
-                "        const std::array<float, 4> bad{value};\n        for (int i = 0; i < 4; ++i) cs.{n}[i] = bad[i];\n"
+            Kind::F32x3 | Kind::F32x4 => format!(
+                "        const {} bad{value};\n        for (std::size_t i = 0; i < bad.size(); ++i) cs.{n}[i] = bad[i];\n",
+                cpp_type(p)
             ),
             _ => format!("        cs.{n} = {value};\n"),
         };
-        out += &format!("        message(\"c\", \"{n}\", scene, cs);\n    }}\n");
+        out += &format!("        message(\"c\", \"{label}{n}\", cs);\n    }}\n");
     }
     out
 }
 
-// --- Python: python/mlt/_types.py's RenderSettings ---
+// --- Python: python/mlt/_types.py's RenderSettings and Material ---
 
-fn python_type(kind: Kind) -> &'static str {
-    match kind {
-        Kind::U32 | Kind::U64 => "int",
-        Kind::F32 | Kind::F64 => "float",
-        Kind::Bool => "bool",
-        Kind::Choice(_) => "Union[Algorithm, str]",
-        Kind::F32x4 => "Tuple[float, float, float, float]",
+fn python_type<S>(p: &Parameter<S>) -> String {
+    match p.kind {
+        Kind::U32 | Kind::U64 => "int".into(),
+        Kind::F32 | Kind::F64 => "float".into(),
+        Kind::Bool => "bool".into(),
+        Kind::Choice(choices) if PYTHON_ENUMS.contains(&choices.type_name) => {
+            format!("Union[{}, str]", choices.type_name)
+        }
+        Kind::Choice(_) => "str".into(),
+        Kind::F32x3 => "Vec3".into(),
+        Kind::F32x4 => "Tuple[float, float, float, float]".into(),
+        Kind::Texture => "Optional[TextureRef]".into(),
     }
 }
 
-fn python_value(p: &Parameter<RenderSettings>, v: &Value) -> String {
-    match v {
-        Value::Bool(true) => "True".into(),
-        Value::Bool(false) => "False".into(),
-        Value::Choice(c) => format!("{}.{}", camel(p.name), upper(c)),
-        Value::Floats(v) => format!(
-            "({})",
-            v.map(|x| number(Kind::F32, &Value::Float(x.into())))
-                .join(", ")
-        ),
-        v => number(p.kind, v),
+fn python_value<S>(p: &Parameter<S>, v: &Value) -> String {
+    match (p.kind, v) {
+        (_, Value::Bool(true)) => "True".into(),
+        (_, Value::Bool(false)) => "False".into(),
+        (Kind::Choice(choices), Value::Choice(c)) if PYTHON_ENUMS.contains(&choices.type_name) => {
+            format!("{}.{}", choices.type_name, upper(c))
+        }
+        (_, Value::Choice(c)) => format!("{c:?}"),
+        (_, Value::Texture(_)) => "None".into(),
+        (_, Value::Vec3(_) | Value::Floats(_)) => {
+            format!("({})", numbers(Kind::F32, v).join(", "))
+        }
+        (kind, v) => number(kind, v),
     }
 }
 
-fn python_fields() -> String {
+fn python_fields<S: Parameters>() -> String {
     let mut out = String::new();
-    for p in settings() {
+    for p in S::parameters() {
         out += &wrapped("    #:", p.doc);
         out += &format!(
             "    {}: {} = {}\n",
             p.name,
-            python_type(p.kind),
+            python_type(p),
             python_value(p, &default(p))
         );
     }
@@ -296,47 +370,80 @@ fn python_fields() -> String {
 
 // --- docs/settings.md ---
 
+fn docs_kind(kind: Kind) -> &'static str {
+    match kind {
+        Kind::U32 => "u32",
+        Kind::U64 => "u64",
+        Kind::F32 => "f32",
+        Kind::F64 => "f64",
+        Kind::Bool => "bool",
+        Kind::Choice(_) => "name",
+        Kind::F32x3 => "3 × f32",
+        Kind::F32x4 => "4 × f32",
+        Kind::Texture => "texture",
+    }
+}
+
+fn docs_default<S>(p: &Parameter<S>) -> String {
+    match default(p) {
+        Value::Choice(c) => format!("`{c}`"),
+        Value::Bool(b) => b.to_string(),
+        Value::Texture(None) => "none".into(),
+        v => numbers(p.kind, &v).join(", "),
+    }
+}
+
 fn docs() -> String {
     let mut out = String::from(
-        "# Render settings\n\n\
-         Every setting of a render, as `src/render/settings.rs` declares it: the C field of\n\
-         `MltRenderSettings` (`include/mlt.h`), the member of `mlt::RenderSettings`\n\
-         (`include/mlt.hpp`), the Rust field of `mlt::RenderSettings`, the keyword of\n\
-         `mlt.RenderSettings` in Python and the flag of `mlt-render` all have the name, default\n\
-         and valid values below; a value outside them is refused with the same message\n\
-         everywhere, `settings.<name> is <value>; <valid values>`. Booleans are 0 or 1 in C.\n\
-         This page is generated: `MLT_BLESS=1 cargo test --test parameters` rewrites it.\n\n\
+        "# Render settings and material parameters\n\n\
+         Every setting of a render, as `src/render/settings.rs` declares it, and every parameter\n\
+         of a material, as `src/scene/material.rs` does. This page is generated:\n\
+         `MLT_BLESS=1 cargo test --test parameters` rewrites it.\n\n\
+         ## Render settings\n\n\
+         The C field of `MltRenderSettings` (`include/mlt.h`), the member of\n\
+         `mlt::RenderSettings` (`include/mlt.hpp`), the Rust field of `mlt::RenderSettings`, the\n\
+         keyword of `mlt.RenderSettings` in Python and the flag of `mlt-render` all have the\n\
+         name, default and valid values below; a value outside them is refused with the same\n\
+         message everywhere, `settings.<name> is <value>; <valid values>`. Booleans are 0 or 1\n\
+         in C.\n\n\
          | Setting | Type | Default | Valid values | Command line | What it does |\n\
          |---|---|---|---|---|---|\n",
     );
     for p in settings() {
-        let kind = match p.kind {
-            Kind::U32 => "u32",
-            Kind::U64 => "u64",
-            Kind::F32 => "f32",
-            Kind::F64 => "f64",
-            Kind::Bool => "bool",
-            Kind::Choice(_) => "name",
-            Kind::F32x4 => "4 × f32",
-        };
+        let flag = p.flag.expect("every setting has a flag");
         let flag = match p.kind {
-            Kind::Bool => format!("`--{}`", p.flag),
-            Kind::Choice(_) => format!("`--{} NAME`", p.flag),
-            Kind::U32 | Kind::U64 => format!("`--{} N`", p.flag),
-            Kind::F32x4 => format!("`--{} B,L,C,M`", p.flag),
-            Kind::F32 | Kind::F64 => format!("`--{} X`", p.flag),
-        };
-        let shown = match default(p) {
-            Value::Choice(c) => format!("`{c}`"),
-            Value::Bool(b) => b.to_string(),
-            Value::Floats(v) => v
-                .map(|x| number(Kind::F32, &Value::Float(x.into())))
-                .join(", "),
-            v => number(p.kind, &v),
+            Kind::Bool => format!("`--{flag}`"),
+            Kind::Choice(_) => format!("`--{flag} NAME`"),
+            Kind::U32 | Kind::U64 => format!("`--{flag} N`"),
+            Kind::F32x4 => format!("`--{flag} B,L,C,M`"),
+            _ => format!("`--{flag} X`"),
         };
         out += &format!(
-            "| `{}` | {kind} | {shown} | {} | {flag} | {} |\n",
+            "| `{}` | {} | {} | {} | {flag} | {} |\n",
             p.name,
+            docs_kind(p.kind),
+            docs_default(p),
+            valid(p),
+            p.doc
+        );
+    }
+    out += "\n## Material parameters\n\n\
+         The C field of `MltMaterial`, the member of `mlt::Material`, the Rust field of\n\
+         `mlt::Material` and the keyword of `mlt.Material` in Python all have the name, default\n\
+         and valid values below; a value outside them is refused with the same message\n\
+         everywhere, `desc.materials[<index>].<name> is <value>; <valid values>`. The command\n\
+         line sets a parameter on every material of the scene it loads with\n\
+         `--material NAME=VALUE` (a texture slot takes `none` or a texture's index). Every\n\
+         number must be finite. Choices are `MLT_MATERIAL_*` and `MLT_ALPHA_*` in C, texture\n\
+         slots `MltTextureRef`.\n\n\
+         | Parameter | Type | Default | Valid values | What it does |\n\
+         |---|---|---|---|---|\n";
+    for p in materials() {
+        out += &format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            p.name,
+            docs_kind(p.kind),
+            docs_default(p),
             valid(p),
             p.doc
         );
@@ -366,23 +473,58 @@ fn with_block(text: &str, tag: &str, block: &str, path: &Path) -> String {
 /// Compares each generated file with what is committed; rewrites them with `MLT_BLESS`.
 #[test]
 fn generated_code_and_docs_follow_the_declarations() {
-    let blocks: [(&str, &str, String); 9] = [
-        ("src/capi/types.rs", "render settings", c_struct_fields()),
+    type S = RenderSettings;
+    type M = Material;
+    let blocks: [(&str, &str, String); 18] = [
+        (
+            "src/capi/types.rs",
+            "render settings",
+            c_struct_fields::<S>(),
+        ),
+        ("src/capi/types.rs", "material", c_struct_fields::<M>()),
         (
             "src/capi/convert.rs",
             "settings from C",
-            names_list("        "),
+            names_list::<S>("        "),
+        ),
+        (
+            "src/capi/convert.rs",
+            "material from C",
+            names_list::<M>("        "),
         ),
         (
             "src/capi/extensible.rs",
             "settings to C",
-            names_list("            "),
+            names_list::<S>("            "),
         ),
-        ("include/mlt.hpp", "members", cpp_members()),
-        ("include/mlt.hpp", "to C", cpp_to_c()),
-        ("include/mlt.hpp", "from C", cpp_from_c()),
-        ("python/mlt/_types.py", "render settings", python_fields()),
-        ("c_examples/parameters.cpp", "checks", cpp_checks()),
+        (
+            "src/capi/extensible.rs",
+            "material to C",
+            names_list::<M>("            "),
+        ),
+        ("include/mlt.hpp", "settings members", cpp_members::<S>()),
+        ("include/mlt.hpp", "settings to C", cpp_to_c::<S>()),
+        ("include/mlt.hpp", "settings from C", cpp_from_c::<S>("s")),
+        ("include/mlt.hpp", "material members", cpp_members::<M>()),
+        ("include/mlt.hpp", "material to C", cpp_to_c::<M>()),
+        ("include/mlt.hpp", "material from C", cpp_from_c::<M>("m")),
+        (
+            "python/mlt/_types.py",
+            "render settings",
+            python_fields::<S>(),
+        ),
+        ("python/mlt/_types.py", "material", python_fields::<M>()),
+        ("c_examples/parameters.cpp", "constants", cpp_constants()),
+        (
+            "c_examples/parameters.cpp",
+            "settings checks",
+            cpp_checks::<S>("", "RenderSettings", "MltRenderSettings"),
+        ),
+        (
+            "c_examples/parameters.cpp",
+            "material checks",
+            cpp_checks::<M>("material.", "Material", "MltMaterial"),
+        ),
         ("docs/settings.md", "", docs()),
     ];
     let bless = std::env::var_os("MLT_BLESS").is_some();
@@ -405,7 +547,7 @@ fn generated_code_and_docs_follow_the_declarations() {
     }
     assert!(
         stale.is_empty(),
-        "out of date with the declarations in src/render/settings.rs: {stale:?}; run `MLT_BLESS=1 cargo test --test parameters`, then build"
+        "out of date with the declarations in src/render/settings.rs and src/scene/material.rs: {stale:?}; run `MLT_BLESS=1 cargo test --test parameters`, then build"
     );
 }
 
@@ -416,7 +558,8 @@ fn every_declaration_is_complete() {
     let mut flags = std::collections::BTreeSet::new();
     for p in settings() {
         assert!(p.doc.ends_with('.') && !p.doc.contains('\n'), "{}", p.name);
-        assert!(flags.insert(p.flag), "two settings have --{}", p.flag);
+        let flag = p.flag.expect("every setting has a flag");
+        assert!(flags.insert(flag), "two settings have --{flag}");
         assert_eq!(p.range.is_some(), p.rule.is_some(), "{}", p.name);
         let defaults = RenderSettings::default();
         assert_eq!(defaults.get(p.name), Some(default(p)), "{}", p.name);
@@ -432,6 +575,28 @@ fn every_declaration_is_complete() {
         }
     }
     RenderSettings::default().validate().unwrap();
+    for p in materials() {
+        assert!(p.doc.ends_with('.') && !p.doc.contains('\n'), "{}", p.name);
+        assert!(p.flag.is_none(), "{}: materials are set by name", p.name);
+        assert_eq!(p.range.is_some(), p.rule.is_some(), "{}", p.name);
+        assert_eq!(
+            Material::default().get(p.name),
+            Some(default(p)),
+            "{}",
+            p.name
+        );
+        if let Some(bad) = p.outside_value() {
+            let mut m = Material::default();
+            m.set(p.name, bad).unwrap();
+            let message = m.validate(3, 0).unwrap_err().message;
+            assert!(
+                message.starts_with(&format!("desc.materials[3].{}", p.name)),
+                "{}: {message}",
+                p.name
+            );
+        }
+    }
+    Material::default().validate(0, 0).unwrap();
 }
 
 /// Setting by name refuses what the field cannot hold, with the rule's message.

@@ -205,45 +205,59 @@ struct HostScene {
     colors: Vec<f32>,
 }
 
-fn texture_ref(u: &mut Unstructured, textures: usize) -> Result<MltTextureRef> {
-    Ok(MltTextureRef {
-        texture: match u.int_in_range(0u8..=7)? {
-            0..=4 => MLT_NO_TEXTURE,
-            5 | 6 => u.int_in_range(0..=textures as i32)?,
-            _ => u.arbitrary()?,
-        },
+/// The material parameters whose values are drawn from a range of their own rather than
+/// their declared one (which for these is unbounded above): dim-to-bright emission, common
+/// indices of refraction and Abbe numbers, normal scales of either sign.
+const MATERIAL_LIMITS: &[(&str, f64, f64)] = &[
+    ("emission", 0.0, 20.0),
+    ("ior", 1.0, 3.0),
+    ("alpha_cutoff", 0.0, 1.0),
+    ("normal_scale", -2.0, 2.0),
+    ("abbe_number", 0.0, 90.0),
+];
+
+/// A texture slot: mostly none; else a texture's index, or the index past the last (refused),
+/// with a transform.
+fn texture_slot(u: &mut Unstructured, textures: usize) -> Result<Value> {
+    let may_have_one = textures > 0 || u.ratio(1, 8)?;
+    if !may_have_one || u.ratio(5, 8)? {
+        return Ok(Value::Texture(None));
+    }
+    Ok(Value::Texture(Some(mlt::TextureRef {
+        texture: u.int_in_range(0..=textures as u32)?,
         offset: [float(u, -1.0, 1.0)?, float(u, -1.0, 1.0)?],
         rotation: float(u, -4.0, 4.0)?,
         scale: [float(u, -2.0, 4.0)?, float(u, -2.0, 4.0)?],
-    })
+    })))
 }
 
+/// A material, each declared parameter drawn by `parameter`, then as a C host may pass it:
+/// an older layout's `struct_size`, or values of the C types that Rust's types do not hold
+/// (an unknown kind or alpha mode, a boolean other than 0 and 1, a texture index below -1;
+/// refused).
 fn material(u: &mut Unstructured, textures: usize) -> Result<MltMaterial> {
-    let mut m = initialized(mlt_material_init);
+    let mut rust = mlt::Material::default();
+    for p in mlt::Material::parameters() {
+        let value = match p.kind {
+            Kind::Texture => texture_slot(u, textures)?,
+            _ => parameter(u, p, MATERIAL_LIMITS)?,
+        };
+        rust.set(p.name, value)
+            .expect("a value of the parameter's type");
+    }
+    let mut m = MltMaterial::from(&rust);
     m.struct_size = struct_size::<MltMaterial>(u, &[offset_of!(MltMaterial, metallic)])?;
-    m.kind = enum_int(u, 4)?;
-    m.color = float3(u, 0.0, 1.0)?;
-    // Mostly dark: one emitter among the materials is the usual scene.
-    if u.ratio(1, 3)? {
-        m.emission = float3(u, 0.0, 20.0)?;
+    if u.ratio(1, 16)? {
+        m.kind = enum_int(u, 4)?;
     }
-    if u.ratio(1, 2)? {
-        m.ior = float(u, 1.0, 3.0)?;
-        m.metallic = float(u, 0.0, 1.0)?;
-        m.roughness = float(u, 0.0, 1.0)?;
-        m.transmission = float(u, 0.0, 1.0)?;
-        m.alpha = float(u, 0.0, 1.0)?;
+    if u.ratio(1, 16)? {
         m.alpha_mode = enum_int(u, 2)?;
-        m.alpha_cutoff = float(u, 0.0, 1.0)?;
-        m.normal_scale = float(u, -2.0, 2.0)?;
-        m.energy_compensation = flag(u)?;
-        m.abbe_number = float(u, 0.0, 90.0)?;
     }
-    if textures > 0 || u.ratio(1, 8)? {
-        m.base_color_texture = texture_ref(u, textures)?;
-        m.metallic_roughness_texture = texture_ref(u, textures)?;
-        m.normal_texture = texture_ref(u, textures)?;
-        m.emission_texture = texture_ref(u, textures)?;
+    if u.ratio(1, 16)? {
+        m.energy_compensation = flag(u)?;
+    }
+    if u.ratio(1, 16)? {
+        m.normal_texture.texture = u.arbitrary()?;
     }
     Ok(m)
 }
@@ -464,15 +478,19 @@ const WORK_LIMITS: &[(&str, f64, f64)] = &[
     ("mutation_weights", 0.0, 2.0),
 ];
 
-/// A value of the declared setting `p`: sometimes one outside its range (it must be
-/// refused), else within its work limit or declared range.
-fn setting(u: &mut Unstructured, p: &Parameter<RenderSettings>) -> Result<Value> {
+/// A value of the declared parameter `p`: sometimes one outside its range (it must be
+/// refused), else within its limit in `limits` or its declared range.
+fn parameter<S>(
+    u: &mut Unstructured,
+    p: &Parameter<S>,
+    limits: &[(&str, f64, f64)],
+) -> Result<Value> {
     if let Some(bad) = p.outside_value()
         && u.ratio(1, 32)?
     {
         return Ok(bad);
     }
-    let limit = WORK_LIMITS
+    let limit = limits
         .iter()
         .find(|&&(name, ..)| name == p.name)
         .map(|&(_, lo, hi)| (lo, hi));
@@ -498,7 +516,13 @@ fn setting(u: &mut Unstructured, p: &Parameter<RenderSettings>) -> Result<Value>
         Kind::U32 | Kind::U64 => Value::Int(u.int_in_range(lo as u64..=hi as u64)?.into()),
         Kind::F32 | Kind::F64 => Value::Float(float(u, lo as f32, hi as f32)?.into()),
         Kind::Bool => Value::Bool(u.arbitrary()?),
-        Kind::Choice(names) => Value::Choice(names[u.choose_index(names.len())?]),
+        Kind::Choice(choices) => Value::Choice(choices.names[u.choose_index(choices.names.len())?]),
+        Kind::F32x3 => Value::Vec3([
+            float(u, lo as f32, hi as f32)?,
+            float(u, lo as f32, hi as f32)?,
+            float(u, lo as f32, hi as f32)?,
+        ]),
+        Kind::Texture => Value::Texture(None),
         Kind::F32x4 => Value::Floats([
             float(u, lo as f32, hi as f32)?,
             float(u, lo as f32, hi as f32)?,
@@ -508,13 +532,13 @@ fn setting(u: &mut Unstructured, p: &Parameter<RenderSettings>) -> Result<Value>
     })
 }
 
-/// Render settings, each declared setting drawn by `setting`, then as a C host may pass
+/// Render settings, each declared setting drawn by `parameter`, then as a C host may pass
 /// them: an older layout's `struct_size`, or values of the C types that Rust's types do not
 /// hold (an unknown algorithm, a boolean other than 0 and 1; refused).
 fn settings(u: &mut Unstructured) -> Result<MltRenderSettings> {
     let mut rust = RenderSettings::default();
     for p in RenderSettings::parameters() {
-        let value = setting(u, p)?;
+        let value = parameter(u, p, WORK_LIMITS)?;
         rust.set(p.name, value)
             .expect("a value of the setting's type");
     }

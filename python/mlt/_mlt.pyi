@@ -28,6 +28,7 @@ __all__ = [
     "load_environment",
     "_defaults_mismatches",
     "_settings_declarations",
+    "_material_declarations",
     "__version__",
     "EMBREE_AVAILABLE",
 ]
@@ -244,3 +245,4 @@ def _defaults_mismatches(
     settings: RenderSettings, camera: Camera, material: Material
 ) -> list[Tuple[str, str, str]]: ...
 def _settings_declarations() -> list[Tuple[str, object, Optional[object], Optional[str]]]: ...
+def _material_declarations() -> list[Tuple[str, object, Optional[object], Optional[str]]]: ...

@@ -71,8 +71,8 @@ class Material:
 
     Any material emits ``emission`` (linear RGB radiance) from its front side
     (counter-clockwise winding): emissive triangles are area lights. Colours are linear
-    RGB in [0, 1]. The defaults are ``mlt::Material::diffuse``'s, with the loaders'
-    0.8 grey albedo.
+    RGB in [0, 1]. The defaults are ``mlt::Material``'s, a light grey (0.8) diffuse surface;
+    ``docs/settings.md`` lists every field with its valid values.
 
     Textures (``TextureRef``) refer to ``Scene.from_arrays(textures=...)`` and need
     ``texcoords``: ``base_color_texture`` multiplies ``color`` and ``alpha``,
@@ -86,23 +86,51 @@ class Material:
     spectral renders.
     """
 
+    # BEGIN GENERATED material: tests/parameters.rs writes these lines from src/scene/material.rs
+    #: The scattering model: diffuse (Lambertian), mirror, dielectric (smooth glass) or
+    #: metallic-roughness (glTF 2.0's).
     kind: str = "diffuse"
+    #: Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour, linear RGB.
     color: Vec3 = (0.8, 0.8, 0.8)
+    #: Radiance emitted from the front (counter-clockwise) side, linear RGB; emissive triangles are
+    #: area lights.
     emission: Vec3 = (0.0, 0.0, 0.0)
+    #: Index of refraction of a dielectric and of the metallic-roughness model's dielectric part
+    #: (there > 0).
     ior: float = 1.5
+    #: Metallic-roughness: metalness, 0 a dielectric, 1 a metal whose reflectance is the colour.
     metallic: float = 0.0
+    #: Metallic-roughness: perceptual roughness (GGX alpha = roughness squared; 0 is the exact
+    #: specular lobe).
     roughness: float = 1.0
+    #: Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely
+    #: reflected (KHR_materials_transmission).
     transmission: float = 0.0
+    #: Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
+    #: alpha mode.
     alpha: float = 1.0
+    #: What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
+    #: (glTF's MASK).
     alpha_mode: str = "opaque"
+    #: The mask alpha mode's threshold (glTF's alphaCutoff).
     alpha_cutoff: float = 0.5
+    #: Multiplies the colour (RGB) and alpha (A), for every kind; usually 8-bit sRGB.
     base_color_texture: Optional[TextureRef] = None
+    #: Green multiplies the roughness, blue the metalness (glTF's packing); usually linear.
     metallic_roughness_texture: Optional[TextureRef] = None
+    #: A tangent-space normal map (glTF's convention: +Y up in the image); usually linear.
     normal_texture: Optional[TextureRef] = None
-    normal_scale: float = 1.0
+    #: Multiplies the emission; usually 8-bit sRGB.
     emission_texture: Optional[TextureRef] = None
+    #: Scales the normal map's x and y (glTF's normalTexture.scale).
+    normal_scale: float = 1.0
+    #: Metallic-roughness: give rough metals the light glTF's single-scattering model loses (Kulla
+    #: and Conty 2017).
     energy_compensation: bool = False
+    #: Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 /
+    #: V_d); spectral renders only.
     abbe_number: float = 0.0
+    # END GENERATED material
 
     @classmethod
     def diffuse(cls, albedo: Sequence[float], emission: Sequence[float] = (0.0, 0.0, 0.0)) -> Material:

@@ -5,9 +5,9 @@ use crate::arrays::{self, Array};
 use crate::errors::{invalid, with_context};
 use mlt::params::{ChoiceParameter, Kind, Parameters, Value};
 use mlt::{
-    Algorithm, AlphaMode, Backend, BuildQuality, Camera, Material, MaterialKind, PunctualLight,
-    PunctualLightKind, RenderSettings, SunDesc, TexelData, TextureDesc, TextureEncoding,
-    TextureFilter, TextureRef, WrapMode,
+    Algorithm, Backend, BuildQuality, Camera, Material, PunctualLight, PunctualLightKind,
+    RenderSettings, SunDesc, TexelData, TextureDesc, TextureEncoding, TextureFilter, TextureRef,
+    WrapMode,
 };
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -77,13 +77,6 @@ fn same_name(a: &str, b: &str) -> bool {
     a.len() == b.len() && a.chars().map(canonical).eq(b.chars().map(canonical))
 }
 
-const MATERIAL_KINDS: [(&str, MaterialKind); 4] = [
-    ("diffuse", MaterialKind::Diffuse),
-    ("mirror", MaterialKind::Mirror),
-    ("dielectric", MaterialKind::Dielectric),
-    ("metallic_roughness", MaterialKind::MetallicRoughness),
-];
-
 const BACKENDS: [(&str, Backend); 2] = [("bvh", Backend::Bvh), ("embree", Backend::Embree)];
 
 pub fn backend(py: Python<'_>, name: &str) -> PyResult<Backend> {
@@ -115,36 +108,49 @@ pub fn camera(obj: &Bound<'_, PyAny>) -> PyResult<Camera> {
 /// The settings of `obj`, one attribute per declared setting (`mlt::params`): a value of
 /// the wrong type or out of range is refused with the message every front end gives.
 pub fn settings(obj: &Bound<'_, PyAny>) -> PyResult<RenderSettings> {
+    parameters(obj, "RenderSettings")
+}
+
+/// The struct of parameters `S` read from `obj`, one attribute per declared parameter
+/// (`mlt::params`), `owner` naming it in messages. What the type cannot hold is refused
+/// here; the ranges are checked by Rust's validation.
+fn parameters<S: Parameters>(obj: &Bound<'_, PyAny>, owner: &str) -> PyResult<S> {
     let py = obj.py();
-    let owner = "RenderSettings";
-    let mut settings = RenderSettings::default();
-    for p in RenderSettings::parameters() {
+    let mut values = S::default();
+    for p in S::parameters() {
         let name = p.name;
         let value = match p.kind {
             Kind::U32 | Kind::U64 => Value::Int(field::<i128>(obj, owner, name)?),
             Kind::F32 | Kind::F64 => Value::Float(field::<f64>(obj, owner, name)?),
             Kind::Bool => Value::Bool(field::<bool>(obj, owner, name)?),
+            Kind::F32x3 => Value::Vec3(field::<[f32; 3]>(obj, owner, name)?),
             Kind::F32x4 => Value::Floats(field::<[f32; 4]>(obj, owner, name)?),
-            Kind::Choice(names) => {
+            Kind::Texture => Value::Texture(texture_ref(obj, owner, name)?),
+            Kind::Choice(choices) => {
                 let given = name_field(obj, owner, name)?;
-                let choice = names.iter().find(|n| same_name(n, &given)).ok_or_else(|| {
-                    let names: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
-                    invalid(
-                        py,
-                        &format!(
-                            "{owner}.{name} is {given:?}; expected one of {}",
-                            names.join(", ")
-                        ),
-                    )
-                })?;
+                let choice = choices
+                    .names
+                    .iter()
+                    .find(|n| same_name(n, &given))
+                    .ok_or_else(|| {
+                        let names: Vec<String> =
+                            choices.names.iter().map(|n| format!("{n:?}")).collect();
+                        invalid(
+                            py,
+                            &format!(
+                                "{owner}.{name} is {given:?}; expected one of {}",
+                                names.join(", ")
+                            ),
+                        )
+                    })?;
                 Value::Choice(choice)
             }
         };
-        settings
+        values
             .set(name, value)
             .map_err(|e| crate::errors::from_mlt(py, &e))?;
     }
-    Ok(settings)
+    Ok(values)
 }
 
 /// The Python float that prints as `value` does (0.3f32 as 0.3, not 0.30000001192092896),
@@ -161,25 +167,43 @@ pub fn algorithm_name(algorithm: Algorithm) -> &'static str {
 
 static SETTINGS_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
-/// A setting's value as `mlt.RenderSettings` holds it.
-pub fn setting_to_py<'py>(
-    py: Python<'py>,
-    kind: Kind,
-    value: Value,
-) -> PyResult<Bound<'py, PyAny>> {
+/// A parameter's value as the Python dataclasses (`mlt.RenderSettings`, `mlt.Material`)
+/// hold it.
+pub fn value_to_py<'py>(py: Python<'py>, kind: Kind, value: Value) -> PyResult<Bound<'py, PyAny>> {
     Ok(match (kind, value) {
         (_, Value::Int(v)) => v.into_pyobject(py)?.into_any(),
         (Kind::F32, Value::Float(v)) => shortest(v as f32).into_pyobject(py)?.into_any(),
         (_, Value::Float(v)) => v.into_pyobject(py)?.into_any(),
         (_, Value::Bool(v)) => v.into_pyobject(py)?.to_owned().into_any(),
+        (_, Value::Vec3(v)) => {
+            let [a, b, c] = v.map(shortest);
+            (a, b, c).into_pyobject(py)?.into_any()
+        }
         (_, Value::Floats(v)) => {
             let [a, b, c, d] = v.map(shortest);
             (a, b, c, d).into_pyobject(py)?.into_any()
         }
-        (_, Value::Choice(name)) => ALGORITHM_CLASS
-            .import(py, "mlt._types", "Algorithm")?
-            .call1((name,))?,
+        (_, Value::Texture(None)) => py.None().into_bound(py),
+        (_, Value::Texture(Some(t))) => TEXTURE_REF_CLASS
+            .import(py, "mlt._types", "TextureRef")?
+            .call1((
+            t.texture,
+            shortest_pair(t.offset),
+            t.rotation,
+            shortest_pair(t.scale),
+        ))?,
+        (Kind::Choice(choices), Value::Choice(name)) if choices.type_name == "Algorithm" => {
+            ALGORITHM_CLASS
+                .import(py, "mlt._types", "Algorithm")?
+                .call1((name,))?
+        }
+        (_, Value::Choice(name)) => name.into_pyobject(py)?.into_any(),
     })
+}
+static TEXTURE_REF_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
+
+fn shortest_pair(v: [f32; 2]) -> (f64, f64) {
+    (shortest(v[0]), shortest(v[1]))
 }
 static ALGORITHM_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
@@ -191,7 +215,7 @@ pub fn settings_to_py<'py>(
     let kwargs = PyDict::new(py);
     for p in RenderSettings::parameters() {
         let value = settings.get(p.name).expect("a declared setting");
-        kwargs.set_item(p.name, setting_to_py(py, p.kind, value)?)?;
+        kwargs.set_item(p.name, value_to_py(py, p.kind, value)?)?;
     }
     SETTINGS_CLASS
         .import(py, "mlt._types", "RenderSettings")?
@@ -201,7 +225,8 @@ pub fn settings_to_py<'py>(
 static MATERIAL_CLASS: PyOnceLock<Py<PyType>> = PyOnceLock::new();
 
 /// A material: an `mlt.Material` (or an object with its attributes), or a dict of its
-/// fields (`{"kind": "diffuse", "color": (1, 0, 0)}`; unknown keys are an error).
+/// fields (`{"kind": "diffuse", "color": (1, 0, 0)}`; unknown keys are an error), one
+/// attribute per declared material parameter.
 pub fn material(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Material> {
     let py = obj.py();
     let owner = format!("materials[{index}]");
@@ -216,34 +241,7 @@ pub fn material(obj: &Bound<'_, PyAny>, index: usize) -> PyResult<Material> {
         }
         Err(_) => obj,
     };
-    let owner = owner.as_str();
-    let kind = name_field(obj, owner, "kind")?;
-    let alpha_mode = name_field(obj, owner, "alpha_mode")?;
-    Ok(Material {
-        kind: choose(py, owner, "kind", &kind, &MATERIAL_KINDS)?,
-        color: field(obj, owner, "color")?,
-        emission: field(obj, owner, "emission")?,
-        ior: field(obj, owner, "ior")?,
-        metallic: field(obj, owner, "metallic")?,
-        roughness: field(obj, owner, "roughness")?,
-        transmission: field(obj, owner, "transmission")?,
-        alpha: field(obj, owner, "alpha")?,
-        alpha_mode: choose(
-            py,
-            owner,
-            "alpha_mode",
-            &alpha_mode,
-            &[("opaque", AlphaMode::Opaque), ("mask", AlphaMode::Mask)],
-        )?,
-        alpha_cutoff: field(obj, owner, "alpha_cutoff")?,
-        base_color_texture: texture_ref(obj, owner, "base_color_texture")?,
-        metallic_roughness_texture: texture_ref(obj, owner, "metallic_roughness_texture")?,
-        normal_texture: texture_ref(obj, owner, "normal_texture")?,
-        normal_scale: field(obj, owner, "normal_scale")?,
-        emission_texture: texture_ref(obj, owner, "emission_texture")?,
-        energy_compensation: field(obj, owner, "energy_compensation")?,
-        abbe_number: field(obj, owner, "abbe_number")?,
-    })
+    parameters(obj, &owner)
 }
 
 fn texture_ref(obj: &Bound<'_, PyAny>, owner: &str, name: &str) -> PyResult<Option<TextureRef>> {

@@ -44,30 +44,42 @@ fn _defaults_mismatches(
     check(
         "Material",
         format!("{:?}", convert::material(material, 0)?),
-        // The loaders' default albedo (a Rust material has no default colour).
-        format!("{:?}", mlt::Material::diffuse([0.8; 3])),
+        format!("{:?}", mlt::Material::default()),
     );
     Ok(mismatches)
 }
 
-/// Each declared render setting as `(name, default, outside, message)`: its default as
-/// `mlt.RenderSettings` holds it, a value outside its range (or None) and the message
-/// Rust's validation gives for it, for the test that Python agrees.
+/// Every declared render setting as `(name, default, a value outside its range or None,
+/// the message that value gets)`: what `tests/test_parameters.py` checks `mlt.RenderSettings`
+/// against.
 #[pyfunction]
-fn _settings_declarations(py: Python<'_>) -> PyResult<Vec<SettingDeclaration<'_>>> {
-    use mlt::params::Parameters;
-    mlt::RenderSettings::parameters()
+fn _settings_declarations(py: Python<'_>) -> PyResult<Vec<Declaration<'_>>> {
+    declarations::<mlt::RenderSettings>(py, |s| s.validate())
+}
+
+/// Every declared material parameter, as `_settings_declarations` (the message names the
+/// scene's first material).
+#[pyfunction]
+fn _material_declarations(py: Python<'_>) -> PyResult<Vec<Declaration<'_>>> {
+    declarations::<mlt::Material>(py, |m| m.validate(0, 0))
+}
+
+fn declarations<S: mlt::params::Parameters>(
+    py: Python<'_>,
+    validate: fn(&S) -> mlt::Result<()>,
+) -> PyResult<Vec<Declaration<'_>>> {
+    S::parameters()
         .iter()
         .map(|p| {
-            let default = convert::setting_to_py(py, p.kind, (p.default)())?;
+            let default = convert::value_to_py(py, p.kind, (p.default)())?;
             let (outside, message) = match p.outside_value() {
                 Some(bad) => {
-                    let mut settings = mlt::RenderSettings::default();
-                    settings
+                    let mut values = S::default();
+                    values
                         .set(p.name, bad)
                         .map_err(|e| errors::from_mlt(py, &e))?;
-                    let message = settings.validate().err().map(|e| e.message);
-                    (Some(convert::setting_to_py(py, p.kind, bad)?), message)
+                    let message = validate(&values).err().map(|e| e.message);
+                    (Some(convert::value_to_py(py, p.kind, bad)?), message)
                 }
                 None => (None, None),
             };
@@ -76,7 +88,7 @@ fn _settings_declarations(py: Python<'_>) -> PyResult<Vec<SettingDeclaration<'_>
         .collect()
 }
 
-type SettingDeclaration<'py> = (
+type Declaration<'py> = (
     &'static str,
     Bound<'py, PyAny>,
     Option<Bound<'py, PyAny>>,
@@ -103,6 +115,7 @@ fn _mlt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load_environment, m)?)?;
     m.add_function(wrap_pyfunction!(_defaults_mismatches, m)?)?;
     m.add_function(wrap_pyfunction!(_settings_declarations, m)?)?;
+    m.add_function(wrap_pyfunction!(_material_declarations, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("EMBREE_AVAILABLE", mlt::Backend::Embree.is_available())?;
     Ok(())

@@ -93,9 +93,9 @@ def test_error_carries_status_code_and_message() -> None:
 
 
 def test_bad_materials() -> None:
-    with invalid(r'materials\[0\].kind is "plastic"; expected one of "diffuse", "mirror", "dielectric", "metallic_roughness"$'):
+    with invalid(r'materials\[0\].kind is "plastic"; expected one of "diffuse", "mirror", "dielectric", "metallic-roughness"$'):
         build(materials=[mlt.Material(kind="plastic")])
-    with invalid(r"desc.materials\[1\].color.y is 1.5; a reflectance above 1 would create energy"):
+    with invalid(r"desc.materials\[1\].color.y is 1.5; a reflectance must be in \[0, 1\]; above 1 would create energy"):
         build(materials=[mlt.Material(), mlt.Material(color=(0.5, 1.5, 0.5))])
     with pytest.raises(TypeError, match=r"materials\[0\]: .*unexpected keyword argument 'colour'"):
         build(materials=[{"colour": (1, 0, 0)}])

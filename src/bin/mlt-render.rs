@@ -8,7 +8,9 @@ use clap::{Arg, ArgAction, ArgMatches, Parser, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mlt::io::{CameraFile, ImageFormat};
 use mlt::params::{ChoiceParameter, Kind, Parameters, Value};
-use mlt::{EnvironmentDesc, LightsDesc, RenderSettings, RenderStats, Scene, StopReason, SunDesc};
+use mlt::{
+    EnvironmentDesc, LightsDesc, Material, RenderSettings, RenderStats, Scene, StopReason, SunDesc,
+};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -33,41 +35,100 @@ fn flag_text(kind: Kind, value: Value) -> String {
 }
 
 /// Parses a flag's text into a value of `kind` (the range is checked with the others).
-fn parse_setting(kind: Kind, text: &str) -> Result<Value, String> {
+fn parse_value(kind: Kind, text: &str) -> Result<Value, String> {
     let text = text.trim();
     let float = |t: &str| t.trim().parse::<f32>().map_err(|e| format!("{t:?}: {e}"));
+    let floats = |n: usize| -> Result<Vec<f32>, String> {
+        let values: Vec<f32> = text.split(',').map(float).collect::<Result<_, _>>()?;
+        if values.len() == n {
+            Ok(values)
+        } else {
+            Err(format!("{n} numbers are needed, not {}", values.len()))
+        }
+    };
+    let integer = |t: &str| t.parse::<i128>().map_err(|e| format!("{t:?}: {e}"));
     match kind {
-        Kind::U32 | Kind::U64 => text
-            .parse::<i128>()
-            .map(Value::Int)
-            .map_err(|e| format!("{text:?}: {e}")),
+        Kind::U32 | Kind::U64 => integer(text).map(Value::Int),
         Kind::F32 => float(text).map(|v| Value::Float(v.into())),
         Kind::F64 => text
             .parse::<f64>()
             .map(Value::Float)
             .map_err(|e| format!("{text:?}: {e}")),
-        Kind::F32x4 => {
-            let values: Vec<f32> = text.split(',').map(float).collect::<Result<_, _>>()?;
-            <[f32; 4]>::try_from(values.as_slice())
-                .map(Value::Floats)
-                .map_err(|_| format!("four numbers are needed, not {}", values.len()))
+        Kind::Bool => match text {
+            "true" | "1" => Ok(Value::Bool(true)),
+            "false" | "0" => Ok(Value::Bool(false)),
+            _ => Err(format!("{text:?}: expected true or false")),
+        },
+        Kind::Choice(choices) => {
+            let canonical = |c: char| match c {
+                '_' => '-',
+                c => c.to_ascii_lowercase(),
+            };
+            let given: String = text.chars().map(canonical).collect();
+            choices
+                .names
+                .iter()
+                .find(|&&n| n == given)
+                .map(|&n| Value::Choice(n))
+                .ok_or_else(|| format!("{text:?}: expected one of {}", choices.names.join(", ")))
         }
-        Kind::Bool | Kind::Choice(_) => unreachable!("flags without a parser"),
+        Kind::F32x3 => floats(3).map(|v| Value::Vec3([v[0], v[1], v[2]])),
+        Kind::F32x4 => floats(4).map(|v| Value::Floats([v[0], v[1], v[2], v[3]])),
+        Kind::Texture => match text {
+            "none" => Ok(Value::Texture(None)),
+            _ => u32::try_from(integer(text)?)
+                .map(|i| Value::Texture(Some(mlt::TextureRef::new(i))))
+                .map_err(|_| format!("{text:?}: expected none or a texture's index")),
+        },
     }
+}
+
+/// `--material NAME=VALUE`: a declared material parameter and its value.
+fn parse_material_parameter(text: &str) -> Result<(&'static str, Value), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("{text:?}: expected NAME=VALUE"))?;
+    let p = Material::parameter(name.trim()).ok_or_else(|| {
+        let names: Vec<&str> = Material::parameters().iter().map(|p| p.name).collect();
+        format!(
+            "{name:?} is not a material parameter; they are {}",
+            names.join(", ")
+        )
+    })?;
+    Ok((p.name, parse_value(p.kind, value)?))
+}
+
+/// `--material`'s long help: every declared parameter with its default.
+fn material_help() -> String {
+    let mut help = String::from(
+        "Set a parameter of every material of the scene, after the file's values (a clay \
+         render: --material kind=diffuse --material color=0.8,0.8,0.8); repeatable. A texture \
+         slot takes none or a texture's index. The parameters, with mlt's defaults:",
+    );
+    for p in Material::parameters() {
+        help += &format!(
+            "\n  {}  {} [default: {}]",
+            p.name,
+            p.doc,
+            flag_text(p.kind, (p.default)())
+        );
+    }
+    help
 }
 
 impl clap::Args for SettingsArgs {
     fn augment_args(mut command: clap::Command) -> clap::Command {
         for p in RenderSettings::parameters() {
-            let mut arg = Arg::new(p.name).long(p.flag).help(p.doc);
+            let flag = p.flag.expect("every setting has a flag");
+            let mut arg = Arg::new(p.name).long(flag).help(p.doc);
             let full_name = p.name.replace('_', "-");
-            if full_name != p.flag {
+            if full_name != flag {
                 arg = arg.visible_alias(full_name);
             }
             let kind = p.kind;
             arg = match kind {
                 Kind::Bool => arg.action(ArgAction::SetTrue),
-                Kind::Choice(names) => arg.value_parser(
+                Kind::Choice(&mlt::params::Choices { names, .. }) => arg.value_parser(
                     PossibleValuesParser::new(names.iter().copied()).map(move |name| {
                         Value::Choice(names.iter().find(|&&n| n == name).expect("a choice"))
                     }),
@@ -79,9 +140,7 @@ impl clap::Args for SettingsArgs {
                         Kind::F32x4 => "B,L,C,M",
                         _ => "X",
                     })
-                    .value_parser(ValueParser::new(move |text: &str| {
-                        parse_setting(kind, text)
-                    })),
+                    .value_parser(ValueParser::new(move |text: &str| parse_value(kind, text))),
             };
             if !FROM_CAMERA.contains(&p.name) && kind != Kind::Bool {
                 arg = arg.default_value(flag_text(kind, (p.default)()));
@@ -247,6 +306,9 @@ struct Args {
     /// stronger). Seen in --spectral renders only.
     #[arg(long, value_name = "V")]
     abbe_number: Option<f32>,
+    /// Set a material parameter on every material (see the long help, --help).
+    #[arg(long = "material", value_name = "NAME=VALUE", value_parser = parse_material_parameter, allow_hyphen_values = true)]
+    material: Vec<(&'static str, Value)>,
     /// Metropolis and ERPT: filter the image's blotchy noise after the render (non-local
     /// means guided by variances measured from partial images; keeps the total), with 8
     /// partial images unless --filter-buffers says otherwise.
@@ -290,7 +352,12 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    let args = match Args::try_parse() {
+    use clap::{CommandFactory, FromArgMatches};
+    let command = Args::command().mut_arg("material", |arg| arg.long_help(material_help()));
+    let args = match command
+        .try_get_matches()
+        .and_then(|matches| Args::from_arg_matches(&matches))
+    {
         Ok(args) => args,
         Err(e) => {
             use clap::error::ErrorKind;
@@ -331,6 +398,11 @@ fn run(args: &Args) -> Result<(), String> {
     let load_start = Instant::now();
     let mut data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
     data.override_materials(args.energy_compensation, args.abbe_number);
+    for material in &mut data.materials {
+        for &(name, value) in &args.material {
+            material.set(name, value).map_err(|e| e.message)?;
+        }
+    }
     let framed = data.camera.is_none() && args.camera.is_none();
     let camera_file = match &args.camera {
         Some(path) => mlt::io::load_camera_json(path).map_err(|e| e.to_string())?,

@@ -5,81 +5,47 @@ use super::types::*;
 use crate::accel::{Backend, BuildQuality};
 use crate::error::*;
 use crate::integrators::mlt::driver::MutationWeights;
-use crate::render::{Algorithm, RenderSettings, RenderStats};
-use crate::scene::{
-    AlphaMode, Camera, Material, MaterialKind, PunctualLight, PunctualLightKind, SunDesc,
-    TextureRef,
-};
+use crate::params::ChoiceParameter;
+use crate::render::{RenderSettings, RenderStats};
+use crate::scene::{Camera, Material, PunctualLight, PunctualLightKind, SunDesc, TextureRef};
 use crate::texture::{TextureEncoding, TextureFilter, WrapMode};
 use glam::Vec3A;
 
-pub(super) fn material_kind(kind: i32, index: usize) -> Result<MaterialKind> {
-    match kind {
-        MLT_MATERIAL_DIFFUSE => Ok(MaterialKind::Diffuse),
-        MLT_MATERIAL_MIRROR => Ok(MaterialKind::Mirror),
-        MLT_MATERIAL_DIELECTRIC => Ok(MaterialKind::Dielectric),
-        MLT_MATERIAL_METALLIC_ROUGHNESS => Ok(MaterialKind::MetallicRoughness),
-        other => Err(Error::invalid(format!(
-            "desc.materials[{index}].kind is {other}; use MLT_MATERIAL_DIFFUSE (0), MLT_MATERIAL_MIRROR (1), MLT_MATERIAL_DIELECTRIC (2) or MLT_MATERIAL_METALLIC_ROUGHNESS (3)"
-        ))),
-    }
-}
-
 /// The host's material `index`; its values are validated with the scene (`Material::validate`),
-/// its enums and texture indices below -1 here.
+/// its choices and texture indices below -1 here.
 pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
-    let name = format!("desc.materials[{index}]");
-    let alpha_mode = match m.alpha_mode {
-        MLT_ALPHA_OPAQUE => AlphaMode::Opaque,
-        MLT_ALPHA_MASK => AlphaMode::Mask,
-        other => {
-            return Err(Error::invalid(format!(
-                "{name}.alpha_mode is {other}; use MLT_ALPHA_OPAQUE (0) or MLT_ALPHA_MASK (1)"
-            )));
-        }
-    };
-    let slot = |field: &str, r: &MltTextureRef| texture_ref(r, &format!("{name}.{field}"));
-    Ok(Material {
-        kind: material_kind(m.kind, index)?,
-        color: m.color,
-        emission: m.emission,
-        ior: m.ior,
-        metallic: m.metallic,
-        roughness: m.roughness,
-        transmission: m.transmission,
-        alpha: m.alpha,
+    let name = |field: &str| format!("desc.materials[{index}].{field}");
+    macro_rules! from_c {
+        ($($field:ident,)*) => {
+            // The defaults fill in a parameter declared since the list was generated, so
+            // that the crate builds to run the generator (`tests/parameters.rs`).
+            #[allow(clippy::needless_update)]
+            Ok(Material {
+                $($field: CField::from_c(m.$field, &name(stringify!($field)))?,)*
+                ..Material::default()
+            })
+        };
+    }
+    from_c! {
+        // BEGIN GENERATED material from C: tests/parameters.rs writes these lines from src/scene/material.rs
+        kind,
+        color,
+        emission,
+        ior,
+        metallic,
+        roughness,
+        transmission,
+        alpha,
         alpha_mode,
-        alpha_cutoff: m.alpha_cutoff,
-        base_color_texture: slot("base_color_texture", &m.base_color_texture)?,
-        metallic_roughness_texture: slot(
-            "metallic_roughness_texture",
-            &m.metallic_roughness_texture,
-        )?,
-        normal_texture: slot("normal_texture", &m.normal_texture)?,
-        normal_scale: m.normal_scale,
-        emission_texture: slot("emission_texture", &m.emission_texture)?,
-        energy_compensation: flag(
-            m.energy_compensation,
-            &format!("{name}.energy_compensation"),
-        )?,
-        abbe_number: m.abbe_number,
-    })
-}
-
-/// A texture slot: `MLT_NO_TEXTURE` is none; an index at or past the texture count is
-/// refused by the scene's validation (`TextureRef::validate`), one below -1 here.
-fn texture_ref(r: &MltTextureRef, name: &str) -> Result<Option<TextureRef>> {
-    match r.texture {
-        MLT_NO_TEXTURE => Ok(None),
-        index if index < 0 => Err(Error::invalid(format!(
-            "{name}.texture is {index}; use an index into desc.textures, or MLT_NO_TEXTURE (-1) for none"
-        ))),
-        index => Ok(Some(TextureRef {
-            texture: index as u32,
-            offset: r.offset,
-            rotation: r.rotation,
-            scale: r.scale,
-        })),
+        alpha_cutoff,
+        base_color_texture,
+        metallic_roughness_texture,
+        normal_texture,
+        emission_texture,
+        normal_scale,
+        energy_compensation,
+        abbe_number,
+        // END GENERATED material from C
     }
 }
 
@@ -226,18 +192,6 @@ impl From<&MltCamera> for Camera {
     }
 }
 
-pub(super) fn algorithm_to_c(algorithm: Algorithm) -> i32 {
-    match algorithm {
-        Algorithm::Path => MLT_ALGORITHM_PATH,
-        Algorithm::Bdpt => MLT_ALGORITHM_BDPT,
-        Algorithm::Pssmlt => MLT_ALGORITHM_PSSMLT,
-        Algorithm::Mmlt => MLT_ALGORITHM_MMLT,
-        Algorithm::PssmltBdpt => MLT_ALGORITHM_PSSMLT_BDPT,
-        Algorithm::PathSpaceMlt => MLT_ALGORITHM_PATH_SPACE_MLT,
-        Algorithm::Erpt => MLT_ALGORITHM_ERPT,
-    }
-}
-
 /// The host's settings as Rust's; every field a setting (see `CField`).
 pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
     macro_rules! from_c {
@@ -304,7 +258,7 @@ macro_rules! same_in_c {
         }
     )*};
 }
-same_in_c!(u32, u64, f32, f64);
+same_in_c!(u32, u64, f32, f64, [f32; 3]);
 
 impl CField for bool {
     type C = u32;
@@ -326,26 +280,74 @@ impl CField for MutationWeights {
     }
 }
 
-impl CField for Algorithm {
+/// A choice is its index in C: the constants `MLT_<PREFIX>_<NAME>` are 0, 1, … in the
+/// declared order (`c_examples/parameters.cpp` checks the header's against it).
+impl<T: ChoiceParameter> CField for T {
     type C = i32;
     fn to_c(self) -> i32 {
-        algorithm_to_c(self)
+        T::ALL
+            .iter()
+            .position(|&v| v == self)
+            .expect("ALL holds every value") as i32
     }
-    fn from_c(value: i32, name: &str) -> Result<Algorithm> {
-        match value {
-            MLT_ALGORITHM_PATH => Ok(Algorithm::Path),
-            MLT_ALGORITHM_BDPT => Ok(Algorithm::Bdpt),
-            MLT_ALGORITHM_PSSMLT => Ok(Algorithm::Pssmlt),
-            MLT_ALGORITHM_MMLT => Ok(Algorithm::Mmlt),
-            MLT_ALGORITHM_PSSMLT_BDPT => Ok(Algorithm::PssmltBdpt),
-            MLT_ALGORITHM_PATH_SPACE_MLT => Ok(Algorithm::PathSpaceMlt),
-            MLT_ALGORITHM_ERPT => Ok(Algorithm::Erpt),
-            other => Err(Error::invalid(format!(
-                "{name} is {other}; use MLT_ALGORITHM_PATH (0), MLT_ALGORITHM_BDPT (1), MLT_ALGORITHM_PSSMLT (2), MLT_ALGORITHM_MMLT (3), MLT_ALGORITHM_PSSMLT_BDPT (4), MLT_ALGORITHM_PATH_SPACE_MLT (5) or MLT_ALGORITHM_ERPT (6)"
+    fn from_c(value: i32, name: &str) -> Result<T> {
+        usize::try_from(value)
+            .ok()
+            .and_then(|i| T::ALL.get(i))
+            .copied()
+            .ok_or_else(|| {
+                let constants: Vec<String> = T::NAMES
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| format!("{} ({i})", T::CHOICES.c_constant(n)))
+                    .collect();
+                let (last, rest) = constants.split_last().expect("a choice has names");
+                Error::invalid(format!(
+                    "{name} is {value}; use {} or {last}",
+                    rest.join(", ")
+                ))
+            })
+    }
+}
+
+/// A material's texture slot: `MLT_NO_TEXTURE` is none; an index at or past the texture
+/// count is refused by the scene's validation (`TextureRef::validate`), one below -1 here.
+impl CField for Option<TextureRef> {
+    type C = MltTextureRef;
+    fn to_c(self) -> MltTextureRef {
+        match self {
+            None => NO_TEXTURE,
+            Some(r) => MltTextureRef {
+                texture: r.texture as i32,
+                offset: r.offset,
+                rotation: r.rotation,
+                scale: r.scale,
+            },
+        }
+    }
+    fn from_c(r: MltTextureRef, name: &str) -> Result<Self> {
+        match r.texture {
+            MLT_NO_TEXTURE => Ok(None),
+            index if index < 0 => Err(Error::invalid(format!(
+                "{name}.texture is {index}; use an index into desc.textures, or MLT_NO_TEXTURE (-1) for none"
             ))),
+            index => Ok(Some(TextureRef {
+                texture: index as u32,
+                offset: r.offset,
+                rotation: r.rotation,
+                scale: r.scale,
+            })),
         }
     }
 }
+
+/// A material's texture slot without a texture: index -1, the identity transform.
+pub(super) const NO_TEXTURE: MltTextureRef = MltTextureRef {
+    texture: MLT_NO_TEXTURE,
+    offset: [0.0; 2],
+    rotation: 0.0,
+    scale: [1.0; 2],
+};
 
 /// What a render, a job or a merge did, as the host receives it (`struct_size` 0: the
 /// host's stays, `write_host` skips it).

@@ -200,37 +200,44 @@ impl Extensible for MltMaterial {
     /// Before the metallic-roughness model and textures (mlt 0.2's header): 36 bytes.
     const EARLIER_LAYOUTS: &'static [usize] = &[offset_of!(MltMaterial, metallic)];
     fn defaults() -> Self {
-        let d = Material::diffuse([0.8; 3]);
-        MltMaterial {
-            struct_size: size_of::<Self>() as u32,
-            kind: MLT_MATERIAL_DIFFUSE,
-            color: d.color,
-            emission: d.emission,
-            ior: d.ior,
-            metallic: d.metallic,
-            roughness: d.roughness,
-            transmission: d.transmission,
-            alpha: d.alpha,
-            alpha_mode: MLT_ALPHA_OPAQUE,
-            alpha_cutoff: d.alpha_cutoff,
-            base_color_texture: NO_TEXTURE,
-            metallic_roughness_texture: NO_TEXTURE,
-            normal_texture: NO_TEXTURE,
-            emission_texture: NO_TEXTURE,
-            normal_scale: d.normal_scale,
-            energy_compensation: d.energy_compensation as u32,
-            abbe_number: d.abbe_number,
-        }
+        (&Material::default()).into()
     }
 }
 
-/// A material's texture slot without a texture: index -1, the identity transform.
-const NO_TEXTURE: MltTextureRef = MltTextureRef {
-    texture: MLT_NO_TEXTURE,
-    offset: [0.0; 2],
-    rotation: 0.0,
-    scale: [1.0; 2],
-};
+/// The C struct of a Rust material, with today's `struct_size`.
+impl From<&Material> for MltMaterial {
+    fn from(d: &Material) -> Self {
+        macro_rules! to_c {
+            ($($name:ident,)*) => {
+                MltMaterial {
+                    struct_size: size_of::<Self>() as u32,
+                    $($name: d.$name.to_c(),)*
+                }
+            };
+        }
+        to_c! {
+            // BEGIN GENERATED material to C: tests/parameters.rs writes these lines from src/scene/material.rs
+            kind,
+            color,
+            emission,
+            ior,
+            metallic,
+            roughness,
+            transmission,
+            alpha,
+            alpha_mode,
+            alpha_cutoff,
+            base_color_texture,
+            metallic_roughness_texture,
+            normal_texture,
+            emission_texture,
+            normal_scale,
+            energy_compensation,
+            abbe_number,
+            // END GENERATED material to C
+        }
+    }
+}
 
 impl Extensible for MltTexture {
     const TYPE_NAME: &'static str = "MltTexture";

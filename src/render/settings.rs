@@ -88,6 +88,8 @@ impl ChoiceParameter for Algorithm {
         Algorithm::PathSpaceMlt,
         Algorithm::Erpt,
     ];
+    const TYPE_NAME: &'static str = "Algorithm";
+    const C_PREFIX: &'static str = "MLT_ALGORITHM";
 }
 
 impl ParameterType for MutationWeights {
@@ -98,8 +100,8 @@ impl ParameterType for MutationWeights {
     fn from_value(value: Value) -> std::result::Result<Self, Unfit> {
         <[f32; 4]>::from_value(value).map(MutationWeights)
     }
-    fn outside(&self, range: &Range) -> Option<(Option<usize>, String)> {
-        self.0.outside(range)
+    fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)> {
+        self.0.first(bad)
     }
 }
 
@@ -380,7 +382,7 @@ impl RenderSettings {
 
     /// Checks every setting against its declared range, then the rules between settings.
     pub fn validate(&self) -> Result<()> {
-        self.check_ranges()?;
+        self.check_ranges(<Self as crate::params::Parameters>::PREFIX)?;
         let t = self.time_limit_seconds;
         if self.algorithm.is_metropolis() {
             if self.mutations_per_pixel == 0 && t == 0.0 {

@@ -1,9 +1,11 @@
 //! Surface materials: what a triangle does with light.
 
 use crate::bsdf::{BsdfModel, MetallicRoughness};
-use crate::error::{Error, Result, check_finite, check_finite3};
+use crate::error::{Error, Result};
+use crate::params::{ChoiceParameter, Range, declare_parameters};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
+pub use crate::texture::TextureRef;
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,109 +36,135 @@ pub enum AlphaMode {
     Mask,
 }
 
-/// A material's use of a texture: which one, and the affine map applied to the surface's
-/// texture coordinates before the lookup (glTF `KHR_texture_transform`: scale, then
-/// rotate, then offset).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TextureRef {
-    /// Index into `SceneDesc::textures`.
-    pub texture: u32,
-    pub offset: [f32; 2],
-    /// Radians, counter-clockwise in uv space as `KHR_texture_transform` defines it.
-    pub rotation: f32,
-    pub scale: [f32; 2],
+// Each material parameter is declared once: the C, C++ and Python fields, the command line's
+// `--material NAME=VALUE`, the checks of `validate` and `docs/settings.md` follow from this
+// table. The order is the C struct's: append new parameters at the end.
+declare_parameters! {
+    /// A material. Any material may also emit: `emission` (times `emission_texture`) is the
+    /// radiance leaving the triangle's front side (counter-clockwise winding); emissive
+    /// triangles are area lights.
+    ///
+    /// Textures (`SceneDesc::textures`, looked up at the surface's texture coordinates):
+    /// `base_color_texture` multiplies `color` and `alpha` for every kind;
+    /// `metallic_roughness_texture` multiplies `roughness` (its green channel) and `metallic`
+    /// (blue) as glTF defines; `normal_texture` is a tangent-space normal map (glTF's
+    /// convention, +Y up in the texture) whose x and y are scaled by `normal_scale`;
+    /// `emission_texture` multiplies `emission`. Per-vertex colours multiply `color` and
+    /// `alpha` too.
+    ///
+    /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct Material in "material" {
+        kind: MaterialKind = MaterialKind::Diffuse => {
+            doc: "The scattering model: diffuse (Lambertian), mirror, dielectric (smooth glass) or metallic-roughness (glTF 2.0's).",
+        },
+        /// Diffuse albedo, mirror reflectance, glass tint or base colour; linear RGB in [0, 1].
+        color: [f32; 3] = [0.8; 3] => {
+            doc: "Diffuse albedo, mirror reflectance, glass tint or metallic-roughness base colour, linear RGB.",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "a reflectance must be in [0, 1]; above 1 would create energy".into(),
+        },
+        emission: [f32; 3] = [0.0; 3] => {
+            doc: "Radiance emitted from the front (counter-clockwise) side, linear RGB; emissive triangles are area lights.",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "emission must not be negative".into(),
+        },
+        /// Index of refraction (> 0 where used; the outside is vacuum).
+        ior: f32 = 1.5 => {
+            doc: "Index of refraction of a dielectric and of the metallic-roughness model's dielectric part (there > 0).",
+        },
+        /// Metalness in [0, 1] (metallic-roughness only).
+        metallic: f32 = 0.0 => {
+            doc: "Metallic-roughness: metalness, 0 a dielectric, 1 a metal whose reflectance is the colour.",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "it must be in [0, 1]".into(),
+        },
+        /// Perceptual roughness in [0, 1] (metallic-roughness only).
+        roughness: f32 = 1.0 => {
+            doc: "Metallic-roughness: perceptual roughness (GGX alpha = roughness squared; 0 is the exact specular lobe).",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "it must be in [0, 1]".into(),
+        },
+        /// The fraction of the non-metallic base that is transmission, in [0, 1]
+        /// (metallic-roughness only).
+        transmission: f32 = 0.0 => {
+            doc: "Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely reflected (KHR_materials_transmission).",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "it must be in [0, 1]".into(),
+        },
+        /// Coverage in [0, 1], used by `AlphaMode::Mask`.
+        alpha: f32 = 1.0 => {
+            doc: "Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask alpha mode.",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "it must be in [0, 1]".into(),
+        },
+        alpha_mode: AlphaMode = AlphaMode::Opaque => {
+            doc: "What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff (glTF's MASK).",
+        },
+        /// `AlphaMode::Mask` cuts out where alpha < `alpha_cutoff`; finite, >= 0.
+        alpha_cutoff: f32 = 0.5 => {
+            doc: "The mask alpha mode's threshold (glTF's alphaCutoff).",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "it must not be negative".into(),
+        },
+        base_color_texture: Option<TextureRef> = None => {
+            doc: "Multiplies the colour (RGB) and alpha (A), for every kind; usually 8-bit sRGB.",
+        },
+        metallic_roughness_texture: Option<TextureRef> = None => {
+            doc: "Green multiplies the roughness, blue the metalness (glTF's packing); usually linear.",
+        },
+        normal_texture: Option<TextureRef> = None => {
+            doc: "A tangent-space normal map (glTF's convention: +Y up in the image); usually linear.",
+        },
+        emission_texture: Option<TextureRef> = None => {
+            doc: "Multiplies the emission; usually 8-bit sRGB.",
+        },
+        /// Scales the normal map's x and y; finite.
+        normal_scale: f32 = 1.0 => {
+            doc: "Scales the normal map's x and y (glTF's normalTexture.scale).",
+        },
+        /// Metallic-roughness only: compensate the metal's reflection for the light that
+        /// bounces between microfacets more than once (Kulla and Conty 2017), which glTF's
+        /// single-scattering model loses: a white metal then reflects all the light at every
+        /// roughness instead of 92% at roughness 0.5 and 31% at 1 (normal incidence). Off by
+        /// default, as glTF defines the model; the dielectric's reflection is not compensated.
+        energy_compensation: bool = false => {
+            doc: "Metallic-roughness: give rough metals the light glTF's single-scattering model loses (Kulla and Conty 2017).",
+        },
+        /// Dispersion of a dielectric (and of the metallic-roughness model's dielectric part),
+        /// as the Abbe number V_d: the index of refraction `ior` holds at 587.56 nm (the
+        /// helium d line) and varies with the wavelength λ by the Cauchy form that glTF's
+        /// `KHR_materials_dispersion` defines (whose `dispersion` is 20 / V_d),
+        /// n(λ) = n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168),
+        /// so that n(486.13 nm) − n(656.27 nm) = (n_d − 1) / V_d. 0 means no dispersion;
+        /// otherwise finite and positive (crown glass ≈ 60, flint ≈ 36, diamond ≈ 55 at a
+        /// higher index). Only spectral renders disperse light; RGB renders use n_d.
+        abbe_number: f32 = 0.0 => {
+            doc: "Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 / V_d); spectral renders only.",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "an Abbe number must be positive (0: no dispersion)".into(),
+        },
+    }
 }
 
-impl TextureRef {
-    /// Texture `texture` at the surface's own coordinates.
-    pub const fn new(texture: u32) -> Self {
-        TextureRef {
-            texture,
-            offset: [0.0; 2],
-            rotation: 0.0,
-            scale: [1.0; 2],
-        }
-    }
-
-    /// The transform as the rows of a 2×3 matrix applied to (u, v, 1).
-    #[allow(dead_code)] // Until textures are looked up.
-    pub(crate) fn matrix(&self) -> [[f32; 3]; 2] {
-        let (sin, cos) = self.rotation.sin_cos();
-        let [sx, sy] = self.scale;
-        [
-            [cos * sx, sin * sy, self.offset[0]],
-            [-sin * sx, cos * sy, self.offset[1]],
-        ]
-    }
-
-    fn validate(&self, name: &str, texture_count: usize) -> Result<()> {
-        if self.texture as usize >= texture_count {
-            return Err(Error::invalid(format!(
-                "{name}.texture is {}, but there are only {texture_count} textures",
-                self.texture
-            )));
-        }
-        check_finite(&format_args!("{name}.rotation"), self.rotation)?;
-        for (field, value) in [("offset", self.offset), ("scale", self.scale)] {
-            for (axis, v) in ["u", "v"].iter().zip(value) {
-                check_finite(&format_args!("{name}.{field}.{axis}"), v)?;
-            }
-        }
-        Ok(())
-    }
+impl ChoiceParameter for MaterialKind {
+    const NAMES: &'static [&'static str] =
+        &["diffuse", "mirror", "dielectric", "metallic-roughness"];
+    const ALL: &'static [MaterialKind] = &[
+        MaterialKind::Diffuse,
+        MaterialKind::Mirror,
+        MaterialKind::Dielectric,
+        MaterialKind::MetallicRoughness,
+    ];
+    const TYPE_NAME: &'static str = "MaterialKind";
+    const C_PREFIX: &'static str = "MLT_MATERIAL";
 }
 
-/// A material. Any material may also emit: `emission` (times `emission_texture`) is the
-/// radiance leaving the triangle's front side (counter-clockwise winding); emissive
-/// triangles are area lights.
-///
-/// Textures (`SceneDesc::textures`, looked up at the surface's texture coordinates):
-/// `base_color_texture` multiplies `color` and `alpha` for every kind;
-/// `metallic_roughness_texture` multiplies `roughness` (its green channel) and `metallic`
-/// (blue) as glTF defines; `normal_texture` is a tangent-space normal map (glTF's
-/// convention, +Y up in the texture) whose x and y are scaled by `normal_scale`;
-/// `emission_texture` multiplies `emission`. Per-vertex colours multiply `color` and
-/// `alpha` too.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
-    pub kind: MaterialKind,
-    /// Diffuse albedo, mirror reflectance, glass tint or base colour; linear RGB in [0, 1].
-    pub color: [f32; 3],
-    pub emission: [f32; 3],
-    pub ior: f32,
-    /// Metalness in [0, 1] (metallic-roughness only).
-    pub metallic: f32,
-    /// Perceptual roughness in [0, 1] (metallic-roughness only).
-    pub roughness: f32,
-    /// The fraction of the non-metallic base that is transmission, in [0, 1]
-    /// (metallic-roughness only).
-    pub transmission: f32,
-    /// Coverage in [0, 1], used by `AlphaMode::Mask`.
-    pub alpha: f32,
-    pub alpha_mode: AlphaMode,
-    /// `AlphaMode::Mask` cuts out where alpha < `alpha_cutoff`; finite, >= 0.
-    pub alpha_cutoff: f32,
-    pub base_color_texture: Option<TextureRef>,
-    pub metallic_roughness_texture: Option<TextureRef>,
-    pub normal_texture: Option<TextureRef>,
-    /// Scales the normal map's x and y; finite.
-    pub normal_scale: f32,
-    pub emission_texture: Option<TextureRef>,
-    /// Metallic-roughness only: compensate the metal's reflection for the light that
-    /// bounces between microfacets more than once (Kulla and Conty 2017), which glTF's
-    /// single-scattering model loses: a white metal then reflects all the light at every
-    /// roughness instead of 92% at roughness 0.5 and 31% at 1 (normal incidence). Off by
-    /// default, as glTF defines the model; the dielectric's reflection is not compensated.
-    pub energy_compensation: bool,
-    /// Dispersion of a dielectric (and of the metallic-roughness model's dielectric part),
-    /// as the Abbe number V_d: the index of refraction `ior` holds at 587.56 nm (the
-    /// helium d line) and varies with the wavelength λ by the Cauchy form that glTF's
-    /// `KHR_materials_dispersion` defines (whose `dispersion` is 20 / V_d),
-    /// n(λ) = n_d + (n_d − 1) / V_d · (523655 nm² / λ² − 1.5168),
-    /// so that n(486.13 nm) − n(656.27 nm) = (n_d − 1) / V_d. 0 means no dispersion;
-    /// otherwise finite and positive (crown glass ≈ 60, flint ≈ 36, diamond ≈ 55 at a
-    /// higher index). Only spectral renders disperse light; RGB renders use n_d.
-    pub abbe_number: f32,
+impl ChoiceParameter for AlphaMode {
+    const NAMES: &'static [&'static str] = &["opaque", "mask"];
+    const ALL: &'static [AlphaMode] = &[AlphaMode::Opaque, AlphaMode::Mask];
+    const TYPE_NAME: &'static str = "AlphaMode";
+    const C_PREFIX: &'static str = "MLT_ALPHA";
 }
 
 impl Material {
@@ -144,21 +172,7 @@ impl Material {
         Material {
             kind: MaterialKind::Diffuse,
             color: albedo,
-            emission: [0.0; 3],
-            ior: 1.5,
-            metallic: 0.0,
-            roughness: 1.0,
-            transmission: 0.0,
-            alpha: 1.0,
-            alpha_mode: AlphaMode::Opaque,
-            alpha_cutoff: 0.5,
-            base_color_texture: None,
-            metallic_roughness_texture: None,
-            normal_texture: None,
-            normal_scale: 1.0,
-            emission_texture: None,
-            energy_compensation: false,
-            abbe_number: 0.0,
+            ..Material::default()
         }
     }
 
@@ -220,32 +234,12 @@ impl Material {
         ]
     }
 
-    /// Checks every field, naming `materials[index]` in the message; texture references
-    /// must be below `texture_count`.
+    /// Checks every field, naming `desc.materials[index]` in the message: the declared
+    /// ranges, then what depends on the kind and the scene (texture references must be
+    /// below `texture_count`).
     pub fn validate(&self, index: usize, texture_count: usize) -> Result<()> {
         let name = format!("desc.materials[{index}]");
-        check_finite3(&format!("{name}.color"), self.color)?;
-        check_finite3(&format!("{name}.emission"), self.emission)?;
-        check_finite(&format_args!("{name}.ior"), self.ior)?;
-        for (axis, c) in ["x", "y", "z"].iter().zip(self.color) {
-            if c < 0.0 {
-                return Err(Error::invalid(format!(
-                    "{name}.color.{axis} is {c}; colors must not be negative"
-                )));
-            }
-            if c > 1.0 {
-                return Err(Error::invalid(format!(
-                    "{name}.color.{axis} is {c}; a reflectance above 1 would create energy"
-                )));
-            }
-        }
-        for (axis, e) in ["x", "y", "z"].iter().zip(self.emission) {
-            if e < 0.0 {
-                return Err(Error::invalid(format!(
-                    "{name}.emission.{axis} is {e}; emission must not be negative"
-                )));
-            }
-        }
+        self.check_ranges(&name)?;
         if matches!(
             self.kind,
             MaterialKind::Dielectric | MaterialKind::MetallicRoughness
@@ -254,34 +248,6 @@ impl Material {
             return Err(Error::invalid(format!(
                 "{name}.ior is {}; a dielectric's index of refraction must be greater than 0",
                 self.ior
-            )));
-        }
-        for (field, value) in [
-            ("metallic", self.metallic),
-            ("roughness", self.roughness),
-            ("transmission", self.transmission),
-            ("alpha", self.alpha),
-        ] {
-            check_finite(&format_args!("{name}.{field}"), value)?;
-            if !(0.0..=1.0).contains(&value) {
-                return Err(Error::invalid(format!(
-                    "{name}.{field} is {value}; it must be in [0, 1]"
-                )));
-            }
-        }
-        check_finite(&format_args!("{name}.alpha_cutoff"), self.alpha_cutoff)?;
-        if self.alpha_cutoff < 0.0 {
-            return Err(Error::invalid(format!(
-                "{name}.alpha_cutoff is {}; it must not be negative",
-                self.alpha_cutoff
-            )));
-        }
-        check_finite(&format_args!("{name}.normal_scale"), self.normal_scale)?;
-        check_finite(&format_args!("{name}.abbe_number"), self.abbe_number)?;
-        if self.abbe_number < 0.0 {
-            return Err(Error::invalid(format!(
-                "{name}.abbe_number is {}; an Abbe number must be positive (0: no dispersion)",
-                self.abbe_number
             )));
         }
         for (field, texture) in self.texture_refs() {

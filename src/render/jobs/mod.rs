@@ -459,14 +459,17 @@ fn write_settings(w: &mut Writer, settings: &RenderSettings) {
             (Kind::F64, Value::Float(v)) => w.f64(v),
             (_, Value::Float(v)) => w.f32(v as f32),
             (_, Value::Bool(v)) => w.bool(v),
-            (Kind::Choice(names), Value::Choice(name)) => w.u32(
-                names
+            (Kind::Choice(choices), Value::Choice(name)) => w.u32(
+                choices
+                    .names
                     .iter()
                     .position(|&n| n == name)
                     .expect("a declared name") as u32,
             ),
             (_, Value::Choice(_)) => unreachable!("a choice's kind names its choices"),
+            (_, Value::Vec3(values)) => values.into_iter().for_each(|v| w.f32(v)),
             (_, Value::Floats(values)) => values.into_iter().for_each(|v| w.f32(v)),
+            (_, Value::Texture(_)) => unreachable!("settings have no textures"),
         }
     }
 }
@@ -480,15 +483,18 @@ fn read_settings(r: &mut Reader) -> Result<RenderSettings> {
             Kind::F32 => Value::Float(r.f32()?.into()),
             Kind::F64 => Value::Float(r.f64()?),
             Kind::Bool => Value::Bool(r.bool()?),
-            Kind::Choice(names) => {
+            Kind::Choice(choices) => {
                 let code = r.u32()?;
                 Value::Choice(
-                    names
+                    choices
+                        .names
                         .get(code as usize)
                         .ok_or_else(|| r.malformed(&format!("an unknown {}", p.name)))?,
                 )
             }
+            Kind::F32x3 => Value::Vec3([r.f32()?, r.f32()?, r.f32()?]),
             Kind::F32x4 => Value::Floats([r.f32()?, r.f32()?, r.f32()?, r.f32()?]),
+            Kind::Texture => unreachable!("settings have no textures"),
         };
         settings.set(p.name, value)?;
     }
