@@ -231,6 +231,12 @@ pub trait ParameterType: Copy {
     #[doc(hidden)]
     /// The first of the numbers the value holds for which `bad` is true, as `outside`.
     fn first(&self, bad: impl Fn(f64) -> bool) -> Option<(String, String)>;
+    /// The texture, for a texture slot that holds one.
+    #[doc(hidden)]
+    #[inline(always)]
+    fn texture(&self) -> Option<TextureRef> {
+        None
+    }
 }
 
 macro_rules! integer_parameter {
@@ -328,6 +334,10 @@ impl ParameterType for Option<TextureRef> {
     /// textures.
     fn first(&self, _: impl Fn(f64) -> bool) -> Option<(String, String)> {
         None
+    }
+    #[inline(always)]
+    fn texture(&self) -> Option<TextureRef> {
+        *self
     }
 }
 
@@ -516,6 +526,26 @@ macro_rules! declare_parameters {
                     $crate::params::check(self, prefix, stringify!($name), self.$name, range)?;
                 })*
                 Ok(())
+            }
+
+            /// Whether any texture slot holds a texture (a test per slot: hot code asks).
+            #[allow(dead_code)]
+            #[inline(always)]
+            pub(crate) fn any_texture(&self) -> bool {
+                false $(|| $crate::params::ParameterType::texture(&self.$name).is_some())*
+            }
+
+            /// The texture slots that hold a texture, with their names, in declaration order.
+            #[allow(dead_code)]
+            #[inline(always)]
+            pub(crate) fn textures(
+                &self,
+            ) -> impl Iterator<Item = (&'static str, $crate::texture::TextureRef)> {
+                [$(
+                    (stringify!($name), $crate::params::ParameterType::texture(&self.$name)),
+                )*]
+                .into_iter()
+                .filter_map(|(name, texture)| Some((name, texture?)))
             }
         }
 

@@ -214,24 +214,9 @@ impl Material {
     }
 
     /// Whether any texture is looked up at the surface's texture coordinates.
+    #[inline]
     pub fn has_textures(&self) -> bool {
-        self.base_color_texture.is_some()
-            || self.metallic_roughness_texture.is_some()
-            || self.normal_texture.is_some()
-            || self.emission_texture.is_some()
-    }
-
-    /// The texture references with their field names, for validation.
-    fn texture_refs(&self) -> [(&'static str, Option<TextureRef>); 4] {
-        [
-            ("base_color_texture", self.base_color_texture),
-            (
-                "metallic_roughness_texture",
-                self.metallic_roughness_texture,
-            ),
-            ("normal_texture", self.normal_texture),
-            ("emission_texture", self.emission_texture),
-        ]
+        self.any_texture()
     }
 
     /// Checks every field, naming `desc.materials[index]` in the message: the declared
@@ -250,10 +235,8 @@ impl Material {
                 self.ior
             )));
         }
-        for (field, texture) in self.texture_refs() {
-            if let Some(texture) = texture {
-                texture.validate(&format!("{name}.{field}"), texture_count)?;
-            }
+        for (field, texture) in self.textures() {
+            texture.validate(&format!("{name}.{field}"), texture_count)?;
         }
         Ok(())
     }
