@@ -132,52 +132,11 @@ impl Mesh {
         self.materials.clone()
     }
 
+    /// The materials as a host of today's header passes them.
     pub fn c_materials(&self) -> Vec<mlt::capi::MltMaterial> {
-        use mlt::capi::*;
-        let slot = |r: Option<mlt::TextureRef>| match r {
-            Some(r) => MltTextureRef {
-                texture: r.texture as i32,
-                offset: r.offset,
-                rotation: r.rotation,
-                scale: r.scale,
-            },
-            None => MltTextureRef {
-                texture: MLT_NO_TEXTURE,
-                offset: [0.0; 2],
-                rotation: 0.0,
-                scale: [1.0; 2],
-            },
-        };
         self.materials
             .iter()
-            .map(|m| MltMaterial {
-                struct_size: size_of::<MltMaterial>() as u32,
-                kind: match m.kind {
-                    mlt::MaterialKind::Diffuse => MLT_MATERIAL_DIFFUSE,
-                    mlt::MaterialKind::Mirror => MLT_MATERIAL_MIRROR,
-                    mlt::MaterialKind::Dielectric => MLT_MATERIAL_DIELECTRIC,
-                    mlt::MaterialKind::MetallicRoughness => MLT_MATERIAL_METALLIC_ROUGHNESS,
-                },
-                color: m.color,
-                emission: m.emission,
-                ior: m.ior,
-                metallic: m.metallic,
-                roughness: m.roughness,
-                transmission: m.transmission,
-                alpha: m.alpha,
-                alpha_mode: match m.alpha_mode {
-                    mlt::AlphaMode::Opaque => MLT_ALPHA_OPAQUE,
-                    mlt::AlphaMode::Mask => MLT_ALPHA_MASK,
-                },
-                alpha_cutoff: m.alpha_cutoff,
-                base_color_texture: slot(m.base_color_texture),
-                metallic_roughness_texture: slot(m.metallic_roughness_texture),
-                normal_texture: slot(m.normal_texture),
-                emission_texture: slot(m.emission_texture),
-                normal_scale: m.normal_scale,
-                energy_compensation: m.energy_compensation as u32,
-                abbe_number: m.abbe_number,
-            })
+            .map(mlt::capi::MltMaterial::from)
             .collect()
     }
 
