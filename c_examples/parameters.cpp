@@ -372,6 +372,8 @@ void check_materials() {
     show("c++", "material.energy_compensation", cpp.energy_compensation);
     show("c", "material.abbe_number", c.abbe_number);
     show("c++", "material.abbe_number", cpp.abbe_number);
+    show("c", "material.transmission_texture", c.transmission_texture);
+    show("c++", "material.transmission_texture", cpp.transmission_texture);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};

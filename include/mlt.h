@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 3
+#define MLT_VERSION_MINOR 4
 
 /**
  * Patch version.
@@ -443,7 +443,8 @@ typedef struct MltTextureRef {
  * `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
  * `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
  * by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
- * normal map; `emission_texture` multiplies `emission`. Per-vertex colours
+ * normal map; `emission_texture` multiplies `emission`; `transmission_texture`'s red
+ * channel multiplies `transmission`. Per-vertex colours
  * (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
  */
 typedef struct MltMaterial {
@@ -537,6 +538,12 @@ typedef struct MltMaterial {
    * 0.0.
    */
   float abbe_number;
+  /**
+   * Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
+   * transmissionTexture); usually linear. An index into `MltSceneDesc.textures` and its
+   * transform. Default `MLT_NO_TEXTURE` (-1).
+   */
+  struct MltTextureRef transmission_texture;
 } MltMaterial;
 
 /**

@@ -484,6 +484,9 @@ struct Material {
     /// Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 /
     /// V_d); spectral renders only.
     float abbe_number = 0.0f;
+    /// Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
+    /// transmissionTexture); usually linear.
+    TextureRef transmission_texture;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -541,6 +544,7 @@ struct Material {
         c.normal_scale = normal_scale;
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
+        c.transmission_texture = transmission_texture.to_c();
         // END GENERATED material to C
         return c;
     }
@@ -564,6 +568,7 @@ struct Material {
         m.normal_scale = c.normal_scale;
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
+        m.transmission_texture = TextureRef::from_c(c.transmission_texture);
         // END GENERATED material from C
         return m;
     }

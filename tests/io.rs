@@ -279,6 +279,39 @@ fn sky_spheres_scene_files_are_what_the_generator_writes() {
     assert_eq!(data.triangle_count(), 2 + 3 * (24 * 48 * 2 - 2 * 48));
 }
 
+/// `KHR_materials_transmission`'s `transmissionTexture` becomes the material's
+/// transmission texture, with its texture transform: the sky-spheres glass given the
+/// clay's (linear) normal-map image as one.
+#[test]
+fn gltf_transmission_texture_is_read() {
+    let text = std::fs::read_to_string(scenes().join("sky-spheres.gltf")).unwrap();
+    let textured = text.replacen(
+        r#""transmissionFactor": 1.0"#,
+        r#""transmissionFactor": 1.0, "transmissionTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "rotation": 0.5 } } }"#,
+        1,
+    );
+    assert_ne!(text, textured);
+    let dir = temp_path("transmission-texture");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        scenes().join("sky-spheres.bin"),
+        dir.join("sky-spheres.bin"),
+    )
+    .unwrap();
+    let path = dir.join("sky-spheres.gltf");
+    std::fs::write(&path, textured).unwrap();
+    let data = io::load_scene(&path).unwrap();
+    let (_, glass) = material_named(&data, "glass");
+    let (_, clay) = material_named(&data, "clay");
+    let slot = glass
+        .transmission_texture
+        .expect("the transmission texture");
+    assert_eq!(slot.texture, clay.normal_texture.unwrap().texture);
+    assert_eq!(slot.rotation, 0.5);
+    assert_eq!(clay.transmission_texture, None);
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");

@@ -321,3 +321,57 @@ fn a_normal_map_shades_like_its_normal_baked_into_the_vertices() {
         "the map changes nothing: {mapped_mean} against {flat_mean} flat"
     );
 }
+
+/// A transmission texture's red channel multiplies the transmission: a quad of
+/// transmission 1 under a texture of 0.25 renders bit for bit as one of transmission 0.25
+/// under a texture of 1, and lets through about a quarter of the lamp light behind it that
+/// the untextured quad of transmission 1 lets through.
+#[test]
+fn a_transmission_texture_multiplies_the_transmission() {
+    let (positions, indices, texcoords) = quad_before_a_lamp();
+    let grey = |value: f32| TextureDesc {
+        width: 1,
+        height: 1,
+        channels: 1,
+        data: TexelData::F32(Cow::Owned(vec![value])),
+        encoding: TextureEncoding::Linear,
+        wrap_u: WrapMode::Repeat,
+        wrap_v: WrapMode::Repeat,
+        filter: TextureFilter::Nearest,
+    };
+    let textures = [grey(0.25), grey(1.0)];
+    let glass = |transmission: f32, texture: Option<u32>| Material {
+        transmission,
+        transmission_texture: texture.map(TextureRef::new),
+        ..Material::metallic_roughness([1.0; 3], 0.0, 0.2)
+    };
+    let lamp = Material::diffuse([0.0; 3]).with_emission([1.0; 3]);
+    let settings = RenderSettings {
+        width: 8,
+        height: 8,
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 16,
+        max_depth: 2,
+        ..Default::default()
+    };
+    let render = |quad: Material| {
+        let materials = [quad, lamp];
+        let scene = Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &indices,
+            material_ids: &[0, 0, 1, 1],
+            materials: &materials,
+            texcoords: &texcoords,
+            textures: &textures,
+            ..Default::default()
+        })
+        .unwrap();
+        render_image(&scene, &quad_camera(), &settings)
+    };
+    let quarter_by_texture = render(glass(1.0, Some(0)));
+    let quarter_by_factor = render(glass(0.25, Some(1)));
+    assert_eq!(quarter_by_texture, quarter_by_factor);
+    let full = render(glass(1.0, None));
+    let ratio = common::stats::mean(&quarter_by_texture)[0] / common::stats::mean(&full)[0];
+    assert!((0.2..0.3).contains(&ratio), "{ratio}");
+}

@@ -130,6 +130,9 @@ class Material:
     #: Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 /
     #: V_d); spectral renders only.
     abbe_number: float = 0.0
+    #: Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
+    #: transmissionTexture); usually linear.
+    transmission_texture: Optional[TextureRef] = None
     # END GENERATED material
 
     @classmethod

@@ -45,6 +45,7 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         normal_scale,
         energy_compensation,
         abbe_number,
+        transmission_texture,
         // END GENERATED material from C
     }
 }

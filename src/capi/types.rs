@@ -6,7 +6,7 @@ use std::ffi::c_void;
 /// Major version of the mlt library this header belongs to.
 pub const MLT_VERSION_MAJOR: u32 = 0;
 /// Minor version.
-pub const MLT_VERSION_MINOR: u32 = 3;
+pub const MLT_VERSION_MINOR: u32 = 4;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
 /// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
@@ -157,7 +157,8 @@ pub struct MltTextureRef {
 /// `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
 /// `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
 /// by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
-/// normal map; `emission_texture` multiplies `emission`. Per-vertex colours
+/// normal map; `emission_texture` multiplies `emission`; `transmission_texture`'s red
+/// channel multiplies `transmission`. Per-vertex colours
 /// (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
@@ -217,6 +218,10 @@ pub struct MltMaterial {
     /// V_d); spectral renders only. An Abbe number must be positive (0: no dispersion). Default
     /// 0.0.
     pub abbe_number: f32,
+    /// Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
+    /// transmissionTexture); usually linear. An index into `MltSceneDesc.textures` and its
+    /// transform. Default `MLT_NO_TEXTURE` (-1).
+    pub transmission_texture: MltTextureRef,
     // END GENERATED material
 }
 

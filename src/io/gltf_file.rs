@@ -714,6 +714,13 @@ impl Loader<'_> {
             converted.emission_texture =
                 Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
         }
+        if let Some(info) = material
+            .transmission()
+            .and_then(|t| t.transmission_texture())
+        {
+            converted.transmission_texture =
+                Some(self.texture_ref(info.texture(), info.texture_transform(), false)?);
+        }
         // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
         if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
             let dispersion = extension

@@ -49,7 +49,8 @@ declare_parameters! {
     /// `metallic_roughness_texture` multiplies `roughness` (its green channel) and `metallic`
     /// (blue) as glTF defines; `normal_texture` is a tangent-space normal map (glTF's
     /// convention, +Y up in the texture) whose x and y are scaled by `normal_scale`;
-    /// `emission_texture` multiplies `emission`. Per-vertex colours multiply `color` and
+    /// `emission_texture` multiplies `emission`; `transmission_texture`'s red channel
+    /// multiplies `transmission`. Per-vertex colours multiply `color` and
     /// `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
@@ -143,6 +144,9 @@ declare_parameters! {
             doc: "Dispersion as the Abbe number V_d (0: none; KHR_materials_dispersion's dispersion is 20 / V_d); spectral renders only.",
             range: Range::closed(0.0, f32::MAX as f64),
             rule: |_| "an Abbe number must be positive (0: no dispersion)".into(),
+        },
+        transmission_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's transmissionTexture); usually linear.",
         },
     }
 }
@@ -274,19 +278,21 @@ impl Material {
             channels.reflectance(self.color),
             self.metallic,
             self.roughness,
+            self.transmission,
             self.ior_in(channels),
         )
     }
 
     /// The scattering model with the colour replaced by `color` and, for the
-    /// metallic-roughness model, its metalness and roughness by `metallic` and `roughness`
-    /// (textured).
+    /// metallic-roughness model, its metalness, roughness and transmission by `metallic`,
+    /// `roughness` and `transmission` (textured).
     #[inline]
     pub(crate) fn textured_bsdf_model(
         &self,
         color: Spectrum,
         metallic: f32,
         roughness: f32,
+        transmission: f32,
         ior: f32,
     ) -> BsdfModel {
         match self.kind {
@@ -298,7 +304,7 @@ impl Material {
                 metallic,
                 roughness,
                 ior,
-                transmission: self.transmission,
+                transmission,
                 energy_compensation: self.energy_compensation,
             }),
         }

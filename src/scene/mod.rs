@@ -441,13 +441,20 @@ impl Scene {
             if m.kind != MaterialKind::MetallicRoughness {
                 return false;
             }
-            let texture_min = |channel| {
-                m.metallic_roughness_texture.map_or(1.0, |t| {
+            let texture_min = |texture: Option<crate::TextureRef>, channel| {
+                texture.map_or(1.0, |t| {
                     self.textures[t.texture as usize].channel_min(channel)
                 })
             };
-            let (roughness, metallic) = (m.roughness * texture_min(1), m.metallic * texture_min(2));
-            let smoothest = m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, m.ior);
+            let packed = m.metallic_roughness_texture;
+            let (roughness, metallic) = (
+                m.roughness * texture_min(packed, 1),
+                m.metallic * texture_min(packed, 2),
+            );
+            // The least transmission leaves the most diffuse base beside the specular lobes.
+            let transmission = m.transmission * texture_min(m.transmission_texture, 0);
+            let smoothest =
+                m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
             roughness == 0.0 && {
                 let lobes = smoothest.lobes();
                 lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()

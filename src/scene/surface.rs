@@ -321,6 +321,7 @@ impl SurfacePoint<'_> {
                 channels.fitted_reflectance(&self.colours.color),
                 m.metallic,
                 m.roughness,
+                m.transmission,
                 m.ior_in(channels),
             );
             return Bsdf::new(model, geometric_normal, geometric_normal)
@@ -335,7 +336,12 @@ impl SurfacePoint<'_> {
             roughness *= texel.y;
             metallic *= texel.z;
         }
-        let model = m.textured_bsdf_model(color, metallic, roughness, m.ior_in(channels));
+        let mut transmission = m.transmission;
+        if let Some(texture) = &m.transmission_texture {
+            transmission *= lookup(self.textures, texture, self.texcoord()).x;
+        }
+        let model =
+            m.textured_bsdf_model(color, metallic, roughness, transmission, m.ior_in(channels));
         Bsdf::new(
             model,
             self.shading_normal(geometric_normal),
