@@ -17,17 +17,25 @@
 //!   from the denser side) and 1 under total internal reflection. From the outside of glass
 //!   that is glTF's Schlick term exactly; it is also symmetric across the interface, which
 //!   refraction's reciprocity needs.
-//! - The diffuse base is weighted by (1 − F(cos θo)) (1 − F(cos θi)), not glTF's
-//!   (1 − F(v·h)): with the half vector of wo and wi the base keeps almost all its energy
-//!   while the coat reflects nearly everything at grazing angles, so a smooth white
-//!   dielectric would reflect 1.35 times the incident energy at 80° and 1.9 times near
-//!   90°; the product is reciprocal and keeps the albedo at most 1.
+//! - The diffuse base is scaled by its albedo under the coat, not glTF's (1 − F(v·h)):
+//!   with the half vector of wo and wi the base keeps almost all its energy while the coat
+//!   reflects nearly everything at grazing angles, so a smooth white dielectric would
+//!   reflect 1.35 times the incident energy at 80° and 1.9 times near 90°. Instead (albedo
+//!   scaling, as Cycles and OpenPBR do, in Kulla and Conty's reciprocal form)
+//!   base · (1 − R(μo)) (1 − R(μi)) / (1 − R_avg), with R the coat's reflectance: the
+//!   Fresnel-weighted share of what its GGX lobe reflects, E_F / E (tabulated in
+//!   `multiple_scattering`; the albedo the coat would have with its multiple scattering
+//!   kept), and R_avg its cosine-weighted mean. The base then reflects 1 − R(μo) of its
+//!   albedo at every μo, and a white dielectric reflects 1 − R(μo) (1 − E(μo)): all but
+//!   what the rough coat's single scattering loses, as the specification's model loses
+//!   it. Face-on the albedo is the specification's within 1% at every roughness (tested).
+//!   It stays reciprocal. For `ior` < 1 the coat's reflectance is Schlick's from the
+//!   outside, without the total internal reflection the interface has there.
 //! - Multiple scattering between microfacets is left out, as glTF's model leaves it out,
 //!   unless `energy_compensation` is set: then the metal gains Kulla and Conty's
 //!   compensation lobe (see `multiple_scattering`), a smooth lobe with the light single
 //!   scattering loses (a white metal then reflects 1 at every roughness and angle). The
-//!   dielectric's reflection is not compensated: what its rough coat loses would partly
-//!   reach the base below, which the layering here does not model.
+//!   dielectric's coat is not compensated.
 //! - Reflection is two-sided (as the diffuse BSDF). The transmissive part is a real
 //!   interface (front side outside with index 1, back side inside with index `ior`), so its
 //!   reflectance seen from the back includes total internal reflection; the opaque part is
@@ -35,7 +43,7 @@
 
 use super::dielectric::{refract, refracted};
 use super::microfacet::TrowbridgeReitz;
-use super::multiple_scattering::EnergyCompensation;
+use super::multiple_scattering::{CoatReflectance, EnergyCompensation};
 use super::scattering::{ScatterSample, TransportMode, reflect};
 use super::{BsdfLobes, SpecularLobe};
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
@@ -503,7 +511,7 @@ impl MetallicRoughness {
         let cos_o = view.wo.z;
         let transmitted = 1.0 - interface_reflectance(self.f0(), cos_o, view.eta());
         let reflection = mean(self.reflectance(cos_o, view.eta()));
-        let diffuse = mean(self.diffuse_tint()) * (1.0 - self.opaque_reflectance(cos_o));
+        let diffuse = mean(self.diffuse_tint()) * (1.0 - self.coat().reflectance(cos_o));
         let transmission = mean(self.transmission_tint()) * transmitted;
         let at_least = |estimate: f32, scatters: bool| {
             if scatters {
@@ -535,11 +543,21 @@ impl MetallicRoughness {
         }
     }
 
-    /// The diffuse base's f at cosines `cos_o`, `cos_i` (same side).
+    /// The reflectance of the coat over the diffuse base: the dielectric's reflection seen
+    /// from the outside.
+    #[inline]
+    fn coat(&self) -> CoatReflectance {
+        CoatReflectance::new(self.roughness, self.f0())
+    }
+
+    /// The diffuse base's f at cosines `cos_o`, `cos_i` (same side), scaled by what the
+    /// coat does not reflect at either: (1 − R(μo)) (1 − R(μi)) / (1 − R_avg), whose
+    /// cosine-weighted integral over μi is 1 − R(μo) (see the module's documentation).
     #[inline]
     fn diffuse_f(&self, cos_o: f32, cos_i: f32) -> Spectrum {
-        let through =
-            (1.0 - self.opaque_reflectance(cos_o)) * (1.0 - self.opaque_reflectance(cos_i));
+        let coat = self.coat();
+        let through = (1.0 - coat.reflectance(cos_o)) * (1.0 - coat.reflectance(cos_i))
+            / (1.0 - coat.average());
         self.diffuse_tint() * (through * FRAC_1_PI)
     }
 
@@ -737,7 +755,9 @@ impl LobeChoice {
 #[cfg(test)]
 mod tests {
     use super::super::dielectric;
-    use super::super::multiple_scattering::{EnergyCompensation, single_scattering_albedo};
+    use super::super::multiple_scattering::{
+        EnergyCompensation, single_scattering_albedo, single_scattering_albedos,
+    };
     use super::*;
     use crate::sampling::Rng;
     use crate::sampling::chi_square::{
@@ -1036,6 +1056,134 @@ mod tests {
             for theta in ANGLES.into_iter().chain([89.5]) {
                 let a = albedo(&m, direction(theta), 40_000, &mut rng);
                 assert!(a.max_component() <= 1.01, "{m:?} θ {theta}: albedo {a}");
+            }
+        }
+    }
+
+    /// The glTF specification's directional albedo at normal incidence of a non-metal
+    /// (its appendix B: diffuse c/π · (1 − F(v·h)) plus F(v·h) times GGX), integrated
+    /// without the tables: the diffuse part over the polar angle of wi (at normal
+    /// incidence v·h = cos(θi/2)), the coat's by the half-vector quadrature at 3000 × 360
+    /// nodes.
+    fn specification_face_on_albedo(color: f32, roughness: f32, f0: f32) -> f64 {
+        let schlick = |cos: f64| f0 as f64 + (1.0 - f0 as f64) * (1.0 - cos).powi(5);
+        let n = 20_000;
+        let diffuse: f64 = (0..n)
+            .map(|k| {
+                let theta = (k as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
+                (1.0 - schlick((theta / 2.0).cos())) * theta.cos() * theta.sin()
+            })
+            .sum::<f64>()
+            * 2.0
+            * std::f64::consts::FRAC_PI_2
+            / n as f64;
+        let coat = if roughness == 0.0 {
+            f0 as f64
+        } else {
+            let [e, e_s] = single_scattering_albedos(roughness * roughness, 1.0, 3000, 360);
+            f0 as f64 * e + (1.0 - f0 as f64) * e_s
+        };
+        color as f64 * diffuse + coat
+    }
+
+    /// Face-on, a non-metal reflects what the specification's model does, within 0.5%, at
+    /// every roughness: the albedo-scaled base loses nothing the specification keeps
+    /// (the product (1 − F(μo)) (1 − F(μi)) it replaced was 8.5% dark at roughness 1).
+    /// The specification's directional albedo of a non-metal (base colour `color`, index
+    /// giving `f0`) at roughness 1 for light arriving at polar angle `theta_deg`: its f,
+    /// c/π (1 − F(v·h)) + F(v·h) D G2 / (4 μo μi), integrated over wi by the midpoint rule
+    /// in μi and φi (1000 × 2000 nodes; at roughness 1 every part of it is smooth).
+    fn specification_albedo_at_roughness_one(color: f64, f0: f64, theta_deg: f64) -> f64 {
+        use std::f64::consts::PI;
+        let (sin_o, mu_o) = theta_deg.to_radians().sin_cos();
+        let lambda = |mu: f64| ((1.0 + (1.0 - mu * mu) / (mu * mu)).sqrt() - 1.0) / 2.0;
+        let (n_mu, n_phi) = (1000, 2000);
+        let mut sum = 0.0;
+        for i in 0..n_mu {
+            let mu_i = (i as f64 + 0.5) / n_mu as f64;
+            let sin_i = (1.0 - mu_i * mu_i).sqrt();
+            for j in 0..n_phi {
+                let phi = (j as f64 + 0.5) / n_phi as f64 * 2.0 * PI;
+                let h = [sin_o + sin_i * phi.cos(), sin_i * phi.sin(), mu_o + mu_i];
+                let length = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+                let cos_vh = (sin_o * h[0] + mu_o * h[2]) / length;
+                let fresnel = f0 + (1.0 - f0) * (1.0 - cos_vh).powi(5);
+                // GGX with α = 1: D = 1/π.
+                let d = 1.0 / PI;
+                let g2 = 1.0 / (1.0 + lambda(mu_o) + lambda(mu_i));
+                let f = color / PI * (1.0 - fresnel) + fresnel * d * g2 / (4.0 * mu_o * mu_i);
+                sum += f * mu_i;
+            }
+        }
+        sum * 2.0 * PI / (n_mu * n_phi) as f64
+    }
+
+    /// At roughness 1, where the specification's model does not create energy, a grey
+    /// non-metal follows it at oblique incidence too, within 1% up to 76° (Cycles' albedo
+    /// scaling is 5% below it at 64–76°).
+    #[test]
+    fn oblique_albedo_at_roughness_one_is_the_specifications() {
+        let mut rng = Rng::new(45, 3);
+        let m = MetallicRoughness {
+            base_color: Spectrum::splat(0.8),
+            ..material(1.0, 0.0, 0.0, 1.5)
+        };
+        for theta in [40.0f32, 64.0, 76.0] {
+            let ours = albedo(&m, direction(theta), 200_000, &mut rng)[0] as f64;
+            let specification =
+                specification_albedo_at_roughness_one(0.8, m.f0() as f64, theta as f64);
+            assert!(
+                (ours / specification - 1.0).abs() < 0.01,
+                "θ {theta}: {ours} vs the specification's {specification}"
+            );
+        }
+    }
+
+    #[test]
+    fn face_on_albedo_is_the_specifications() {
+        let mut rng = Rng::new(45, 1);
+        for ior in [1.33f32, 1.5, 2.4] {
+            for roughness in [0.0f32, 0.1, 0.25, 0.5, 0.75, 1.0] {
+                let m = MetallicRoughness {
+                    base_color: Spectrum::splat(0.8),
+                    ..material(roughness, 0.0, 0.0, ior)
+                };
+                let ours = albedo(&m, normal(), 200_000, &mut rng)[0] as f64;
+                let specification = specification_face_on_albedo(0.8, roughness, m.f0());
+                assert!(
+                    (ours / specification - 1.0).abs() < 0.005,
+                    "ior {ior} roughness {roughness}: {ours} vs the specification's {specification}"
+                );
+            }
+        }
+    }
+
+    /// A white non-metal reflects all the light but what its coat's single scattering
+    /// loses, 1 − R(μo) (1 − E(μo)) (E the white GGX albedo, R the coat's reflectance, both
+    /// by the fine quadrature), at every angle and roughness; never more than arrives.
+    #[test]
+    fn white_dielectric_loses_only_the_coats_multiple_scattering() {
+        let mut rng = Rng::new(45, 2);
+        for roughness in [0.0f32, 0.1, 0.3, 0.6, 1.0] {
+            let m = MetallicRoughness {
+                base_color: Spectrum::ONE,
+                ..material(roughness, 0.0, 0.0, 1.5)
+            };
+            for theta in [0.0f32, 30.0, 60.0, 80.0, 89.0, 120.0, 170.0] {
+                let wo = direction(theta);
+                let mu = wo.dot(normal()).abs();
+                let expected = if roughness == 0.0 {
+                    1.0
+                } else {
+                    let [e, e_s] = single_scattering_albedos(roughness * roughness, mu, 1500, 180);
+                    let r = m.f0() as f64 + (1.0 - m.f0() as f64) * e_s / e;
+                    1.0 - r * (1.0 - e)
+                };
+                let a = albedo(&m, wo, 100_000, &mut rng)[0] as f64;
+                assert!(
+                    (a - expected).abs() < 0.01 && a <= 1.005,
+                    "roughness {roughness} θ {theta}: albedo {a}, expected {expected}"
+                );
             }
         }
     }

@@ -15,6 +15,14 @@
 //! quadrature over the half vectors, and interpolated bilinearly; E_avg is the exact cosine-weighted
 //! integral of the interpolated E, so the compensated white reflector's albedo is 1 up to the
 //! table's error in E alone.
+//!
+//! The same quadrature tabulates the reflectance of a GGX coat with Schlick's Fresnel: the
+//! Fresnel-weighted share of what its single scattering reflects, E_F(μ) / E(μ) =
+//! F0 + (1 − F0) E_s(μ) / E(μ), with E_F the albedo with Fresnel and E_s the albedo weighted
+//! by (1 − wo·h)⁵ (linear in F0, so one table serves every index of refraction). It is the
+//! albedo the coat would have with its multiple scattering restored (1 for F = 1), and the
+//! metallic-roughness model scales its diffuse base by what it leaves
+//! ([`CoatReflectance`]).
 
 use super::microfacet::{MIN_ALPHA, TrowbridgeReitz};
 use super::scattering::reflect;
@@ -35,6 +43,10 @@ struct AlbedoTable {
     albedo: Vec<f32>,
     /// E_avg per roughness node.
     average: Vec<f32>,
+    /// E_s / E, E_s the albedo weighted by Schlick's (1 − wo·h)⁵, as `albedo`.
+    schlick_share: Vec<f32>,
+    /// Its cosine-weighted mean per roughness node, as `average`.
+    schlick_share_average: Vec<f32>,
 }
 
 fn cosine_node(i: usize) -> f32 {
@@ -48,19 +60,31 @@ fn cosine_node(i: usize) -> f32 {
 /// the visible normals on a grid would leave the tail, where the loss is, to a node or
 /// two), and in the azimuth on one side of the plane of incidence (the integrand is
 /// symmetric about it): `polar_nodes` × `azimuth_nodes` nodes.
+#[cfg(test)]
 pub(crate) fn single_scattering_albedo(
     alpha: f32,
     mu: f32,
     polar_nodes: usize,
     azimuth_nodes: usize,
 ) -> f64 {
+    single_scattering_albedos(alpha, mu, polar_nodes, azimuth_nodes)[0]
+}
+
+/// The white albedo E (as [`single_scattering_albedo`]) and E_s, the same integral weighted
+/// by Schlick's (1 − wo·h)⁵, in one quadrature.
+pub(crate) fn single_scattering_albedos(
+    alpha: f32,
+    mu: f32,
+    polar_nodes: usize,
+    azimuth_nodes: usize,
+) -> [f64; 2] {
     use std::f64::consts::PI;
     let distribution = TrowbridgeReitz::new(alpha);
     let alpha = alpha.max(MIN_ALPHA);
     let mu = mu.max(1e-4);
     let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let alpha = alpha as f64;
-    let mut sum = 0.0f64;
+    let (mut sum, mut schlick) = (0.0f64, 0.0f64);
     for i in 0..polar_nodes {
         let x = (i as f64 + 0.5) / polar_nodes as f64;
         let t = (PI / 2.0 * x).tan();
@@ -82,40 +106,61 @@ pub(crate) fn single_scattering_albedo(
             }
             let f = distribution.d(h) as f64 * distribution.g2(wo, wi) as f64 * cos_oh as f64;
             sum += f * sin * d_theta;
+            schlick += f * sin * d_theta * (1.0 - cos_oh as f64).powi(5);
         }
     }
     // Both sides of the plane: 2 × π / azimuth_nodes per azimuth node.
-    sum * 2.0 * PI / (azimuth_nodes * polar_nodes) as f64 / mu as f64
+    let scale = 2.0 * PI / (azimuth_nodes * polar_nodes) as f64 / mu as f64;
+    [sum * scale, schlick * scale]
+}
+
+/// 2 ∫ E(μ) μ dμ of the E that is linear in μ between the cosine nodes, segment by segment
+/// exactly.
+fn cosine_weighted_mean(row: &[f32]) -> f32 {
+    let mut integral = 0.0f64;
+    for i in 0..COSINES - 1 {
+        let (a, b) = (cosine_node(i) as f64, cosine_node(i + 1) as f64);
+        let (ea, eb) = (row[i] as f64, row[i + 1] as f64);
+        let slope = (eb - ea) / (b - a);
+        let at = |x: f64| (ea - slope * a) * x * x / 2.0 + slope * x * x * x / 3.0;
+        integral += at(b) - at(a);
+    }
+    (2.0 * integral).min(1.0) as f32
 }
 
 fn table() -> &'static AlbedoTable {
     static TABLE: OnceLock<AlbedoTable> = OnceLock::new();
     TABLE.get_or_init(|| {
         let mut albedo = Vec::with_capacity(COSINES * ROUGHNESSES);
+        let mut schlick_share = Vec::with_capacity(COSINES * ROUGHNESSES);
         let mut average = Vec::with_capacity(ROUGHNESSES);
+        let mut schlick_share_average = Vec::with_capacity(ROUGHNESSES);
         for j in 0..ROUGHNESSES {
             let roughness = j as f32 / (ROUGHNESSES - 1) as f32;
             let alpha = roughness * roughness;
-            let row: Vec<f32> = (0..COSINES)
+            let (row, share_row): (Vec<f32>, Vec<f32>) = (0..COSINES)
                 .map(|i| {
-                    let e =
-                        single_scattering_albedo(alpha, cosine_node(i), POLAR_NODES, AZIMUTH_NODES);
-                    e.min(1.0) as f32
+                    let [e, e_s] = single_scattering_albedos(
+                        alpha,
+                        cosine_node(i),
+                        POLAR_NODES,
+                        AZIMUTH_NODES,
+                    );
+                    let share = if e > 0.0 { (e_s / e).min(1.0) } else { 1.0 };
+                    (e.min(1.0) as f32, share as f32)
                 })
-                .collect();
-            // 2 ∫ E(μ) μ dμ of the piecewise-linear E, segment by segment exactly.
-            let mut integral = 0.0f64;
-            for i in 0..COSINES - 1 {
-                let (a, b) = (cosine_node(i) as f64, cosine_node(i + 1) as f64);
-                let (ea, eb) = (row[i] as f64, row[i + 1] as f64);
-                let slope = (eb - ea) / (b - a);
-                let at = |x: f64| (ea - slope * a) * x * x / 2.0 + slope * x * x * x / 3.0;
-                integral += at(b) - at(a);
-            }
-            average.push((2.0 * integral).min(1.0) as f32);
+                .unzip();
+            average.push(cosine_weighted_mean(&row));
+            schlick_share_average.push(cosine_weighted_mean(&share_row));
             albedo.extend(row);
+            schlick_share.extend(share_row);
         }
-        AlbedoTable { albedo, average }
+        AlbedoTable {
+            albedo,
+            average,
+            schlick_share,
+            schlick_share_average,
+        }
     })
 }
 
@@ -124,6 +169,22 @@ fn roughness_cell(roughness: f32) -> (usize, f32) {
     let x = roughness.clamp(0.0, 1.0) * (ROUGHNESSES - 1) as f32;
     let j = (x as usize).min(ROUGHNESSES - 2);
     (j, x - j as f32)
+}
+
+/// A tabulated albedo (`albedo` or `schlick` of the table) at roughness node `j` plus
+/// weight `w` towards the next, and cosine `mu`: bilinear, linear in μ between the nodes
+/// (the integral of the averages assumes it).
+#[inline]
+fn lookup(values: &[f32], j: usize, w: f32, mu: f32) -> f32 {
+    let t = mu.clamp(0.0, 1.0).sqrt() * (COSINES - 1) as f32;
+    let i = (t as usize).min(COSINES - 2);
+    let (a, b) = (cosine_node(i), cosine_node(i + 1));
+    let s = ((mu - a) / (b - a)).clamp(0.0, 1.0);
+    let row = |j: usize| {
+        let e = &values[j * COSINES..];
+        e[i] * (1.0 - s) + e[i + 1] * s
+    };
+    row(j) * (1.0 - w) + row(j + 1) * w
 }
 
 /// A GGX reflector's compensation at one roughness: E and E_avg looked up in the table.
@@ -156,18 +217,12 @@ impl EnergyCompensation {
 
     /// E(μ): the white single-scattering lobe's albedo at cosine `mu`.
     pub fn albedo(&self, mu: f32) -> f32 {
-        let albedo = &table().albedo;
-        let t = mu.clamp(0.0, 1.0).sqrt() * (COSINES - 1) as f32;
-        let i = (t as usize).min(COSINES - 2);
-        // Linear in μ between the nodes (the integral of E_avg assumes it).
-        let (a, b) = (cosine_node(i), cosine_node(i + 1));
-        let s = ((mu - a) / (b - a)).clamp(0.0, 1.0);
-        let row = |j: usize| {
-            let e = &albedo[j * COSINES..];
-            e[i] * (1.0 - s) + e[i + 1] * s
-        };
-        let (j, w) = (self.roughness_node, self.roughness_weight);
-        row(j) * (1.0 - w) + row(j + 1) * w
+        lookup(
+            &table().albedo,
+            self.roughness_node,
+            self.roughness_weight,
+            mu,
+        )
     }
 
     /// The white compensation lobe f_ms at cosines `mu_o`, `mu_i` (without F_ms).
@@ -181,6 +236,55 @@ impl EnergyCompensation {
     pub fn fresnel(&self, f_avg: f32) -> f32 {
         let average = 1.0 - self.missing_average;
         f_avg * f_avg * average / (1.0 - f_avg * self.missing_average)
+    }
+}
+
+/// The reflectance of a dielectric coat, GGX of perceptual roughness `roughness` with
+/// Schlick's Fresnel of normal reflectance F0: the Fresnel-weighted share of what it
+/// reflects by single scattering, R(μ) = F0 + (1 − F0) E_s(μ) / E(μ), and its
+/// cosine-weighted mean. At roughness 0 it is Schlick's F itself, exactly, and its mean
+/// F0 + (1 − F0) / 21.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CoatReflectance {
+    f0: f32,
+    /// `None` at roughness 0.
+    cell: Option<(usize, f32)>,
+    /// R's cosine-weighted mean.
+    average: f32,
+}
+
+impl CoatReflectance {
+    pub fn new(roughness: f32, f0: f32) -> Self {
+        if roughness <= 0.0 {
+            return CoatReflectance {
+                f0,
+                cell: None,
+                average: f0 + (1.0 - f0) / 21.0,
+            };
+        }
+        let (j, w) = roughness_cell(roughness);
+        let shares = &table().schlick_share_average;
+        CoatReflectance {
+            f0,
+            cell: Some((j, w)),
+            average: f0 + (1.0 - f0) * (shares[j] * (1.0 - w) + shares[j + 1] * w),
+        }
+    }
+
+    /// R(μ): the coat's reflectance for light arriving at cosine `mu`.
+    #[inline]
+    pub fn reflectance(&self, mu: f32) -> f32 {
+        let share = match self.cell {
+            None => (1.0 - mu.clamp(0.0, 1.0)).powi(5),
+            Some((j, w)) => lookup(&table().schlick_share, j, w, mu),
+        };
+        self.f0 + (1.0 - self.f0) * share
+    }
+
+    /// The cosine-weighted mean of R.
+    #[inline]
+    pub fn average(&self) -> f32 {
+        self.average
     }
 }
 
@@ -214,5 +318,44 @@ mod tests {
             assert!(compensation.fresnel(0.5) < 0.5);
         }
         assert!(EnergyCompensation::new(0.0).is_none());
+    }
+
+    /// The coat's tabulated reflectance is the quadrature of GGX with Schlick's Fresnel
+    /// at fine resolution (within the table's interpolation), its mean the cosine-weighted
+    /// integral of it, and at roughness 0 Schlick's F and its mean exactly.
+    #[test]
+    fn coat_reflectance_is_the_fresnel_share_of_the_single_scattering() {
+        for roughness in [0.1f32, 0.45, 0.8, 1.0] {
+            for f0 in [0.02f32, 0.04, 0.17] {
+                let coat = CoatReflectance::new(roughness, f0);
+                for mu in [0.05f32, 0.3, 0.7, 1.0] {
+                    let [e, e_s] = single_scattering_albedos(roughness * roughness, mu, 1500, 180);
+                    let fine = f0 as f64 + (1.0 - f0 as f64) * e_s / e;
+                    let table = coat.reflectance(mu) as f64;
+                    assert!(
+                        (table - fine).abs() < 2e-3 + 1e-2 * fine,
+                        "roughness {roughness} F0 {f0} μ {mu}: table {table}, quadrature {fine}"
+                    );
+                }
+                let n = 4000;
+                let mean: f64 = (0..n)
+                    .map(|k| {
+                        let mu = (k as f32 + 0.5) / n as f32;
+                        (coat.reflectance(mu) * mu) as f64
+                    })
+                    .sum::<f64>()
+                    * 2.0
+                    / n as f64;
+                assert!(
+                    (mean - coat.average() as f64).abs() < 1e-4,
+                    "roughness {roughness} F0 {f0}: {mean} vs {}",
+                    coat.average()
+                );
+            }
+        }
+        let smooth = CoatReflectance::new(0.0, 0.04);
+        assert_eq!(smooth.reflectance(1.0), 0.04);
+        assert!((smooth.reflectance(0.0) - 1.0).abs() < 1e-6);
+        assert!((smooth.average() - (0.04 + 0.96 / 21.0)).abs() < 1e-7);
     }
 }
