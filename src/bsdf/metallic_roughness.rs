@@ -511,7 +511,9 @@ impl MetallicRoughness {
         let cos_o = view.wo.z;
         let transmitted = 1.0 - interface_reflectance(self.f0(), cos_o, view.eta());
         let reflection = mean(self.reflectance(cos_o, view.eta()));
-        let diffuse = mean(self.diffuse_tint()) * (1.0 - self.coat().reflectance(cos_o));
+        // The base's albedo is (1 − R(cos_o)) of its tint; 1 − F(cos_o) is close to it and
+        // cheaper (estimates only need to be positive where the lobe scatters).
+        let diffuse = mean(self.diffuse_tint()) * (1.0 - self.opaque_reflectance(cos_o));
         let transmission = mean(self.transmission_tint()) * transmitted;
         let at_least = |estimate: f32, scatters: bool| {
             if scatters {

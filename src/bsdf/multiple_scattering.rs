@@ -49,6 +49,7 @@ struct AlbedoTable {
     schlick_share_average: Vec<f32>,
 }
 
+#[inline]
 fn cosine_node(i: usize) -> f32 {
     let t = i as f32 / (COSINES - 1) as f32;
     t * t
@@ -85,6 +86,10 @@ pub(crate) fn single_scattering_albedos(
     let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let alpha = alpha as f64;
     let (mut sum, mut schlick) = (0.0f64, 0.0f64);
+    // The azimuths' sines and cosines, once rather than per polar node.
+    let azimuths: Vec<(f64, f64)> = (0..azimuth_nodes)
+        .map(|j| (PI * (j as f64 + 0.5) / azimuth_nodes as f64).sin_cos())
+        .collect();
     for i in 0..polar_nodes {
         let x = (i as f64 + 0.5) / polar_nodes as f64;
         let t = (PI / 2.0 * x).tan();
@@ -92,13 +97,8 @@ pub(crate) fn single_scattering_albedos(
         // dθ/dx, with the sine of the solid angle.
         let d_theta = alpha * PI / 2.0 * (1.0 + t * t) / (1.0 + alpha * alpha * t * t);
         let (sin, cos) = theta.sin_cos();
-        for j in 0..azimuth_nodes {
-            let phi = PI * (j as f64 + 0.5) / azimuth_nodes as f64;
-            let h = Vec3A::new(
-                (sin * phi.cos()) as f32,
-                (sin * phi.sin()) as f32,
-                cos as f32,
-            );
+        for &(sin_phi, cos_phi) in &azimuths {
+            let h = Vec3A::new((sin * cos_phi) as f32, (sin * sin_phi) as f32, cos as f32);
             let cos_oh = wo.dot(h);
             let wi = reflect(wo, h);
             if cos_oh <= 0.0 || wi.z <= 0.0 {
@@ -128,6 +128,7 @@ fn cosine_weighted_mean(row: &[f32]) -> f32 {
     (2.0 * integral).min(1.0) as f32
 }
 
+#[inline]
 fn table() -> &'static AlbedoTable {
     static TABLE: OnceLock<AlbedoTable> = OnceLock::new();
     TABLE.get_or_init(|| {
@@ -165,6 +166,7 @@ fn table() -> &'static AlbedoTable {
 }
 
 /// The roughness node below `roughness` and the weight of the one above.
+#[inline]
 fn roughness_cell(roughness: f32) -> (usize, f32) {
     let x = roughness.clamp(0.0, 1.0) * (ROUGHNESSES - 1) as f32;
     let j = (x as usize).min(ROUGHNESSES - 2);
@@ -247,36 +249,52 @@ impl EnergyCompensation {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CoatReflectance {
     f0: f32,
-    /// `None` at roughness 0.
-    cell: Option<(usize, f32)>,
+    /// The table's rows of E_s / E at the roughness nodes below and above, and the weight
+    /// of the one above; `None` at roughness 0.
+    rows: Option<(&'static [f32; COSINES], &'static [f32; COSINES], f32)>,
     /// R's cosine-weighted mean.
     average: f32,
 }
 
 impl CoatReflectance {
+    #[inline]
     pub fn new(roughness: f32, f0: f32) -> Self {
         if roughness <= 0.0 {
             return CoatReflectance {
                 f0,
-                cell: None,
+                rows: None,
                 average: f0 + (1.0 - f0) / 21.0,
             };
         }
+        let table = table();
         let (j, w) = roughness_cell(roughness);
-        let shares = &table().schlick_share_average;
+        let row = |j: usize| -> &'static [f32; COSINES] {
+            table.schlick_share[j * COSINES..(j + 1) * COSINES]
+                .try_into()
+                .expect("a row of the table")
+        };
+        let shares = &table.schlick_share_average;
         CoatReflectance {
             f0,
-            cell: Some((j, w)),
+            rows: Some((row(j), row(j + 1), w)),
             average: f0 + (1.0 - f0) * (shares[j] * (1.0 - w) + shares[j + 1] * w),
         }
     }
 
-    /// R(μ): the coat's reflectance for light arriving at cosine `mu`.
+    /// R(μ): the coat's reflectance for light arriving at cosine `mu` (linear in μ between
+    /// the table's nodes, as the mean's integral assumes).
     #[inline]
     pub fn reflectance(&self, mu: f32) -> f32 {
-        let share = match self.cell {
-            None => (1.0 - mu.clamp(0.0, 1.0)).powi(5),
-            Some((j, w)) => lookup(&table().schlick_share, j, w, mu),
+        let mu = mu.clamp(0.0, 1.0);
+        let share = match self.rows {
+            None => (1.0 - mu).powi(5),
+            Some((lower, upper, w)) => {
+                let i = ((mu.sqrt() * (COSINES - 1) as f32) as usize).min(COSINES - 2);
+                let (a, b) = (cosine_node(i), cosine_node(i + 1));
+                let s = ((mu - a) / (b - a)).clamp(0.0, 1.0);
+                let at = |row: &[f32; COSINES]| row[i] + (row[i + 1] - row[i]) * s;
+                at(lower) + (at(upper) - at(lower)) * w
+            }
         };
         self.f0 + (1.0 - self.f0) * share
     }
