@@ -93,6 +93,9 @@ pub struct Range {
 }
 
 impl Range {
+    /// `[0, 1]`, a fraction or probability; its rule is [`in_unit_interval`].
+    pub const UNIT: Range = Range::closed(0.0, 1.0);
+
     /// `[min, max]`.
     pub const fn closed(min: f64, max: f64) -> Range {
         Range {
@@ -129,6 +132,11 @@ impl Range {
 /// What an out-of-range value's message says after `"<prefix>.<name> is <value>; "`, given
 /// the whole struct (a limit may depend on another parameter).
 pub type Rule<S> = fn(&S) -> String;
+
+/// The rule of [`Range::UNIT`].
+pub fn in_unit_interval<S>(_: &S) -> String {
+    "it must be in [0, 1]".into()
+}
 
 /// What is known of one parameter of the struct `S`.
 pub struct Parameter<S> {

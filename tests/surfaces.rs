@@ -157,6 +157,26 @@ fn quad_before_a_lamp() -> (Vec<f32>, Vec<u32>, Vec<f32>) {
     (positions, indices, texcoords)
 }
 
+/// The quad with `materials[0]` before the lamp with `materials[1]`, and `textures`.
+fn quad_before_a_lamp_scene(
+    materials: &[Material; 2],
+    textures: &[TextureDesc],
+    backend: Backend,
+) -> Scene {
+    let (positions, indices, texcoords) = quad_before_a_lamp();
+    Scene::new(&SceneDesc {
+        positions: &positions,
+        indices: &indices,
+        material_ids: &[0, 0, 1, 1],
+        materials,
+        texcoords: &texcoords,
+        textures,
+        backend,
+        ..Default::default()
+    })
+    .unwrap()
+}
+
 /// A pinhole at z = 1 whose 90° view just covers the quad.
 fn quad_camera() -> mlt::Camera {
     mlt::Camera {
@@ -174,7 +194,6 @@ fn quad_camera() -> mlt::Camera {
 /// with the texture's orientation wrong) whole quarters would be black or lit.
 #[test]
 fn alpha_cut_outs_let_rays_through_in_every_backend() {
-    let (positions, indices, texcoords) = quad_before_a_lamp();
     // Grey + alpha, 8-bit: alpha 0 (a hole) on the diagonal.
     let texture = TextureDesc {
         width: 2,
@@ -198,17 +217,7 @@ fn alpha_cut_outs_let_rays_through_in_every_backend() {
         if !backend.is_available() {
             continue;
         }
-        let scene = Scene::new(&SceneDesc {
-            positions: &positions,
-            indices: &indices,
-            material_ids: &[0, 0, 1, 1],
-            materials: &materials,
-            texcoords: &texcoords,
-            textures: std::slice::from_ref(&texture),
-            backend,
-            ..Default::default()
-        })
-        .unwrap();
+        let scene = quad_before_a_lamp_scene(&materials, std::slice::from_ref(&texture), backend);
         let settings = RenderSettings {
             width: 8,
             height: 8,
@@ -328,7 +337,6 @@ fn a_normal_map_shades_like_its_normal_baked_into_the_vertices() {
 /// the untextured quad of transmission 1 lets through.
 #[test]
 fn a_transmission_texture_multiplies_the_transmission() {
-    let (positions, indices, texcoords) = quad_before_a_lamp();
     let grey = |value: f32| TextureDesc {
         width: 1,
         height: 1,
@@ -355,17 +363,7 @@ fn a_transmission_texture_multiplies_the_transmission() {
         ..Default::default()
     };
     let render = |quad: Material| {
-        let materials = [quad, lamp];
-        let scene = Scene::new(&SceneDesc {
-            positions: &positions,
-            indices: &indices,
-            material_ids: &[0, 0, 1, 1],
-            materials: &materials,
-            texcoords: &texcoords,
-            textures: &textures,
-            ..Default::default()
-        })
-        .unwrap();
+        let scene = quad_before_a_lamp_scene(&[quad, lamp], &textures, Backend::Bvh);
         render_image(&scene, &quad_camera(), &settings)
     };
     let quarter_by_texture = render(glass(1.0, Some(0)));

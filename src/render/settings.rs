@@ -8,7 +8,7 @@ use crate::filter::{
 use crate::integrators::mlt::driver::MutationWeights;
 use crate::integrators::path::Roulette;
 use crate::params::{
-    ChoiceParameter, Kind, ParameterType, Range, Unfit, Value, declare_parameters,
+    ChoiceParameter, Kind, ParameterType, Range, Unfit, Value, declare_parameters, in_unit_interval,
 };
 /// The light-transport algorithm of a render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -194,8 +194,8 @@ declare_parameters! {
         large_step_probability: f32 = 0.3 => {
             doc: "PSSMLT: probability of a large (independent) step.",
             flag: "large-step",
-            range: Range::closed(0.0, 1.0),
-            rule: |_| "it must be in [0, 1]".into(),
+            range: Range::UNIT,
+            rule: in_unit_interval,
         },
         /// PSSMLT: standard deviation of a small step in primary sample space.
         small_step_sigma: f32 = 0.01 => {

@@ -2,7 +2,7 @@
 
 use crate::bsdf::{BsdfModel, MetallicRoughness};
 use crate::error::{Error, Result};
-use crate::params::{ChoiceParameter, Range, declare_parameters};
+use crate::params::{ChoiceParameter, Range, declare_parameters, in_unit_interval};
 use crate::spectral::Channels;
 use crate::spectrum::Spectrum;
 pub use crate::texture::TextureRef;
@@ -77,27 +77,27 @@ declare_parameters! {
         /// Metalness in [0, 1] (metallic-roughness only).
         metallic: f32 = 0.0 => {
             doc: "Metallic-roughness: metalness, 0 a dielectric, 1 a metal whose reflectance is the colour.",
-            range: Range::closed(0.0, 1.0),
-            rule: |_| "it must be in [0, 1]".into(),
+            range: Range::UNIT,
+            rule: in_unit_interval,
         },
         /// Perceptual roughness in [0, 1] (metallic-roughness only).
         roughness: f32 = 1.0 => {
             doc: "Metallic-roughness: perceptual roughness (GGX alpha = roughness squared; 0 is the exact specular lobe).",
-            range: Range::closed(0.0, 1.0),
-            rule: |_| "it must be in [0, 1]".into(),
+            range: Range::UNIT,
+            rule: in_unit_interval,
         },
         /// The fraction of the non-metallic base that is transmission, in [0, 1]
         /// (metallic-roughness only).
         transmission: f32 = 0.0 => {
             doc: "Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely reflected (KHR_materials_transmission).",
-            range: Range::closed(0.0, 1.0),
-            rule: |_| "it must be in [0, 1]".into(),
+            range: Range::UNIT,
+            rule: in_unit_interval,
         },
         /// Coverage in [0, 1], used by `AlphaMode::Mask`.
         alpha: f32 = 1.0 => {
             doc: "Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask alpha mode.",
-            range: Range::closed(0.0, 1.0),
-            rule: |_| "it must be in [0, 1]".into(),
+            range: Range::UNIT,
+            rule: in_unit_interval,
         },
         alpha_mode: AlphaMode = AlphaMode::Opaque => {
             doc: "What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff (glTF's MASK).",
