@@ -381,7 +381,9 @@ def heat_map(ours, theirs, mask, stops=0.5):
 
 
 def side_by_side(path, ours, theirs, mask, upscale=2):
-    scale = 0.8 / max(np.percentile(luminance(theirs), 99), 1e-12)
+    # One exposure for both, set by the model (the sky behind it may clip).
+    seen = luminance(theirs)[mask] if mask.any() else luminance(theirs)
+    scale = 0.8 / max(np.percentile(seen, 99), 1e-12)
     panels = [to_srgb8(ours, scale), to_srgb8(theirs, scale), heat_map(ours, theirs, mask)]
     gap = np.full((ours.shape[0], 2, 3), 255, np.uint8)
     row = np.concatenate([panels[0], gap, panels[1], gap, panels[2]], axis=1)
@@ -397,8 +399,9 @@ FURNACE_COSINES = (0.95, 0.8, 0.6, 0.4, 0.2, 0.1)
 
 
 def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
-    """A unit sphere of sheen alone: black base, index of refraction 1 (so no specular
-    lobe), white sheen of the given roughness."""
+    """A unit sphere of sheen alone: black base, `KHR_materials_specular`'s factor 0 (no
+    specular lobe at any angle: an index of refraction of 1 would leave Schlick's grazing
+    term), white sheen of the given roughness."""
     import base64
     positions, indices = [], []
     for i in range(rings + 1):
@@ -417,7 +420,7 @@ def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
     count = len(positions) // 3
     document = {
         "asset": {"version": "2.0"},
-        "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_ior"],
+        "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_specular"],
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0}],
@@ -427,7 +430,7 @@ def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
             "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
                                      "roughnessFactor": 1},
             "extensions": {
-                "KHR_materials_ior": {"ior": 1.0},
+                "KHR_materials_specular": {"specularFactor": 0.0},
                 "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
                                         "sheenRoughnessFactor": roughness},
             },
@@ -729,7 +732,7 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
             "",
             "Where Cycles departs from the specification: its sheen is Blender's own model, not",
             "the Charlie sheen of `KHR_materials_sheen`. A unit sphere of sheen alone (black base,",
-            "index of refraction 1 so no specular lobe, white sheen) under a white sky of",
+            "`KHR_materials_specular`'s factor 0 so no specular lobe, white sheen) under a white sky of",
             "radiance 1: a pixel's value is the directional albedo at its cos θo (the pixels",
             "within ±0.02 of it, averaged). The specification's column is its BRDF (Charlie",
             "distribution and visibility, no Fresnel, alphaG = sheenRoughness as it writes)",
