@@ -55,6 +55,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 ASSETS = os.path.join(HERE, "assets")
 DEFAULT_ASSETS = [
+    # No extension: metals and dielectrics over roughness, the control.
+    "MetalRoughSpheresNoTextures",
     "ClearCoatTest",
     "SpecularTest",
     "SheenCloth",
