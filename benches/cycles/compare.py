@@ -96,13 +96,30 @@ def gltf_json(path):
     return json.loads(data[20 : 20 + length])
 
 
-def extensions_of(path):
+def features_of(path):
+    """The file's `extensionsUsed` (shortened), and the core features mlt may lack: texture
+    coordinate sets past the first, alpha modes other than OPAQUE."""
     document = gltf_json(path)
-    used = document.get("extensionsUsed", [])
     required = set(document.get("extensionsRequired", []))
-    short = [e.replace("KHR_materials_", "").replace("KHR_", "") + (" (required)" if e in required else "")
-             for e in used]
-    return ", ".join(short) if short else "—"
+    features = [e.replace("KHR_materials_", "").replace("KHR_", "")
+                + (" (required)" if e in required else "")
+                for e in document.get("extensionsUsed", [])]
+
+    def texture_sets(value):
+        if isinstance(value, dict):
+            if "index" in value and value.get("texCoord", 0) > 0:
+                yield value["texCoord"]
+            for item in value.values():
+                yield from texture_sets(item)
+        elif isinstance(value, list):
+            for item in value:
+                yield from texture_sets(item)
+
+    materials = document.get("materials", [])
+    features += [f"texCoord {n}" for n in sorted(set(texture_sets(materials)))]
+    features += [f"alpha {mode}" for mode in
+                 sorted({m.get("alphaMode", "OPAQUE") for m in materials} - {"OPAQUE"})]
+    return ", ".join(features) if features else "—"
 
 
 # ---------------------------------------------------------------- frames and cameras
@@ -397,7 +414,7 @@ def side_by_side(path, ours, theirs, mask, upscale=2):
 
 
 SHEEN_ROUGHNESSES = (0.3, 0.5, 1.0)
-FURNACE_COSINES = (0.95, 0.8, 0.6, 0.4, 0.2, 0.1)
+FURNACE_COSINES = (0.95, 0.8, 0.6, 0.4, 0.25)
 
 
 def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
@@ -532,7 +549,10 @@ def sheen_furnace(args, directory):
         setup_camera(camera)
         cycles_path = os.path.join(directory, f"sheen_{roughness}_cycles.exr")
         render_cycles(cycles_path)
-        theirs = luminance(read_exr(cycles_path))
+        theirs = read_exr(cycles_path)
+        # Pixels the sphere covers fully: the silhouette's would mix in the sky.
+        inside = theirs[..., 3] >= 0.999
+        theirs = luminance(theirs)
         out = os.path.join(directory, f"sheen_{roughness}_mlt.exr")
         camera_path = os.path.join(directory, "camera.json")
         with open(camera_path, "w") as f:
@@ -543,7 +563,7 @@ def sheen_furnace(args, directory):
         result = subprocess.run(command, capture_output=True, text=True)
         ours = luminance(read_exr(out)) if result.returncode == 0 else None
         for cos_o in FURNACE_COSINES:
-            ring = np.abs(cosines - cos_o) < 0.02
+            ring = (np.abs(cosines - cos_o) < 0.02) & inside
             mlt = (f"{ours[ring].mean():.3f}" if ours is not None
                    else "refused: " + result.stderr.strip().splitlines()[-1])
             rows.append((roughness, cos_o, sheen_albedo(cos_o, roughness),
@@ -634,7 +654,7 @@ def run_asset(args, name, sky, directory, background_cache):
 
     mlt_path = os.path.join(directory, name + "_mlt.exr")
     mlt_seconds, error = render_mlt(args, scene, camera, sky, mlt_path, directory)
-    result = {"name": name, "extensions": extensions_of(scene), "coverage": mask.mean(),
+    result = {"name": name, "features": features_of(scene), "coverage": mask.mean(),
               "cycles_seconds": cycles_seconds, "mlt_seconds": mlt_seconds, "error": error}
     if error is None:
         ours = read_exr(mlt_path)
@@ -645,15 +665,15 @@ def run_asset(args, name, sky, directory, background_cache):
 
 
 def table(results):
-    lines = ["| asset | extensions | covered | mean luminance | worst 16×16 block | mlt s | Cycles s |",
+    lines = ["| asset | features | covered | mean luminance | worst 16×16 block | mlt s | Cycles s |",
              "|---|---|---:|---:|---:|---:|---:|"]
     for r in results:
         if r["error"] is not None:
-            lines.append(f"| {r['name']} | {r['extensions']} | {100 * r['coverage']:.0f}% | refused: "
+            lines.append(f"| {r['name']} | {r['features']} | {100 * r['coverage']:.0f}% | refused: "
                          f"{r['error'].replace('|', '/')} | — | — | {r['cycles_seconds']:.1f} |")
             continue
         worst = "—" if r["worst"] is None else f"{r['worst']:.3f}"
-        lines.append(f"| {r['name']} | {r['extensions']} | {100 * r['coverage']:.0f}% | "
+        lines.append(f"| {r['name']} | {r['features']} | {100 * r['coverage']:.0f}% | "
                      f"{r['mean']:.3f} | {worst} | {r['mlt_seconds']:.1f} | "
                      f"{r['cycles_seconds']:.1f} |")
     return "\n".join(lines)
@@ -718,8 +738,9 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
         "Ratios mlt / Cycles of luminance over the pixels the model covers fully (Cycles'",
         "alpha); the worst block is the 16×16 block (at least a quarter covered) whose ratio is",
         "furthest from 1; seconds are wall-clock (mlt's include loading the file and building",
-        "its acceleration structure), each renderer on the same threads. Extensions are the",
-        "file's `extensionsUsed`, shortened (`KHR_materials_` left out). An asset mlt cannot",
+        "its acceleration structure), each renderer on the same threads. Features are the",
+        "file's `extensionsUsed`, shortened (`KHR_materials_` left out), texture coordinate",
+        "sets past the first and alpha modes other than OPAQUE. An asset mlt cannot",
         "load is marked refused, with its message.",
         "",
         table(results),
@@ -742,7 +763,7 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
             "the Charlie sheen of `KHR_materials_sheen`. A unit sphere of sheen alone (black base,",
             "`KHR_materials_specular`'s factor 0 so no specular lobe, white sheen) under a white sky of",
             "radiance 1: a pixel's value is the directional albedo at its cos θo (the pixels",
-            "within ±0.02 of it, averaged). The specification's column is its BRDF (Charlie",
+            "the sphere covers whose centre's cos θo is within ±0.02, averaged). The specification's column is its BRDF (Charlie",
             "distribution and visibility, no Fresnel, alphaG = sheenRoughness as it writes)",
             "integrated numerically by the script; the next column squares the roughness first,",
             "as the Khronos sample viewer does.",
