@@ -466,7 +466,8 @@ def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
             {"buffer": 0, "byteOffset": 2 * len(vertex_bytes), "byteLength": len(index_bytes)},
         ],
         "buffers": [{"byteLength": len(data),
-                     "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+                     "uri": "data:application/octet-stream;base64,"
+                            + base64.b64encode(data).decode()}],
     }
     with open(path, "w") as f:
         json.dump(document, f)
@@ -665,12 +666,14 @@ def run_asset(args, name, sky, directory, background_cache):
 
 
 def table(results):
-    lines = ["| asset | features | covered | mean luminance | worst 16×16 block | mlt s | Cycles s |",
+    lines = ["| asset | features | covered | mean luminance | worst 16×16 block | mlt s | "
+             "Cycles s |",
              "|---|---|---:|---:|---:|---:|---:|"]
     for r in results:
         if r["error"] is not None:
             lines.append(f"| {r['name']} | {r['features']} | {100 * r['coverage']:.0f}% | refused: "
-                         f"{r['error'].replace('|', '/')} | — | — | {r['cycles_seconds']:.1f} |")
+                         f"{r['error'].replace('|', '/')} | — | — | "
+                         f"{r['cycles_seconds']:.1f} |")
             continue
         worst = "—" if r["worst"] is None else f"{r['worst']:.3f}"
         lines.append(f"| {r['name']} | {r['features']} | {100 * r['coverage']:.0f}% | "
@@ -716,8 +719,8 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
         "Khronos glTF sample assets (`benches/cycles/assets`, each with its licence) rendered by",
         "mlt's path tracer and by Blender Cycles (`bpy` 5.0.1, its stock glTF importer), with the",
         "same camera (the model's bounding box framed from the front), the same sky",
-        f"(`{args.sky}`, the only light), {args.size}² pixels, {args.spp} samples per pixel, depth",
-        f"{args.depth}, a 1-pixel box filter, single-scattering GGX in Cycles' Principled BSDF,",
+        f"(`{args.sky}`, the only light), {args.size}² pixels, {args.spp} samples per pixel,",
+        f"depth {args.depth}, a 1-pixel box filter, single-scattering GGX in Cycles' Principled BSDF,",
         "no denoising or clamping, linear EXR. What the script does and why is in its doc",
         "comment; [benchmarks](benchmarks.md#gltf-assets-against-blender-cycles) says what the",
         "figures mean. Command (about "
@@ -760,13 +763,15 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
             "## Sheen alone in a white furnace",
             "",
             "Where Cycles departs from the specification: its sheen is Blender's own model, not",
-            "the Charlie sheen of `KHR_materials_sheen`. A unit sphere of sheen alone (black base,",
-            "`KHR_materials_specular`'s factor 0 so no specular lobe, white sheen) under a white sky of",
-            "radiance 1: a pixel's value is the directional albedo at its cos θo (the pixels",
-            "the sphere covers whose centre's cos θo is within ±0.02, averaged). The specification's column is its BRDF (Charlie",
-            "distribution and visibility, no Fresnel, alphaG = sheenRoughness as it writes)",
-            "integrated numerically by the script; the next column squares the roughness first,",
-            "as the Khronos sample viewer does.",
+            "the Charlie sheen of `KHR_materials_sheen`. A unit sphere of sheen alone (black",
+            "base, `KHR_materials_specular`'s factor 0 so no specular lobe, white sheen) under a",
+            "white sky of radiance 1: a pixel's value is the directional albedo at its cos θo",
+            "(averaged over the pixels the sphere covers whose centre's cos θo is within ±0.02).",
+            "The specification's column is its BRDF (Charlie distribution and visibility, no",
+            "Fresnel, alphaG = sheenRoughness as it writes) integrated numerically by the",
+            "script; the next column squares the roughness first, as the Khronos sample viewer",
+            "does. mlt's column is whatever mlt makes of that material: the sheen where it reads",
+            "it, else the black base's specular lobe.",
             "",
             furnace_table(furnace_rows),
             "",
