@@ -38,6 +38,7 @@ Defaults: 128 x 128, 64 spp, depth 8 (scattering vertices; Cycles' bounces are o
 the soft pedestrian_overpass sky, 2 threads each.
 """
 import argparse
+import base64
 import json
 import math
 import os
@@ -323,7 +324,6 @@ def far_triangle_gltf(path):
     """A glTF with one tiny triangle far below the origin (mlt refuses a scene with no
     triangles): the sky-only scene, seen from the origin by cameras looking sideways."""
     positions = struct.pack("<9f", 0.0, -1000.0, 0.0, 0.001, -1000.0, 0.0, 0.0, -1000.0, 0.001)
-    import base64
     document = {
         "asset": {"version": "2.0"},
         "scene": 0,
@@ -421,7 +421,6 @@ def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
     """A unit sphere of sheen alone: black base, `KHR_materials_specular`'s factor 0 (no
     specular lobe at any angle: an index of refraction of 1 would leave Schlick's grazing
     term), white sheen of the given roughness."""
-    import base64
     positions, indices = [], []
     for i in range(rings + 1):
         theta = math.pi * i / rings
@@ -620,7 +619,7 @@ def sky_check(args, sky, directory):
     return rows
 
 
-def run_asset(args, name, sky, directory, background_cache):
+def run_asset(args, name, sky, directory):
     scene = asset_file(name)
     reset_blender()
     setup_cycles(args, transparent=True)
@@ -812,7 +811,7 @@ def main():
     print(sky_table(sky_rows), flush=True)
     results = []
     for name in args.assets.split(","):
-        result = run_asset(args, name, sky, directory, None)
+        result = run_asset(args, name, sky, directory)
         results.append(result)
         print(f"{name}: {result.get('mean', result['error'])}", flush=True)
     print(table(results), flush=True)
