@@ -316,7 +316,9 @@ def render_mlt(args, scene, camera, sky, out, directory):
     seconds = time.perf_counter() - start
     if result.returncode != 0:
         lines = [line for line in result.stderr.strip().splitlines() if line.strip()]
-        return None, lines[-1] if lines else f"exit status {result.returncode}"
+        message = lines[-1] if lines else f"exit status {result.returncode}"
+        # The page names the file, not where this checkout lives.
+        return None, message.replace(scene, os.path.basename(scene))
     return seconds, None
 
 
