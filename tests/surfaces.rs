@@ -242,6 +242,68 @@ fn alpha_cut_outs_let_rays_through_in_every_backend() {
     }
 }
 
+/// Blended alpha is stochastic coverage: a black quad of alpha 0.3 (`AlphaMode::Blend`) before
+/// a lamp of radiance 1 lets exactly 0.7 of the lamp through, in every algorithm (camera rays
+/// through the quad, light paths crossing it and connections through it to the camera)
+/// and every backend. Each estimate comes from 16 independent renders (the spread of their
+/// means gives its standard error, valid for Markov chains too), and each check would fail a
+/// 2% error (0.686 or 0.714) by two more standard errors.
+#[test]
+fn alpha_blend_lets_one_minus_alpha_through_in_every_algorithm_and_backend() {
+    let materials = [
+        Material {
+            alpha_mode: AlphaMode::Blend,
+            alpha: 0.3,
+            ..Material::diffuse([0.0; 3])
+        },
+        Material::diffuse([0.0; 3]).with_emission([1.0; 3]),
+    ];
+    const SIDE: u32 = 16;
+    for backend in [Backend::Bvh, Backend::Embree] {
+        if !backend.is_available() {
+            continue;
+        }
+        let scene = quad_before_a_lamp_scene(&materials, &[], backend);
+        for algorithm in [
+            Algorithm::Path,
+            Algorithm::Bdpt,
+            Algorithm::Pssmlt,
+            Algorithm::PssmltBdpt,
+            Algorithm::Mmlt,
+            Algorithm::PathSpaceMlt,
+            Algorithm::Erpt,
+        ] {
+            let renders: Vec<Vec<f32>> = (0..16)
+                .map(|seed| {
+                    let settings = RenderSettings {
+                        width: SIDE,
+                        height: SIDE,
+                        algorithm,
+                        samples_per_pixel: 64,
+                        mutations_per_pixel: 64,
+                        bootstrap_samples: 1 << 16,
+                        chains: 64,
+                        max_depth: 2,
+                        seed: 4500 + seed,
+                        ..Default::default()
+                    };
+                    render_image(&scene, &quad_camera(), &settings)
+                })
+                .collect();
+            let estimate =
+                Estimate::from_correlated_renders(SIDE as usize, SIDE as usize, &renders);
+            let (mean, variance) = estimate.mean();
+            common::stats::assert_within_and_sharp(
+                &format!("{algorithm:?} through alpha 0.3 with {backend:?}"),
+                mean[0],
+                0.7,
+                variance[0].sqrt(),
+                6.0,
+            );
+        }
+    }
+}
+
 /// A normal map bends the shading normal exactly as normals baked into the vertices
 /// would: the quad with a one-texel normal map (and given tangents) renders as the quad
 /// whose vertex normals are that texel's normal in world space, under a sun at a grazing

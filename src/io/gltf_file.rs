@@ -689,10 +689,8 @@ impl Loader<'_> {
                 .map_or(0.0, |t| t.transmission_factor()),
             alpha_mode: match material.alpha_mode() {
                 ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-                // Blending is rendered as a cut-out at the cutoff (0.5 by default).
-                ::gltf::material::AlphaMode::Mask | ::gltf::material::AlphaMode::Blend => {
-                    AlphaMode::Mask
-                }
+                ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+                ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
             },
             alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
             ..Material::metallic_roughness([r, g, b], pbr.metallic_factor(), pbr.roughness_factor())
