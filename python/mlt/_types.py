@@ -52,12 +52,15 @@ class Algorithm(str, enum.Enum):
 class TextureRef:
     """A material's use of a texture: its index in ``Scene.from_arrays(textures=...)`` and
     the ``KHR_texture_transform`` applied to the texture coordinates first (scale, then
-    rotate by ``rotation`` radians counter-clockwise, then offset)."""
+    rotate by ``rotation`` radians counter-clockwise, then offset), at the texture
+    coordinate set ``texcoord``: 0 (``texcoords``) or 1 (``texcoords1``), glTF's
+    ``texCoord``."""
 
     texture: int
     offset: Tuple[float, float] = (0.0, 0.0)
     rotation: float = 0.0
     scale: Tuple[float, float] = (1.0, 1.0)
+    texcoord: int = 0
 
 
 @dataclass

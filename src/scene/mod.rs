@@ -60,6 +60,9 @@ pub struct SceneDesc<'a> {
     /// Per-vertex texture coordinates, u, v per vertex, or empty. glTF's convention: (0, 0)
     /// is the top-left corner of a texture, v grows downwards.
     pub texcoords: &'a [f32],
+    /// A second set of per-vertex texture coordinates (glTF `TEXCOORD_1`), u, v per vertex,
+    /// or empty; textures whose `TextureRef::texcoord` is 1 are looked up at these.
+    pub texcoords1: &'a [f32],
     /// Per-vertex tangents for normal maps, x, y, z, w per vertex (w = ±1: the bitangent
     /// is w · normal × tangent, glTF's convention), or empty: then they are computed with
     /// MikkTSpace where a material has a normal map.
@@ -85,6 +88,7 @@ impl Default for SceneDesc<'_> {
             build_quality: BuildQuality::default(),
             normals: &[],
             texcoords: &[],
+            texcoords1: &[],
             tangents: &[],
             colors: &[],
             textures: &[],
@@ -97,6 +101,7 @@ impl<'a> SceneDesc<'a> {
         surface::VertexArrays {
             normals: self.normals,
             texcoords: self.texcoords,
+            texcoords1: self.texcoords1,
             tangents: self.tangents,
             colors: self.colors,
         }
@@ -184,6 +189,7 @@ fn fingerprint(desc: &SceneDesc) -> u64 {
     words(&mut h, desc.material_ids, u32::to_le_bytes);
     floats(&mut h, desc.normals);
     floats(&mut h, desc.texcoords);
+    floats(&mut h, desc.texcoords1);
     floats(&mut h, desc.tangents);
     floats(&mut h, desc.colors);
     let LightsDesc {
@@ -782,6 +788,15 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
         if material.has_textures() && desc.texcoords.is_empty() && !desc.indices.is_empty() {
             return Err(Error::invalid(format!(
                 "desc.materials[{i}] has textures but desc.texcoords is empty; textured materials need texture coordinates"
+            ))
+            .about_material(i));
+        }
+        if let Some((slot, _)) = material.textures().find(|(_, t)| t.texcoord == 1)
+            && desc.texcoords1.is_empty()
+            && !desc.indices.is_empty()
+        {
+            return Err(Error::invalid(format!(
+                "desc.materials[{i}].{slot} uses texture coordinate set 1 but desc.texcoords1 is empty"
             ))
             .about_material(i));
         }
