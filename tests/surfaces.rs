@@ -333,6 +333,92 @@ fn alpha_blend_lets_one_minus_alpha_through_in_every_algorithm_and_backend() {
     }
 }
 
+/// A texture reads the texture coordinate set its `TextureRef::texcoord` names: a lamp quad
+/// whose emission texture is black at set 0's coordinates and white at set 1's renders
+/// black or white by the set, with either backend's hits; and a reference to set 1 without
+/// `texcoords1`, or to set 2, is refused by name.
+#[test]
+fn a_texture_reads_the_texture_coordinate_set_it_names() {
+    let (positions, indices, _) = quad_before_a_lamp();
+    let (positions, indices) = (&positions[..12], &indices[..6]);
+    // Texel 0 black, texel 1 white; set 0 inside texel 0, set 1 inside texel 1.
+    let texture = TextureDesc {
+        width: 2,
+        height: 1,
+        channels: 1,
+        data: TexelData::U8(Cow::Owned(vec![0, 255])),
+        encoding: TextureEncoding::Linear,
+        wrap_u: WrapMode::ClampToEdge,
+        wrap_v: WrapMode::ClampToEdge,
+        filter: TextureFilter::Nearest,
+    };
+    let set0 = [0.1, 0.5, 0.3, 0.2, 0.4, 0.9, 0.2, 0.6];
+    let set1 = [0.6, 0.5, 0.8, 0.2, 0.9, 0.9, 0.7, 0.6];
+    let lamp = |texcoord| {
+        [Material {
+            emission_texture: Some(TextureRef {
+                texcoord,
+                ..TextureRef::new(0)
+            }),
+            ..Material::diffuse([0.0; 3]).with_emission([1.0; 3])
+        }]
+    };
+    let settings = RenderSettings {
+        width: 4,
+        height: 4,
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 1,
+        max_depth: 0,
+        ..Default::default()
+    };
+    for backend in [Backend::Bvh, Backend::Embree] {
+        if !backend.is_available() {
+            continue;
+        }
+        for (texcoord, expected) in [(0, 0.0), (1, 1.0)] {
+            let materials = lamp(texcoord);
+            let scene = Scene::new(&SceneDesc {
+                positions,
+                indices,
+                materials: &materials,
+                texcoords: &set0,
+                texcoords1: &set1,
+                textures: std::slice::from_ref(&texture),
+                backend,
+                ..Default::default()
+            })
+            .unwrap();
+            let image = render_image(&scene, &quad_camera(), &settings);
+            assert!(
+                image.iter().all(|&v| (v - expected).abs() < 1e-5),
+                "{backend:?}, set {texcoord}: {image:?}"
+            );
+        }
+    }
+    let refused = |texcoord, texcoords1: &[f32]| {
+        let materials = lamp(texcoord);
+        Scene::new(&SceneDesc {
+            positions,
+            indices,
+            materials: &materials,
+            texcoords: &set0,
+            texcoords1,
+            textures: std::slice::from_ref(&texture),
+            ..Default::default()
+        })
+        .err()
+        .expect("refused")
+        .to_string()
+    };
+    let error = refused(1, &[]);
+    assert!(
+        error.contains("emission_texture") && error.contains("texcoords1"),
+        "{error}"
+    );
+    let error = refused(2, &set1);
+    assert!(error.contains("texcoord is 2"), "{error}");
+}
+
 /// A normal map bends the shading normal exactly as normals baked into the vertices
 /// would: the quad with a one-texel normal map (and given tangents) renders as the quad
 /// whose vertex normals are that texel's normal in world space, under a sun at a grazing
