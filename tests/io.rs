@@ -886,6 +886,67 @@ fn gltf_tex_coord_selects_the_texture_coordinate_set() {
     );
 }
 
+/// `KHR_materials_unlit`: the material emits its base colour and scatters nothing, so the
+/// camera sees the base colour itself (paths up to 4 bounces add nothing).
+#[test]
+fn gltf_unlit_material_is_seen_as_its_base_colour() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "extensionsUsed": ["KHR_materials_unlit"],
+  "scene": 0,
+  "scenes": [{{ "nodes": [0] }}],
+  "nodes": [{{ "mesh": 0 }}],
+  "meshes": [{{ "primitives": [{{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0 }}] }}],
+  "materials": [{{ "name": "unlit", "extensions": {{ "KHR_materials_unlit": {{}} }},
+                   "pbrMetallicRoughness": {{ "baseColorFactor": [0.2, 0.4, 0.6, 1] }} }}],
+  "buffers": [{{ "uri": "{uri}", "byteLength": {len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 12 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+       "min": [0, -1, -1], "max": [0, 1, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#,
+        len = buffer.len()
+    );
+    let path = temp_path("unlit.gltf");
+    std::fs::write(&path, json).unwrap();
+    let data = io::load_scene(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let (_, material) = material_named(&data, "unlit");
+    assert_eq!(material.emission, [0.2, 0.4, 0.6]);
+    assert_eq!(material.color, [0.0; 3]);
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    let camera = mlt::Camera {
+        eye: [5.0, 0.0, 0.0],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 10.0,
+        ..Default::default()
+    };
+    let settings = mlt::RenderSettings {
+        width: 4,
+        height: 4,
+        algorithm: mlt::Algorithm::Path,
+        samples_per_pixel: 4,
+        max_depth: 4,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; 4 * 4 * 3];
+    mlt::render(&scene, &camera, &settings, &mut image, None).unwrap();
+    for pixel in image.chunks_exact(3) {
+        for (got, want) in pixel.iter().zip([0.2, 0.4, 0.6]) {
+            assert!((got - want).abs() < 1e-5, "{pixel:?}");
+        }
+    }
+}
+
 /// A negative `KHR_materials_dispersion` is refused with a message naming it.
 #[test]
 fn gltf_with_negative_dispersion_is_refused() {

@@ -782,6 +782,22 @@ impl Loader<'_> {
                 converted.abbe_number = (20.0 / dispersion) as f32;
             }
         }
+        // KHR_materials_unlit (not parsed by the gltf crate): the base colour (times its
+        // texture) is emitted as radiance and nothing is scattered, so the surface looks its
+        // colour to every path and is one consistent light in every algorithm. The base
+        // colour texture stays for its alpha.
+        if material.extension_value("KHR_materials_unlit").is_some() {
+            converted = Material {
+                kind: MaterialKind::Diffuse,
+                color: [0.0; 3],
+                emission_texture: converted.base_color_texture,
+                metallic_roughness_texture: None,
+                normal_texture: None,
+                transmission_texture: None,
+                ..converted
+            }
+            .with_emission([r, g, b]);
+        }
         // Without texture coordinates every lookup would read one texel; glTF files with
         // textures always carry them, so this is a broken file.
         if let Some((slot, texture)) = converted
