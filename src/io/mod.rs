@@ -77,7 +77,8 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   roughness factors and textures, `normalTexture` with its scale, emission =
 ///   `emissiveFactor` × `KHR_materials_emissive_strength` × `emissiveTexture`,
 ///   `KHR_materials_transmission` (factor; its texture is ignored), `KHR_materials_ior`,
-///   `KHR_texture_transform`, alpha modes (`BLEND` as stochastic coverage,
+///   `KHR_texture_transform`, `KHR_materials_unlit` (the base colour emitted, nothing
+///   scattered), alpha modes (`BLEND` as stochastic coverage,
 ///   [`crate::AlphaMode::Blend`]). Images (PNG, JPEG; embedded, data URIs or files) become
 ///   textures: base colour and emission decoded as sRGB, the others linear, with the
 ///   sampler's wrap modes and nearest or bilinear filtering. Attributes: `NORMAL`,
