@@ -189,7 +189,10 @@ fn fingerprint(desc: &SceneDesc) -> u64 {
     words(&mut h, desc.material_ids, u32::to_le_bytes);
     floats(&mut h, desc.normals);
     floats(&mut h, desc.texcoords);
-    floats(&mut h, desc.texcoords1);
+    // Only when given: the fingerprints of scenes with one set stay as they were.
+    if !desc.texcoords1.is_empty() {
+        floats(&mut h, desc.texcoords1);
+    }
     floats(&mut h, desc.tangents);
     floats(&mut h, desc.colors);
     let LightsDesc {
