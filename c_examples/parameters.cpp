@@ -20,7 +20,7 @@
 // BEGIN GENERATED constants: tests/parameters.rs writes these lines from the declarations
 static_assert(MLT_ALGORITHM_PATH == 0 && MLT_ALGORITHM_BDPT == 1 && MLT_ALGORITHM_PSSMLT == 2 && MLT_ALGORITHM_MMLT == 3 && MLT_ALGORITHM_PSSMLT_BDPT == 4 && MLT_ALGORITHM_PATH_SPACE_MLT == 5 && MLT_ALGORITHM_ERPT == 6, "MLT_ALGORITHM_* are 0, 1, ... in the declared order");
 static_assert(MLT_MATERIAL_DIFFUSE == 0 && MLT_MATERIAL_MIRROR == 1 && MLT_MATERIAL_DIELECTRIC == 2 && MLT_MATERIAL_METALLIC_ROUGHNESS == 3, "MLT_MATERIAL_* are 0, 1, ... in the declared order");
-static_assert(MLT_ALPHA_OPAQUE == 0 && MLT_ALPHA_MASK == 1, "MLT_ALPHA_* are 0, 1, ... in the declared order");
+static_assert(MLT_ALPHA_OPAQUE == 0 && MLT_ALPHA_MASK == 1 && MLT_ALPHA_BLEND == 2, "MLT_ALPHA_* are 0, 1, ... in the declared order");
 // END GENERATED constants
 
 namespace {

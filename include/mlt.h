@@ -89,6 +89,13 @@
 #define MLT_ALPHA_MASK 1
 
 /**
+ * `MltMaterial.alpha_mode`: stochastic coverage (glTF `BLEND`): a fraction alpha of the light
+ * meets the surface and 1 − alpha passes straight through, decided by a fixed pseudo-random
+ * threshold per surface point; `alpha_cutoff` is unused.
+ */
+#define MLT_ALPHA_BLEND 2
+
+/**
  * `MltTextureRef.texture` of a material slot without a texture.
  */
 #define MLT_NO_TEXTURE -1
@@ -490,12 +497,13 @@ typedef struct MltMaterial {
   float transmission;
   /**
    * Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
-   * alpha mode. It must be in [0, 1]. Default 1.0.
+   * and blend alpha modes. It must be in [0, 1]. Default 1.0.
    */
   float alpha;
   /**
    * What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
-   * (glTF's MASK). One of `MLT_ALPHA_*`. Default `MLT_ALPHA_OPAQUE`.
+   * (glTF's MASK), blend lets a fraction 1 - alpha of the light pass straight through (glTF's
+   * BLEND, as stochastic coverage). One of `MLT_ALPHA_*`. Default `MLT_ALPHA_OPAQUE`.
    */
   int32_t alpha_mode;
   /**

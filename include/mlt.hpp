@@ -139,6 +139,7 @@ enum class MaterialKind : std::int32_t {
 enum class AlphaMode : std::int32_t {
     Opaque = MLT_ALPHA_OPAQUE,
     Mask = MLT_ALPHA_MASK,
+    Blend = MLT_ALPHA_BLEND,
 };
 
 /// `MLT_TEXEL_*`.
@@ -236,7 +237,8 @@ static_assert(detail::c_value(MaterialKind::Diffuse) == MLT_MATERIAL_DIFFUSE &&
                       MLT_MATERIAL_METALLIC_ROUGHNESS,
               "mlt::MaterialKind mirrors MLT_MATERIAL_*");
 static_assert(detail::c_value(AlphaMode::Opaque) == MLT_ALPHA_OPAQUE &&
-                  detail::c_value(AlphaMode::Mask) == MLT_ALPHA_MASK,
+                  detail::c_value(AlphaMode::Mask) == MLT_ALPHA_MASK &&
+                  detail::c_value(AlphaMode::Blend) == MLT_ALPHA_BLEND,
               "mlt::AlphaMode mirrors MLT_ALPHA_*");
 static_assert(detail::c_value(TexelType::U8) == MLT_TEXEL_U8 &&
                   detail::c_value(TexelType::F32) == MLT_TEXEL_F32,
@@ -461,10 +463,11 @@ struct Material {
     /// reflected (KHR_materials_transmission).
     float transmission = 0.0f;
     /// Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
-    /// alpha mode.
+    /// and blend alpha modes.
     float alpha = 1.0f;
     /// What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
-    /// (glTF's MASK).
+    /// (glTF's MASK), blend lets a fraction 1 - alpha of the light pass straight through (glTF's
+    /// BLEND, as stochastic coverage).
     AlphaMode alpha_mode = AlphaMode::Opaque;
     /// The mask alpha mode's threshold (glTF's alphaCutoff).
     float alpha_cutoff = 0.5f;

@@ -372,6 +372,9 @@ fn lerp4(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
 pub struct TextureRef {
     /// Index into `SceneDesc::textures`.
     pub texture: u32,
+    /// The texture coordinate set it is looked up at: 0 (`SceneDesc::texcoords`) or 1
+    /// (`SceneDesc::texcoords1`), glTF's `texCoord`.
+    pub texcoord: u32,
     pub offset: [f32; 2],
     /// Radians, counter-clockwise in uv space as `KHR_texture_transform` defines it.
     pub rotation: f32,
@@ -383,6 +386,7 @@ impl TextureRef {
     pub const fn new(texture: u32) -> Self {
         TextureRef {
             texture,
+            texcoord: 0,
             offset: [0.0; 2],
             rotation: 0.0,
             scale: [1.0; 2],
@@ -405,6 +409,12 @@ impl TextureRef {
             return Err(Error::invalid(format!(
                 "{name}.texture is {}, but there are only {texture_count} textures",
                 self.texture
+            )));
+        }
+        if self.texcoord > 1 {
+            return Err(Error::invalid(format!(
+                "{name}.texcoord is {}; the texture coordinate sets are 0 and 1",
+                self.texcoord
             )));
         }
         check_finite(&format_args!("{name}.rotation"), self.rotation)?;

@@ -229,8 +229,8 @@ fn scene_create_bad_surfaces() {
         h.host.materials[0].alpha = -0.5 => ["desc.materials[0].alpha is -0.5", "[0, 1]"],
         h.host.materials[0].alpha_cutoff = -0.25
             => ["desc.materials[0].alpha_cutoff is -0.25", "negative"],
-        h.host.materials[0].alpha_mode = 2
-            => ["desc.materials[0].alpha_mode is 2", "MLT_ALPHA_OPAQUE", "MLT_ALPHA_MASK"],
+        h.host.materials[0].alpha_mode = 3
+            => ["desc.materials[0].alpha_mode is 3", "MLT_ALPHA_OPAQUE", "MLT_ALPHA_MASK", "MLT_ALPHA_BLEND"],
         h.host.materials[1].alpha_mode = -1 => ["desc.materials[1].alpha_mode is -1"],
         h.host.materials[0].energy_compensation = 2
             => ["desc.materials[0].energy_compensation is 2", "0 or 1"],

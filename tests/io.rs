@@ -793,6 +793,160 @@ fn check_gltf_scene(data: &SceneData) {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// A quad with two texture coordinate sets and one texture, whose base colour texture reads
+/// `TEXCOORD_{base_set}` (with `alphaMode` BLEND), written with its image into a fresh
+/// directory; returns the glTF's path.
+fn two_uv_sets_gltf(base_set: u32) -> PathBuf {
+    let dir = temp_path("two-uv-sets");
+    std::fs::create_dir_all(&dir).unwrap();
+    io::write_png(
+        &dir.join("texture.png"),
+        2,
+        1,
+        &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+    )
+    .unwrap();
+    let mut buffer = quad_buffer();
+    for set in [[0.25f32, 0.5], [0.75, 0.5]] {
+        for corner in 0..4 {
+            for (k, c) in set.iter().enumerate() {
+                // Each corner its own coordinates, so the order of corners is checked too.
+                buffer.extend_from_slice(&(c + 0.01 * (corner * 2 + k) as f32).to_le_bytes());
+            }
+        }
+    }
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "scene": 0,
+  "scenes": [{{ "nodes": [0] }}],
+  "nodes": [{{ "mesh": 0 }}],
+  "meshes": [{{ "primitives": [{{ "attributes": {{ "POSITION": 0, "TEXCOORD_0": 2, "TEXCOORD_1": 3 }},
+                                  "indices": 1, "material": 0 }}] }}],
+  "materials": [{{ "name": "two sets", "alphaMode": "BLEND",
+                   "pbrMetallicRoughness": {{ "baseColorFactor": [1, 1, 1, 0.3],
+                                              "baseColorTexture": {{ "index": 0, "texCoord": {base_set} }} }},
+                   "emissiveFactor": [1, 1, 1],
+                   "emissiveTexture": {{ "index": 0 }} }}],
+  "textures": [{{ "source": 0 }}],
+  "images": [{{ "uri": "texture.png" }}],
+  "buffers": [{{ "uri": "{uri}", "byteLength": {len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 12 }},
+    {{ "buffer": 0, "byteOffset": 60, "byteLength": 32 }},
+    {{ "buffer": 0, "byteOffset": 92, "byteLength": 32 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+       "min": [0, -1, -1], "max": [0, 1, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }},
+    {{ "bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2" }},
+    {{ "bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC2" }}
+  ]
+}}"#,
+        len = buffer.len()
+    );
+    let path = dir.join("two-uv-sets.gltf");
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+/// glTF's `texCoord` picks the texture coordinate set: the loader reads `TEXCOORD_1` into
+/// `texcoords1` (vertex for vertex) and gives the base colour texture set 1, the emissive
+/// one set 0; `alphaMode` BLEND is `AlphaMode::Blend`. A set past 1 is refused by name.
+#[test]
+fn gltf_tex_coord_selects_the_texture_coordinate_set() {
+    let path = two_uv_sets_gltf(1);
+    let data = io::load_scene(&path).unwrap();
+    let (_, material) = material_named(&data, "two sets");
+    assert_eq!(material.alpha_mode, mlt::AlphaMode::Blend);
+    assert_eq!(material.alpha, 0.3);
+    assert_eq!(material.base_color_texture.unwrap().texcoord, 1);
+    assert_eq!(material.emission_texture.unwrap().texcoord, 0);
+    assert_eq!(data.texcoords.len(), 8);
+    assert_eq!(data.texcoords1.len(), 8);
+    for vertex in 0..4 {
+        for k in 0..2 {
+            let offset = 0.01 * (vertex * 2 + k) as f32;
+            assert_eq!(data.texcoords[vertex * 2 + k], [0.25, 0.5][k] + offset);
+            assert_eq!(data.texcoords1[vertex * 2 + k], [0.75, 0.5][k] + offset);
+        }
+    }
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+
+    let path = two_uv_sets_gltf(2);
+    let error = io::load_scene(&path).unwrap_err().to_string();
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+    assert!(
+        error.contains("TEXCOORD_2") && error.contains("TEXCOORD_1"),
+        "{error}"
+    );
+}
+
+/// `KHR_materials_unlit`: the material emits its base colour and scatters nothing, so the
+/// camera sees the base colour itself (paths up to 4 bounces add nothing).
+#[test]
+fn gltf_unlit_material_is_seen_as_its_base_colour() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "extensionsUsed": ["KHR_materials_unlit"],
+  "scene": 0,
+  "scenes": [{{ "nodes": [0] }}],
+  "nodes": [{{ "mesh": 0 }}],
+  "meshes": [{{ "primitives": [{{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0 }}] }}],
+  "materials": [{{ "name": "unlit", "extensions": {{ "KHR_materials_unlit": {{}} }},
+                   "pbrMetallicRoughness": {{ "baseColorFactor": [0.2, 0.4, 0.6, 1] }} }}],
+  "buffers": [{{ "uri": "{uri}", "byteLength": {len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 12 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+       "min": [0, -1, -1], "max": [0, 1, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#,
+        len = buffer.len()
+    );
+    let path = temp_path("unlit.gltf");
+    std::fs::write(&path, json).unwrap();
+    let data = io::load_scene(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let (_, material) = material_named(&data, "unlit");
+    assert_eq!(material.emission, [0.2, 0.4, 0.6]);
+    assert_eq!(material.color, [0.0; 3]);
+    let scene = Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+    let camera = mlt::Camera {
+        eye: [5.0, 0.0, 0.0],
+        target: [0.0, 0.0, 0.0],
+        up: [0.0, 1.0, 0.0],
+        fov_y_deg: 10.0,
+        ..Default::default()
+    };
+    let settings = mlt::RenderSettings {
+        width: 4,
+        height: 4,
+        algorithm: mlt::Algorithm::Path,
+        samples_per_pixel: 4,
+        max_depth: 4,
+        ..Default::default()
+    };
+    let mut image = vec![0.0; 4 * 4 * 3];
+    mlt::render(&scene, &camera, &settings, &mut image, None).unwrap();
+    for pixel in image.chunks_exact(3) {
+        for (got, want) in pixel.iter().zip([0.2, 0.4, 0.6]) {
+            assert!((got - want).abs() < 1e-5, "{pixel:?}");
+        }
+    }
+}
+
 /// A negative `KHR_materials_dispersion` is refused with a message naming it.
 #[test]
 fn gltf_with_negative_dispersion_is_refused() {

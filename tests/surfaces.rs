@@ -242,6 +242,183 @@ fn alpha_cut_outs_let_rays_through_in_every_backend() {
     }
 }
 
+/// Blended alpha is stochastic coverage: a black 8 × 8 m quad of alpha 0.3
+/// (`AlphaMode::Blend`) at z = 0 before a diffuse plane (albedo 0.8) at z = −1, lit by a sun
+/// of irradiance π through the quad. Sunlight crosses the quad once to reach the plane and
+/// once more on its way to the camera, each time at another point, so the camera sees
+/// 0.7 × 0.7 × 0.8 cos θ (θ the sun's angle): in every algorithm (camera paths and light
+/// paths crossing it, connections through it) and every backend. Each estimate comes from
+/// 16 independent renders (the spread of their means gives its standard error, valid for
+/// Markov chains too), and each check would fail a 2% error by two more standard errors.
+#[test]
+fn alpha_blend_lets_one_minus_alpha_through_in_every_algorithm_and_backend() {
+    #[rustfmt::skip]
+    let positions = [
+        -4.0, 4.0, 0.0,  4.0, 4.0, 0.0,  4.0, -4.0, 0.0,  -4.0, -4.0, 0.0,
+        -8.0, 8.0, -1.0,  8.0, 8.0, -1.0,  8.0, -8.0, -1.0,  -8.0, -8.0, -1.0,
+    ];
+    let indices = [0, 3, 2, 0, 2, 1, 4, 7, 6, 4, 6, 5];
+    let materials = [
+        Material {
+            alpha_mode: AlphaMode::Blend,
+            alpha: 0.3,
+            ..Material::diffuse([0.0; 3])
+        },
+        Material::diffuse([0.8; 3]),
+    ];
+    let sun = [0.5f32, 0.0, 1.0];
+    let cos_sun = 1.0 / (1.0f64 + 0.25).sqrt();
+    let truth = 0.7 * 0.7 * 0.8 * cos_sun;
+    const SIDE: u32 = 16;
+    for backend in [Backend::Bvh, Backend::Embree] {
+        if !backend.is_available() {
+            continue;
+        }
+        let scene = Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &indices,
+            material_ids: &[0, 0, 1, 1],
+            materials: &materials,
+            lights: mlt::LightsDesc {
+                sun: Some(mlt::SunDesc {
+                    direction: sun,
+                    angular_radius_degrees: 0.0,
+                    irradiance: [std::f32::consts::PI; 3],
+                }),
+                ..Default::default()
+            },
+            backend,
+            ..Default::default()
+        })
+        .unwrap();
+        for algorithm in [
+            Algorithm::Path,
+            Algorithm::Bdpt,
+            Algorithm::Pssmlt,
+            Algorithm::PssmltBdpt,
+            Algorithm::Mmlt,
+            Algorithm::PathSpaceMlt,
+            Algorithm::Erpt,
+        ] {
+            let renders: Vec<Vec<f32>> = (0..16)
+                .map(|seed| {
+                    let settings = RenderSettings {
+                        width: SIDE,
+                        height: SIDE,
+                        algorithm,
+                        samples_per_pixel: 128,
+                        mutations_per_pixel: 64,
+                        bootstrap_samples: 1 << 16,
+                        chains: 64,
+                        // The chains render every path, the direct light too.
+                        direct_samples_per_mutation: 0,
+                        max_depth: 2,
+                        seed: 4500 + seed,
+                        ..Default::default()
+                    };
+                    render_image(&scene, &quad_camera(), &settings)
+                })
+                .collect();
+            let estimate =
+                Estimate::from_correlated_renders(SIDE as usize, SIDE as usize, &renders);
+            let (mean, variance) = estimate.mean();
+            common::stats::assert_within_and_sharp(
+                &format!("{algorithm:?} through alpha 0.3 with {backend:?}"),
+                mean[0],
+                truth,
+                variance[0].sqrt(),
+                6.0,
+            );
+        }
+    }
+}
+
+/// A texture reads the texture coordinate set its `TextureRef::texcoord` names: a lamp quad
+/// whose emission texture is black at set 0's coordinates and white at set 1's renders
+/// black or white by the set, with either backend's hits; and a reference to set 1 without
+/// `texcoords1`, or to set 2, is refused by name.
+#[test]
+fn a_texture_reads_the_texture_coordinate_set_it_names() {
+    let (positions, indices, _) = quad_before_a_lamp();
+    let (positions, indices) = (&positions[..12], &indices[..6]);
+    // Texel 0 black, texel 1 white; set 0 inside texel 0, set 1 inside texel 1.
+    let texture = TextureDesc {
+        width: 2,
+        height: 1,
+        channels: 1,
+        data: TexelData::U8(Cow::Owned(vec![0, 255])),
+        encoding: TextureEncoding::Linear,
+        wrap_u: WrapMode::ClampToEdge,
+        wrap_v: WrapMode::ClampToEdge,
+        filter: TextureFilter::Nearest,
+    };
+    let set0 = [0.1, 0.5, 0.3, 0.2, 0.4, 0.9, 0.2, 0.6];
+    let set1 = [0.6, 0.5, 0.8, 0.2, 0.9, 0.9, 0.7, 0.6];
+    let lamp = |texcoord| {
+        [Material {
+            emission_texture: Some(TextureRef {
+                texcoord,
+                ..TextureRef::new(0)
+            }),
+            ..Material::diffuse([0.0; 3]).with_emission([1.0; 3])
+        }]
+    };
+    let settings = RenderSettings {
+        width: 4,
+        height: 4,
+        algorithm: Algorithm::Path,
+        samples_per_pixel: 1,
+        max_depth: 0,
+        ..Default::default()
+    };
+    for backend in [Backend::Bvh, Backend::Embree] {
+        if !backend.is_available() {
+            continue;
+        }
+        for (texcoord, expected) in [(0, 0.0), (1, 1.0)] {
+            let materials = lamp(texcoord);
+            let scene = Scene::new(&SceneDesc {
+                positions,
+                indices,
+                materials: &materials,
+                texcoords: &set0,
+                texcoords1: &set1,
+                textures: std::slice::from_ref(&texture),
+                backend,
+                ..Default::default()
+            })
+            .unwrap();
+            let image = render_image(&scene, &quad_camera(), &settings);
+            assert!(
+                image.iter().all(|&v| (v - expected).abs() < 1e-5),
+                "{backend:?}, set {texcoord}: {image:?}"
+            );
+        }
+    }
+    let refused = |texcoord, texcoords1: &[f32]| {
+        let materials = lamp(texcoord);
+        Scene::new(&SceneDesc {
+            positions,
+            indices,
+            materials: &materials,
+            texcoords: &set0,
+            texcoords1,
+            textures: std::slice::from_ref(&texture),
+            ..Default::default()
+        })
+        .err()
+        .expect("refused")
+        .to_string()
+    };
+    let error = refused(1, &[]);
+    assert!(
+        error.contains("emission_texture") && error.contains("texcoords1"),
+        "{error}"
+    );
+    let error = refused(2, &set1);
+    assert!(error.contains("texcoord is 2"), "{error}");
+}
+
 /// A normal map bends the shading normal exactly as normals baked into the vertices
 /// would: the quad with a one-texel normal map (and given tangents) renders as the quad
 /// whose vertex normals are that texel's normal in world space, under a sun at a grazing

@@ -228,6 +228,8 @@ fn texture_slot(u: &mut Unstructured, textures: usize) -> Result<Value> {
         offset: [float(u, -1.0, 1.0)?, float(u, -1.0, 1.0)?],
         rotation: float(u, -4.0, 4.0)?,
         scale: [float(u, -2.0, 4.0)?, float(u, -2.0, 4.0)?],
+        // Set 1 without `texcoords1`, or 2, is refused.
+        texcoord: u.int_in_range(0..=2)?,
     })))
 }
 

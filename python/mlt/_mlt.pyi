@@ -73,6 +73,7 @@ class Scene:
         *,
         normals: Optional[npt.ArrayLike] = None,
         texcoords: Optional[npt.ArrayLike] = None,
+        texcoords1: Optional[npt.ArrayLike] = None,
         tangents: Optional[npt.ArrayLike] = None,
         colors: Optional[npt.ArrayLike] = None,
         textures: Optional[Iterable[Texture]] = None,

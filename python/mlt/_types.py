@@ -52,12 +52,15 @@ class Algorithm(str, enum.Enum):
 class TextureRef:
     """A material's use of a texture: its index in ``Scene.from_arrays(textures=...)`` and
     the ``KHR_texture_transform`` applied to the texture coordinates first (scale, then
-    rotate by ``rotation`` radians counter-clockwise, then offset)."""
+    rotate by ``rotation`` radians counter-clockwise, then offset), at the texture
+    coordinate set ``texcoord``: 0 (``texcoords``) or 1 (``texcoords1``), glTF's
+    ``texCoord``."""
 
     texture: int
     offset: Tuple[float, float] = (0.0, 0.0)
     rotation: float = 0.0
     scale: Tuple[float, float] = (1.0, 1.0)
+    texcoord: int = 0
 
 
 @dataclass
@@ -79,7 +82,8 @@ class Material:
     ``metallic_roughness_texture`` multiplies ``roughness`` (green) and ``metallic``
     (blue), ``normal_texture`` is a tangent-space normal map scaled by ``normal_scale``,
     ``emission_texture`` multiplies ``emission``. ``alpha_mode="mask"`` cuts the surface
-    out where alpha < ``alpha_cutoff``.
+    out where alpha < ``alpha_cutoff``; ``alpha_mode="blend"`` lets a fraction 1 - alpha of
+    the light pass straight through.
 
     ``energy_compensation`` (metallic-roughness) adds Kulla and Conty's multiple-scattering
     lobe to rough metals. ``abbe_number`` (0: none) makes a dielectric disperse light in
@@ -106,11 +110,12 @@ class Material:
     #: Metallic-roughness: the fraction of the non-metallic base transmitted, not diffusely
     #: reflected (KHR_materials_transmission).
     transmission: float = 0.0
-    #: Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
-    #: alpha mode.
+    #: Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask and
+    #: blend alpha modes.
     alpha: float = 1.0
     #: What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
-    #: (glTF's MASK).
+    #: (glTF's MASK), blend lets a fraction 1 - alpha of the light pass straight through (glTF's
+    #: BLEND, as stochastic coverage).
     alpha_mode: str = "opaque"
     #: The mask alpha mode's threshold (glTF's alphaCutoff).
     alpha_cutoff: float = 0.5

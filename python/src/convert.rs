@@ -252,6 +252,7 @@ fn texture_ref(obj: &Bound<'_, PyAny>, owner: &str, name: &str) -> PyResult<Opti
     let owner = format!("{owner}.{name}");
     Ok(Some(TextureRef {
         texture: field(&value, &owner, "texture")?,
+        texcoord: field(&value, &owner, "texcoord")?,
         offset: field(&value, &owner, "offset")?,
         rotation: field(&value, &owner, "rotation")?,
         scale: field(&value, &owner, "scale")?,

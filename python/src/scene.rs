@@ -63,6 +63,7 @@ struct OwnedDesc {
     materials: Vec<mlt::Material>,
     normals: Vec<f32>,
     texcoords: Vec<f32>,
+    texcoords1: Vec<f32>,
     tangents: Vec<f32>,
     colors: Vec<f32>,
     textures: Vec<mlt::TextureDesc<'static>>,
@@ -85,6 +86,7 @@ impl OwnedDesc {
             build_quality,
             normals: &self.normals,
             texcoords: &self.texcoords,
+            texcoords1: &self.texcoords1,
             tangents: &self.tangents,
             colors: &self.colors,
             textures: &self.textures,
@@ -106,9 +108,10 @@ impl Scene {
     /// (integers, converted to uint32).
     /// materials: `Material`s (or dicts of their fields); default one 0.8 grey diffuse.
     /// material_ids: (M,) index into `materials` per triangle; default material 0.
-    /// normals (N, 3), texcoords (N, 2), tangents (N, 4), colors (N, 4) or (N, 3): optional
-    /// per-vertex shading normals, texture coordinates (glTF's convention: (0, 0) is the
-    /// image's top-left), tangents for normal maps, linear RGB(A) colours.
+    /// normals (N, 3), texcoords (N, 2), texcoords1 (N, 2), tangents (N, 4), colors (N, 4) or
+    /// (N, 3): optional per-vertex shading normals, texture coordinates (glTF's convention:
+    /// (0, 0) is the image's top-left) and a second set of them (for `TextureRef`s whose
+    /// `texcoord` is 1), tangents for normal maps, linear RGB(A) colours.
     /// textures: `Texture`s the materials refer to.
     /// environment, sun, lights: an `Environment`, a `Sun`, and `PunctualLight`s.
     /// backend: "bvh" (default) or "embree" (only in builds with the feature).
@@ -118,7 +121,7 @@ impl Scene {
     /// Raises `InvalidArgumentError` (a `ValueError`) naming the array and element at fault:
     /// a wrong shape or dtype, a non-finite coordinate, an index out of range.
     #[staticmethod]
-    #[pyo3(signature = (positions, indices, materials=None, material_ids=None, *, normals=None, texcoords=None, tangents=None, colors=None, textures=None, environment=None, sun=None, lights=None, backend="bvh", build_quality="high"))]
+    #[pyo3(signature = (positions, indices, materials=None, material_ids=None, *, normals=None, texcoords=None, texcoords1=None, tangents=None, colors=None, textures=None, environment=None, sun=None, lights=None, backend="bvh", build_quality="high"))]
     #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         py: Python<'_>,
@@ -128,6 +131,7 @@ impl Scene {
         material_ids: Option<&Bound<'_, PyAny>>,
         normals: Option<&Bound<'_, PyAny>>,
         texcoords: Option<&Bound<'_, PyAny>>,
+        texcoords1: Option<&Bound<'_, PyAny>>,
         tangents: Option<&Bound<'_, PyAny>>,
         colors: Option<&Bound<'_, PyAny>>,
         textures: Option<&Bound<'_, PyAny>>,
@@ -168,6 +172,7 @@ impl Scene {
             materials,
             normals: convert::vertex_rows(normals, "normals", 3)?,
             texcoords: convert::vertex_rows(texcoords, "texcoords", 2)?,
+            texcoords1: convert::vertex_rows(texcoords1, "texcoords1", 2)?,
             tangents: convert::vertex_rows(tangents, "tangents", 4)?,
             colors,
             textures,

@@ -101,6 +101,25 @@ def test_emission_texture_multiplies_emission() -> None:
     np.testing.assert_allclose(image, np.broadcast_to((1.0, 0.5, 2.0), image.shape), rtol=1e-5)
 
 
+def test_texture_reads_the_texture_coordinate_set_it_names() -> None:
+    # Texel 0 is black, texel 1 white; set 0 lies inside texel 0, set 1 inside texel 1.
+    positions, indices = quad()
+    texcoords = np.array([[0.1, 0.5], [0.3, 0.5], [0.3, 0.6], [0.1, 0.6]], np.float32)
+    texcoords1 = texcoords + np.array([0.5, 0.0], np.float32)
+    texture = mlt.Texture(np.array([[[0.0], [1.0]]], np.float32), filter="nearest", wrap_u="clamp_to_edge")
+    for texcoord, expected in [(0, 0.0), (1, 1.0)]:
+        material = mlt.Material.diffuse((0.0, 0.0, 0.0), emission=(1.0, 1.0, 1.0))
+        material.emission_texture = mlt.TextureRef(0, texcoord=texcoord)
+        scene = mlt.Scene.from_arrays(
+            positions, indices, [material], texcoords=texcoords, texcoords1=texcoords1, textures=[texture]
+        )
+        image, _ = mlt.render(scene, CAMERA, small("path"))
+        np.testing.assert_allclose(image, np.full(image.shape, expected), atol=1e-5)
+    material.emission_texture = mlt.TextureRef(0, texcoord=1)
+    with pytest.raises(mlt.InvalidArgumentError, match="texcoords1"):
+        mlt.Scene.from_arrays(positions, indices, [material], texcoords=texcoords, textures=[texture])
+
+
 def test_material_ids_pick_each_triangles_material() -> None:
     # Two emitters side by side: the left half of the image sees one, the right the other.
     positions = np.array(

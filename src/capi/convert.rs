@@ -332,8 +332,11 @@ impl CField for Option<TextureRef> {
             index if index < 0 => Err(Error::invalid(format!(
                 "{name}.texture is {index}; use an index into desc.textures, or MLT_NO_TEXTURE (-1) for none"
             ))),
+            // C hosts have one texture coordinate set (`MltTextureRef` cannot grow without
+            // moving the material's later fields).
             index => Ok(Some(TextureRef {
                 texture: index as u32,
+                texcoord: 0,
                 offset: r.offset,
                 rotation: r.rotation,
                 scale: r.scale,

@@ -294,6 +294,7 @@ pub unsafe extern "C" fn mlt_scene_create(
                 build_quality: build_quality(desc.build_quality)?,
                 normals,
                 texcoords,
+                texcoords1: &[],
                 tangents,
                 colors,
                 textures: &textures,

@@ -32,6 +32,10 @@ pub const MLT_ALPHA_OPAQUE: i32 = 0;
 /// colour texture's alpha × the vertex colour's alpha) is below `alpha_cutoff` there is no
 /// surface, and every ray passes through.
 pub const MLT_ALPHA_MASK: i32 = 1;
+/// `MltMaterial.alpha_mode`: stochastic coverage (glTF `BLEND`): a fraction alpha of the light
+/// meets the surface and 1 − alpha passes straight through, decided by a fixed pseudo-random
+/// threshold per surface point; `alpha_cutoff` is unused.
+pub const MLT_ALPHA_BLEND: i32 = 2;
 
 /// `MltTextureRef.texture` of a material slot without a texture.
 pub const MLT_NO_TEXTURE: i32 = -1;
@@ -189,10 +193,11 @@ pub struct MltMaterial {
     /// reflected (KHR_materials_transmission). It must be in [0, 1]. Default 0.0.
     pub transmission: f32,
     /// Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask
-    /// alpha mode. It must be in [0, 1]. Default 1.0.
+    /// and blend alpha modes. It must be in [0, 1]. Default 1.0.
     pub alpha: f32,
     /// What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff
-    /// (glTF's MASK). One of `MLT_ALPHA_*`. Default `MLT_ALPHA_OPAQUE`.
+    /// (glTF's MASK), blend lets a fraction 1 - alpha of the light pass straight through (glTF's
+    /// BLEND, as stochastic coverage). One of `MLT_ALPHA_*`. Default `MLT_ALPHA_OPAQUE`.
     pub alpha_mode: i32,
     /// The mask alpha mode's threshold (glTF's alphaCutoff). It must not be negative. Default 0.5.
     pub alpha_cutoff: f32,

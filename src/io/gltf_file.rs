@@ -123,7 +123,8 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     use ::gltf::Semantic;
     let attributes = Attributes {
         normals: triangle_primitives().any(|p| p.get(&Semantic::Normals).is_some()),
-        texcoords: triangle_primitives().any(|p| p.get(&Semantic::TexCoords(0)).is_some()),
+        texcoords: [0, 1]
+            .map(|set| triangle_primitives().any(|p| p.get(&Semantic::TexCoords(set)).is_some())),
         colors: triangle_primitives().any(|p| p.get(&Semantic::Colors(0)).is_some()),
         tangents: triangle_primitives().next().is_some()
             && triangle_primitives().all(|p| {
@@ -149,8 +150,8 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
 struct Attributes {
     /// Some primitive has normals (the others get their flat face normals).
     normals: bool,
-    /// Some primitive has TEXCOORD_0 (the others get (0, 0)).
-    texcoords: bool,
+    /// Some primitive has TEXCOORD_0, TEXCOORD_1 (the others get (0, 0)).
+    texcoords: [bool; 2],
     /// Some primitive has COLOR_0 (the others get white).
     colors: bool,
     /// Every primitive has tangents and normals (else MikkTSpace computes them all).
@@ -449,9 +450,11 @@ impl Loader<'_> {
             ),
             None => None,
         };
-        let texcoords: Option<Vec<[f32; 2]>> = reader
-            .read_tex_coords(0)
-            .map(|read| read.into_f32().collect());
+        let texcoords: [Option<Vec<[f32; 2]>>; 2] = [0, 1].map(|set| {
+            reader
+                .read_tex_coords(set)
+                .map(|read| read.into_f32().collect())
+        });
         let colors: Option<Vec<[f32; 4]>> = reader
             .read_colors(0)
             .map(|read| read.into_rgba_f32().collect());
@@ -461,7 +464,8 @@ impl Loader<'_> {
         };
         for (name, count) in [
             ("NORMAL", normals.as_ref().map(Vec::len)),
-            ("TEXCOORD_0", texcoords.as_ref().map(Vec::len)),
+            ("TEXCOORD_0", texcoords[0].as_ref().map(Vec::len)),
+            ("TEXCOORD_1", texcoords[1].as_ref().map(Vec::len)),
             ("COLOR_0", colors.as_ref().map(Vec::len)),
             ("TANGENT", tangents.as_ref().map(Vec::len)),
         ] {
@@ -525,10 +529,19 @@ impl Loader<'_> {
                 }
             }
         }
-        if self.attributes.texcoords {
-            for &c in &corners {
-                let uv = texcoords.as_ref().map_or([0.0; 2], |t| t[c as usize]);
-                self.data.texcoords.extend_from_slice(&uv);
+        let texcoord_sets = [&mut self.data.texcoords, &mut self.data.texcoords1];
+        for ((present, values), out) in self
+            .attributes
+            .texcoords
+            .iter()
+            .zip(&texcoords)
+            .zip(texcoord_sets)
+        {
+            if *present {
+                for &c in &corners {
+                    let uv = values.as_ref().map_or([0.0; 2], |t| t[c as usize]);
+                    out.extend_from_slice(&uv);
+                }
             }
         }
         if self.attributes.colors {
@@ -567,9 +580,21 @@ impl Loader<'_> {
     fn texture_ref(
         &mut self,
         texture: ::gltf::texture::Texture,
+        texcoord: u32,
         transform: Option<::gltf::texture::TextureTransform>,
         srgb: bool,
     ) -> Result<TextureRef, IoError> {
+        // KHR_texture_transform may name another set than the textureInfo's.
+        let texcoord = transform
+            .as_ref()
+            .and_then(|t| t.tex_coord())
+            .unwrap_or(texcoord);
+        if texcoord > 1 {
+            return Err(self.fail(format!(
+                "texture {} uses TEXCOORD_{texcoord}; mlt reads the sets TEXCOORD_0 and TEXCOORD_1",
+                texture.index()
+            )));
+        }
         let index = match self.texture_map.get(&(texture.index(), srgb)) {
             Some(&index) => index,
             None => {
@@ -580,7 +605,10 @@ impl Loader<'_> {
                 index
             }
         };
-        let mut reference = TextureRef::new(index);
+        let mut reference = TextureRef {
+            texcoord,
+            ..TextureRef::new(index)
+        };
         if let Some(transform) = transform {
             reference.offset = transform.offset();
             reference.rotation = transform.rotation();
@@ -689,37 +717,52 @@ impl Loader<'_> {
                 .map_or(0.0, |t| t.transmission_factor()),
             alpha_mode: match material.alpha_mode() {
                 ::gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-                // Blending is rendered as a cut-out at the cutoff (0.5 by default).
-                ::gltf::material::AlphaMode::Mask | ::gltf::material::AlphaMode::Blend => {
-                    AlphaMode::Mask
-                }
+                ::gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+                ::gltf::material::AlphaMode::Blend => AlphaMode::Blend,
             },
             alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
             ..Material::metallic_roughness([r, g, b], pbr.metallic_factor(), pbr.roughness_factor())
         }
         .with_emission(emission);
         if let Some(info) = pbr.base_color_texture() {
-            converted.base_color_texture =
-                Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
+            converted.base_color_texture = Some(self.texture_ref(
+                info.texture(),
+                info.tex_coord(),
+                info.texture_transform(),
+                true,
+            )?);
         }
         if let Some(info) = pbr.metallic_roughness_texture() {
-            converted.metallic_roughness_texture =
-                Some(self.texture_ref(info.texture(), info.texture_transform(), false)?);
+            converted.metallic_roughness_texture = Some(self.texture_ref(
+                info.texture(),
+                info.tex_coord(),
+                info.texture_transform(),
+                false,
+            )?);
         }
         if let Some(normal) = material.normal_texture() {
-            converted.normal_texture = Some(self.texture_ref(normal.texture(), None, false)?);
+            converted.normal_texture =
+                Some(self.texture_ref(normal.texture(), normal.tex_coord(), None, false)?);
             converted.normal_scale = normal.scale();
         }
         if let Some(info) = material.emissive_texture() {
-            converted.emission_texture =
-                Some(self.texture_ref(info.texture(), info.texture_transform(), true)?);
+            converted.emission_texture = Some(self.texture_ref(
+                info.texture(),
+                info.tex_coord(),
+                info.texture_transform(),
+                true,
+            )?);
         }
         if let Some(info) = material
             .transmission()
             .and_then(|t| t.transmission_texture())
         {
-            converted.transmission_texture =
-                Some(self.texture_ref(info.texture(), info.texture_transform(), false)?);
+            converted.transmission_texture = Some(self.texture_ref(
+                info.texture(),
+                info.tex_coord(),
+                info.texture_transform(),
+                false,
+            )?);
         }
         // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
         if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
@@ -739,14 +782,34 @@ impl Loader<'_> {
                 converted.abbe_number = (20.0 / dispersion) as f32;
             }
         }
-        if converted.has_textures() && !self.attributes.texcoords {
-            // Without texture coordinates every lookup would read one texel; glTF files
-            // with textures always carry them, so this is a broken file.
+        // KHR_materials_unlit (not parsed by the gltf crate): the base colour (times its
+        // texture) is emitted as radiance and nothing is scattered, so the surface looks its
+        // colour to every path and is one consistent light in every algorithm. The base
+        // colour texture stays for its alpha.
+        if material.extension_value("KHR_materials_unlit").is_some() {
+            converted = Material {
+                kind: MaterialKind::Diffuse,
+                color: [0.0; 3],
+                emission_texture: converted.base_color_texture,
+                metallic_roughness_texture: None,
+                normal_texture: None,
+                transmission_texture: None,
+                ..converted
+            }
+            .with_emission([r, g, b]);
+        }
+        // Without texture coordinates every lookup would read one texel; glTF files with
+        // textures always carry them, so this is a broken file.
+        if let Some((slot, texture)) = converted
+            .textures()
+            .find(|(_, t)| !self.attributes.texcoords[t.texcoord as usize])
+        {
             return Err(self.fail(format!(
-                "material {} has textures but no primitive has TEXCOORD_0",
+                "material {}'s {slot} uses TEXCOORD_{} but no primitive has it",
                 material
                     .index()
-                    .map_or("(default)".into(), |i| i.to_string())
+                    .map_or("(default)".into(), |i| i.to_string()),
+                texture.texcoord
             )));
         }
         let name = match (material.name(), material.index()) {

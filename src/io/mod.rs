@@ -77,12 +77,15 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   roughness factors and textures, `normalTexture` with its scale, emission =
 ///   `emissiveFactor` × `KHR_materials_emissive_strength` × `emissiveTexture`,
 ///   `KHR_materials_transmission` (factor; its texture is ignored), `KHR_materials_ior`,
-///   `KHR_texture_transform`, alpha modes (`BLEND` is rendered as `MASK` at the cutoff).
-///   Images (PNG, JPEG; embedded, data URIs or files) become textures: base colour and
-///   emission decoded as sRGB, the others linear, with the sampler's wrap modes and nearest
-///   or bilinear filtering. Attributes: `NORMAL`, `TEXCOORD_0` (other sets are ignored),
-///   `COLOR_0` and `TANGENT` (used when every primitive has it; else MikkTSpace computes
-///   them); a primitive without normals in a scene that has some is flat-shaded.
+///   `KHR_texture_transform`, `KHR_materials_unlit` (the base colour emitted, nothing
+///   scattered), alpha modes (`BLEND` as stochastic coverage,
+///   [`crate::AlphaMode::Blend`]). Images (PNG, JPEG; embedded, data URIs or files) become
+///   textures: base colour and emission decoded as sRGB, the others linear, with the
+///   sampler's wrap modes and nearest or bilinear filtering. Attributes: `NORMAL`,
+///   `TEXCOORD_0` and `TEXCOORD_1` (each texture reads the set its `texCoord` names; later
+///   sets are refused), `COLOR_0` and `TANGENT` (used when every primitive has it; else
+///   MikkTSpace computes them); a primitive without normals in a scene that has some is
+///   flat-shaded.
 ///   Primitives without a material get the glTF default material (white, metallic 1,
 ///   roughness 1). Occlusion textures are ignored.
 ///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into

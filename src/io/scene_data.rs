@@ -63,6 +63,7 @@ pub struct SceneData {
     /// Per-vertex attributes, each empty or complete (see [`SceneDesc`]).
     pub normals: Vec<f32>,
     pub texcoords: Vec<f32>,
+    pub texcoords1: Vec<f32>,
     pub tangents: Vec<f32>,
     pub colors: Vec<f32>,
     /// The textures the materials refer to, with their texels.
@@ -114,6 +115,7 @@ impl SceneData {
             build_quality: Default::default(),
             normals: &self.normals,
             texcoords: &self.texcoords,
+            texcoords1: &self.texcoords1,
             tangents: &self.tangents,
             colors: &self.colors,
             textures: &self.textures,

@@ -34,6 +34,11 @@ pub enum AlphaMode {
     /// A cut-out: where alpha < `alpha_cutoff` there is no surface, and rays (camera,
     /// light and shadow rays alike) pass through (glTF `MASK`).
     Mask,
+    /// Stochastic coverage (glTF `BLEND`): a fraction alpha of the light meets the surface
+    /// and the rest passes straight on. A cut-out whose cutoff is a fixed pseudo-random
+    /// threshold per surface point (`Scene::is_solid`), so every ray that reaches a point
+    /// finds the same surface there; `alpha_cutoff` is unused.
+    Blend,
 }
 
 // Each material parameter is declared once: the C, C++ and Python fields, the command line's
@@ -93,14 +98,14 @@ declare_parameters! {
             range: Range::UNIT,
             rule: in_unit_interval,
         },
-        /// Coverage in [0, 1], used by `AlphaMode::Mask`.
+        /// Coverage in [0, 1], used by `AlphaMode::Mask` and `AlphaMode::Blend`.
         alpha: f32 = 1.0 => {
-            doc: "Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask alpha mode.",
+            doc: "Coverage, times the base colour texture's alpha and the vertex colour's; used by the mask and blend alpha modes.",
             range: Range::UNIT,
             rule: in_unit_interval,
         },
         alpha_mode: AlphaMode = AlphaMode::Opaque => {
-            doc: "What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff (glTF's MASK).",
+            doc: "What alpha does: opaque ignores it, mask cuts the surface out where alpha < alpha_cutoff (glTF's MASK), blend lets a fraction 1 - alpha of the light pass straight through (glTF's BLEND, as stochastic coverage).",
         },
         /// `AlphaMode::Mask` cuts out where alpha < `alpha_cutoff`; finite, >= 0.
         alpha_cutoff: f32 = 0.5 => {
@@ -165,8 +170,8 @@ impl ChoiceParameter for MaterialKind {
 }
 
 impl ChoiceParameter for AlphaMode {
-    const NAMES: &'static [&'static str] = &["opaque", "mask"];
-    const ALL: &'static [AlphaMode] = &[AlphaMode::Opaque, AlphaMode::Mask];
+    const NAMES: &'static [&'static str] = &["opaque", "mask", "blend"];
+    const ALL: &'static [AlphaMode] = &[AlphaMode::Opaque, AlphaMode::Mask, AlphaMode::Blend];
     const TYPE_NAME: &'static str = "AlphaMode";
     const C_PREFIX: &'static str = "MLT_ALPHA";
 }

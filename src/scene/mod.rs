@@ -60,6 +60,9 @@ pub struct SceneDesc<'a> {
     /// Per-vertex texture coordinates, u, v per vertex, or empty. glTF's convention: (0, 0)
     /// is the top-left corner of a texture, v grows downwards.
     pub texcoords: &'a [f32],
+    /// A second set of per-vertex texture coordinates (glTF `TEXCOORD_1`), u, v per vertex,
+    /// or empty; textures whose `TextureRef::texcoord` is 1 are looked up at these.
+    pub texcoords1: &'a [f32],
     /// Per-vertex tangents for normal maps, x, y, z, w per vertex (w = ±1: the bitangent
     /// is w · normal × tangent, glTF's convention), or empty: then they are computed with
     /// MikkTSpace where a material has a normal map.
@@ -85,6 +88,7 @@ impl Default for SceneDesc<'_> {
             build_quality: BuildQuality::default(),
             normals: &[],
             texcoords: &[],
+            texcoords1: &[],
             tangents: &[],
             colors: &[],
             textures: &[],
@@ -97,6 +101,7 @@ impl<'a> SceneDesc<'a> {
         surface::VertexArrays {
             normals: self.normals,
             texcoords: self.texcoords,
+            texcoords1: self.texcoords1,
             tangents: self.tangents,
             colors: self.colors,
         }
@@ -144,8 +149,9 @@ pub struct Scene {
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
     /// lights, a delta sun, the lights at infinity; with their selection distribution.
     pub(crate) lights: lights::SceneLights,
-    /// Whether some triangle's material is an alpha cut-out (`AlphaMode::Mask`): then ray
-    /// queries test candidate hits against its alpha.
+    /// Whether some triangle's material is an alpha cut-out (`AlphaMode::Mask`) or blended
+    /// (`AlphaMode::Blend`, a cut-out at a per-point threshold): then ray queries test
+    /// candidate hits against its alpha.
     has_cutouts: bool,
     /// Whether ray queries leave the plain structure query for `closest_hit_slow` and
     /// `blocked_slow`: `has_cutouts`, or a ray recording is on. One flag, so a normal query
@@ -183,6 +189,10 @@ fn fingerprint(desc: &SceneDesc) -> u64 {
     words(&mut h, desc.material_ids, u32::to_le_bytes);
     floats(&mut h, desc.normals);
     floats(&mut h, desc.texcoords);
+    // Only when given: the fingerprints of scenes with one set stay as they were.
+    if !desc.texcoords1.is_empty() {
+        floats(&mut h, desc.texcoords1);
+    }
     floats(&mut h, desc.tangents);
     floats(&mut h, desc.colors);
     let LightsDesc {
@@ -274,7 +284,7 @@ impl Scene {
         let has_cutouts = desc
             .materials
             .iter()
-            .any(|m| m.alpha_mode == AlphaMode::Mask);
+            .any(|m| m.alpha_mode != AlphaMode::Opaque);
         let filtering = if has_cutouts {
             Filtering::Filtered
         } else {
@@ -463,12 +473,23 @@ impl Scene {
     }
 
     /// Whether a candidate hit at barycentrics (u, v) of internal triangle `triangle` is a
-    /// surface: false where an alpha cut-out removes it.
+    /// surface: false where an alpha cut-out removes it, or where blended coverage lets the
+    /// point through (alpha at most the point's `coverage_threshold`).
     #[inline]
     fn is_solid(&self, triangle: u32, u: f32, v: f32) -> bool {
         let material = &self.materials[self.shading[triangle as usize].material as usize];
-        material.alpha_mode != AlphaMode::Mask
-            || self.surface_point(triangle, [u, v]).alpha() >= material.alpha_cutoff
+        match material.alpha_mode {
+            AlphaMode::Opaque => true,
+            AlphaMode::Mask => {
+                self.surface_point(triangle, [u, v]).alpha() >= material.alpha_cutoff
+            }
+            AlphaMode::Blend => {
+                // The host's triangle id, not the internal one: the internal order is each
+                // backend's build order.
+                let threshold = coverage_threshold(self.internal_to_input[triangle as usize], u, v);
+                self.surface_point(triangle, [u, v]).alpha() > threshold
+            }
+        }
     }
 
     /// The closest surface `ray` hits (internal triangle ids), through alpha cut-outs.
@@ -773,6 +794,15 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
             ))
             .about_material(i));
         }
+        if let Some((slot, _)) = material.textures().find(|(_, t)| t.texcoord == 1)
+            && desc.texcoords1.is_empty()
+            && !desc.indices.is_empty()
+        {
+            return Err(Error::invalid(format!(
+                "desc.materials[{i}].{slot} uses texture coordinate set 1 but desc.texcoords1 is empty"
+            ))
+            .about_material(i));
+        }
     }
     Ok(())
 }
@@ -828,9 +858,70 @@ fn area_weighted_vertex_normals(positions: &[f32], indices: &[u32]) -> Vec<f32> 
         .collect()
 }
 
+/// Cells per barycentric axis of `coverage_threshold`'s grid (2^16).
+const COVERAGE_CELLS: f32 = 65536.0;
+
+/// The pseudo-random threshold in [0, 1) that blended coverage (`AlphaMode::Blend`) compares
+/// alpha with at barycentrics (u, v) of host triangle `triangle`: a hash of the triangle and
+/// the cell of a 2^16 × 2^16 grid over its barycentrics. A fixed function of the surface
+/// point, not of the ray, so every ray reaching a point (camera, light, shadow or
+/// connection, traced either way) finds the same surface there, except within float error
+/// of a cell's edge; a cell is 2^8 ulps of barycentrics near 1, where a ray's intersection
+/// errs by a few. Over more than a few cells the surface covers a fraction alpha.
+#[inline]
+pub(crate) fn coverage_threshold(triangle: u32, u: f32, v: f32) -> f32 {
+    // Float-to-int casts saturate (NaN to 0); barycentrics a rounding error outside [0, 1]
+    // land in the edge cells.
+    let cell = |b: f32| ((b * COVERAGE_CELLS) as u32).min(COVERAGE_CELLS as u32 - 1) as u64;
+    let key = ((triangle as u64) << 32) | (cell(u) << 16) | cell(v);
+    let hash = xxhash_rust::xxh3::xxh3_64(&key.to_le_bytes());
+    // The top 24 bits: exact in an f32, below 1.
+    (hash >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Blended coverage's threshold is uniform on [0, 1) over cells (a surface of alpha a
+    /// covers a fraction a of them, within 5 standard errors of 2^18 cells, 0.2% of 0.3),
+    /// one value per cell of the 2^16 grid, and defined for barycentrics a rounding error
+    /// outside [0, 1] or NaN.
+    #[test]
+    fn coverage_threshold_is_uniform_and_constant_per_cell() {
+        let cell = 1.0 / COVERAGE_CELLS;
+        let (mut below, mut total) = (0u32, 0u32);
+        for triangle in [0, 1, 77_777] {
+            for i in 0..296u32 {
+                for j in 0..296u32 {
+                    let (u, v) = ((i * 221) as f32 * cell, (j * 221) as f32 * cell);
+                    let t = coverage_threshold(triangle, u, v);
+                    assert!((0.0..1.0).contains(&t));
+                    // Anywhere inside the cell gives the same threshold.
+                    assert_eq!(
+                        t,
+                        coverage_threshold(triangle, u + 0.7 * cell, v + 0.3 * cell)
+                    );
+                    below += (t < 0.3) as u32;
+                    total += 1;
+                }
+            }
+        }
+        let fraction = below as f64 / total as f64;
+        let standard_error = (0.3 * 0.7 / total as f64).sqrt();
+        assert!(
+            (fraction - 0.3).abs() < 5.0 * standard_error,
+            "{fraction} of the cells below 0.3 (± {standard_error})"
+        );
+        // Neighbouring cells and triangles differ.
+        let t = coverage_threshold(5, 0.5, 0.5);
+        assert_ne!(t, coverage_threshold(5, 0.5 + cell, 0.5));
+        assert_ne!(t, coverage_threshold(5, 0.5, 0.5 + cell));
+        assert_ne!(t, coverage_threshold(6, 0.5, 0.5));
+        for b in [-1e-7, 1.0 + 1e-7, f32::NAN] {
+            assert!((0.0..1.0).contains(&coverage_threshold(3, b, b)));
+        }
+    }
 
     /// Ray queries through a scene go through its cut-outs, with either backend: a triangle
     /// whose vertex alphas make alpha = 1 - u - v is solid only where u + v <= 1/2 (the

@@ -18,6 +18,7 @@ use glam::{Vec3A, Vec4};
 pub(crate) struct VertexArrays<'a> {
     pub normals: &'a [f32],
     pub texcoords: &'a [f32],
+    pub texcoords1: &'a [f32],
     pub tangents: &'a [f32],
     pub colors: &'a [f32],
 }
@@ -25,9 +26,10 @@ pub(crate) struct VertexArrays<'a> {
 impl VertexArrays<'_> {
     /// Checks lengths and values against `vertex_count` vertices.
     pub fn validate(&self, vertex_count: usize) -> Result<()> {
-        let arrays: [(&str, &[f32], usize, &[&str]); 4] = [
+        let arrays: [(&str, &[f32], usize, &[&str]); 5] = [
             ("normals", self.normals, 3, &["x", "y", "z"]),
             ("texcoords", self.texcoords, 2, &["u", "v"]),
+            ("texcoords1", self.texcoords1, 2, &["u", "v"]),
             ("tangents", self.tangents, 4, &["x", "y", "z", "w"]),
             ("colors", self.colors, 4, &["r", "g", "b", "a"]),
         ];
@@ -88,7 +90,8 @@ impl VertexArrays<'_> {
 #[derive(Debug, Default)]
 pub(crate) struct SurfaceAttributes {
     normals: Vec<[Vec3A; 3]>,
-    texcoords: Vec<[[f32; 2]; 3]>,
+    /// The texture coordinate sets 0 and 1 (`TextureRef::texcoord`).
+    texcoords: [Vec<[[f32; 2]; 3]>; 2],
     colors: Vec<[Vec4; 3]>,
     /// xyz and the bitangent sign w, per corner: the host's, or MikkTSpace's where a
     /// material has a normal map (empty otherwise).
@@ -101,7 +104,10 @@ impl SurfaceAttributes {
         let capacity = |values: &[f32]| if values.is_empty() { 0 } else { triangle_count };
         SurfaceAttributes {
             normals: Vec::with_capacity(capacity(arrays.normals)),
-            texcoords: Vec::with_capacity(capacity(arrays.texcoords)),
+            texcoords: [
+                Vec::with_capacity(capacity(arrays.texcoords)),
+                Vec::with_capacity(capacity(arrays.texcoords1)),
+            ],
             colors: Vec::with_capacity(capacity(arrays.colors)),
             tangents: Vec::new(),
         }
@@ -128,11 +134,17 @@ impl SurfaceAttributes {
                 Vec3A::from_slice(&arrays.normals[i..i + 3]).normalize()
             }));
         }
-        if !arrays.texcoords.is_empty() {
-            self.texcoords.push(corners.map(|c| {
-                let i = c as usize * 2;
-                [arrays.texcoords[i], arrays.texcoords[i + 1]]
-            }));
+        for (set, values) in self
+            .texcoords
+            .iter_mut()
+            .zip([arrays.texcoords, arrays.texcoords1])
+        {
+            if !values.is_empty() {
+                set.push(corners.map(|c| {
+                    let i = c as usize * 2;
+                    [values[i], values[i + 1]]
+                }));
+            }
         }
         if !arrays.colors.is_empty() {
             self.colors.push(corners.map(|c| {
@@ -148,10 +160,10 @@ impl SurfaceAttributes {
         self.normals.is_empty() && self.colors.is_empty() && !material.has_textures()
     }
 
-    /// The interpolated texture coordinates ((0, 0) without any).
+    /// The interpolated texture coordinates of set `set` (0 or 1; (0, 0) without any).
     #[inline]
-    fn texcoord(&self, triangle: u32, b: [f32; 2]) -> [f32; 2] {
-        match self.texcoords.get(triangle as usize) {
+    fn texcoord(&self, set: u32, triangle: u32, b: [f32; 2]) -> [f32; 2] {
+        match self.texcoords[(set & 1) as usize].get(triangle as usize) {
             Some(t) => {
                 let w = 1.0 - b[0] - b[1];
                 [
@@ -237,9 +249,13 @@ pub(crate) struct SurfacePoint<'a> {
 }
 
 impl SurfacePoint<'_> {
+    /// Texture `texture` at this point, at the texture coordinate set it names.
     #[inline]
-    fn texcoord(&self) -> [f32; 2] {
-        self.attributes.texcoord(self.triangle, self.barycentrics)
+    fn lookup(&self, texture: &TextureRef) -> Vec4 {
+        let uv = self
+            .attributes
+            .texcoord(texture.texcoord, self.triangle, self.barycentrics);
+        lookup(self.textures, texture, uv)
     }
 
     /// The base colour (RGB) and alpha: factors × vertex colour × base colour texture.
@@ -249,7 +265,7 @@ impl SurfacePoint<'_> {
         let mut color = Vec4::new(m.color[0], m.color[1], m.color[2], m.alpha)
             * self.attributes.color(self.triangle, self.barycentrics);
         if let Some(texture) = &m.base_color_texture {
-            color *= lookup(self.textures, texture, self.texcoord());
+            color *= self.lookup(texture);
         }
         color
     }
@@ -267,7 +283,7 @@ impl SurfacePoint<'_> {
         let Some(texture) = &m.emission_texture else {
             return channels.fitted_illuminant(&self.colours.emission);
         };
-        let texel = lookup(self.textures, texture, self.texcoord());
+        let texel = self.lookup(texture);
         channels.illuminant([
             m.emission[0] * texel.x,
             m.emission[1] * texel.y,
@@ -288,7 +304,7 @@ impl SurfacePoint<'_> {
         ) else {
             return normal;
         };
-        let texel = lookup(self.textures, texture, self.texcoord());
+        let texel = self.lookup(texture);
         let scale = self.material.normal_scale;
         let local = Vec3A::new(
             (texel.x * 2.0 - 1.0) * scale,
@@ -332,13 +348,13 @@ impl SurfacePoint<'_> {
         let m = self.material;
         let (mut metallic, mut roughness) = (m.metallic, m.roughness);
         if let Some(texture) = &m.metallic_roughness_texture {
-            let texel = lookup(self.textures, texture, self.texcoord());
+            let texel = self.lookup(texture);
             roughness *= texel.y;
             metallic *= texel.z;
         }
         let mut transmission = m.transmission;
         if let Some(texture) = &m.transmission_texture {
-            transmission *= lookup(self.textures, texture, self.texcoord()).x;
+            transmission *= self.lookup(texture).x;
         }
         let model =
             m.textured_bsdf_model(color, metallic, roughness, transmission, m.ior_in(channels));
