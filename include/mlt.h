@@ -399,6 +399,11 @@ typedef enum MltStatus {
 } MltStatus;
 
 /**
+ * The coat's parameters at a surface point.
+ */
+typedef struct Clearcoat Clearcoat;
+
+/**
  * An immutable scene: triangles, materials, lights and the acceleration structure. Thread
  * safe: any number of threads may render and query one scene at the same time.
  * Reference-counted: `mlt_scene_retain` adds a reference, `mlt_scene_release` drops one,
@@ -544,6 +549,40 @@ typedef struct MltMaterial {
    * transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef transmission_texture;
+  /**
+   * Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with
+   * its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none. It must
+   * be in [0, 1]. Default 0.0.
+   */
+  float clearcoat;
+  /**
+   * Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an
+   * exact mirror). It must be in [0, 1]. Default 0.0.
+   */
+  float clearcoat_roughness;
+  /**
+   * Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's
+   * clearcoatTexture); usually linear. An index into `MltSceneDesc.textures` and its transform.
+   * Default `MLT_NO_TEXTURE` (-1).
+   */
+  struct MltTextureRef clearcoat_texture;
+  /**
+   * Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture);
+   * usually linear. An index into `MltSceneDesc.textures` and its transform. Default
+   * `MLT_NO_TEXTURE` (-1).
+   */
+  struct MltTextureRef clearcoat_roughness_texture;
+  /**
+   * Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture);
+   * without it the coat follows the interpolated normal, not normal_texture. An index into
+   * `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+   */
+  struct MltTextureRef clearcoat_normal_texture;
+  /**
+   * Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale). Any finite
+   * number. Default 1.0.
+   */
+  float clearcoat_normal_scale;
 } MltMaterial;
 
 /**
@@ -1187,6 +1226,8 @@ typedef struct MltBytes {
   uint8_t *data;
   size_t size;
 } MltBytes;
+
+
 
 
 

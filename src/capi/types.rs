@@ -222,6 +222,28 @@ pub struct MltMaterial {
     /// transmissionTexture); usually linear. An index into `MltSceneDesc.textures` and its
     /// transform. Default `MLT_NO_TEXTURE` (-1).
     pub transmission_texture: MltTextureRef,
+    /// Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with
+    /// its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none. It must
+    /// be in [0, 1]. Default 0.0.
+    pub clearcoat: f32,
+    /// Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an
+    /// exact mirror). It must be in [0, 1]. Default 0.0.
+    pub clearcoat_roughness: f32,
+    /// Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's
+    /// clearcoatTexture); usually linear. An index into `MltSceneDesc.textures` and its transform.
+    /// Default `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_texture: MltTextureRef,
+    /// Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture);
+    /// usually linear. An index into `MltSceneDesc.textures` and its transform. Default
+    /// `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_roughness_texture: MltTextureRef,
+    /// Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture);
+    /// without it the coat follows the interpolated normal, not normal_texture. An index into
+    /// `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_normal_texture: MltTextureRef,
+    /// Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale). Any finite
+    /// number. Default 1.0.
+    pub clearcoat_normal_scale: f32,
     // END GENERATED material
 }
 
