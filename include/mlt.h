@@ -399,11 +399,6 @@ typedef enum MltStatus {
 } MltStatus;
 
 /**
- * The coat's parameters at a surface point.
- */
-typedef struct Clearcoat Clearcoat;
-
-/**
  * An immutable scene: triangles, materials, lights and the acceleration structure. Thread
  * safe: any number of threads may render and query one scene at the same time.
  * Reference-counted: `mlt_scene_retain` adds a reference, `mlt_scene_release` drops one,
@@ -1226,8 +1221,6 @@ typedef struct MltBytes {
   uint8_t *data;
   size_t size;
 } MltBytes;
-
-
 
 
 

@@ -55,8 +55,8 @@ pub(crate) struct Clearcoat {
 }
 
 impl Clearcoat {
-    /// No coat.
-    pub const NONE: Clearcoat = Clearcoat {
+    /// No coat. (`pub(crate)`: cbindgen exports `pub` associated constants.)
+    pub(crate) const NONE: Clearcoat = Clearcoat {
         factor: 0.0,
         roughness: 0.0,
         normal: None,
