@@ -961,6 +961,7 @@ impl MetallicRoughness {
         let p = Self::coat_probability(&coat, &choice);
         if u_lobe < p {
             if coat.is_smooth() {
+                coat.sample(u)?;
                 return Some(self.coat_mirror(view, choice, &coat, mode));
             }
             let wi = coat.sample(u)?;
@@ -991,7 +992,10 @@ impl MetallicRoughness {
         if local.z == 0.0 {
             return None;
         }
-        if coat.is_smooth() && wi.dot(coat.mirror()) > 1.0 - MIRROR_TOLERANCE {
+        if coat.is_smooth()
+            && wi.dot(coat.mirror()) > 1.0 - MIRROR_TOLERANCE
+            && coat.stays_on_wo_side(wi)
+        {
             return Some(self.coat_mirror(view, choice, &coat, mode));
         }
         if self.distribution().is_none() {
