@@ -158,7 +158,9 @@ pub struct MltTextureRef {
 /// `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
 /// by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
 /// normal map; `emission_texture` multiplies `emission`; `transmission_texture`'s red
-/// channel multiplies `transmission`. Per-vertex colours
+/// channel multiplies `transmission`; `clearcoat_texture` (red) and
+/// `clearcoat_roughness_texture` (green) multiply the clear coat's factor and roughness, and
+/// `clearcoat_normal_texture` is the coat's own normal map. Per-vertex colours
 /// (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]

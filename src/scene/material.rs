@@ -50,8 +50,10 @@ declare_parameters! {
     /// (blue) as glTF defines; `normal_texture` is a tangent-space normal map (glTF's
     /// convention, +Y up in the texture) whose x and y are scaled by `normal_scale`;
     /// `emission_texture` multiplies `emission`; `transmission_texture`'s red channel
-    /// multiplies `transmission`. Per-vertex colours multiply `color` and
-    /// `alpha` too.
+    /// multiplies `transmission`; `clearcoat_texture`'s red and
+    /// `clearcoat_roughness_texture`'s green multiply the clear coat's factor and roughness,
+    /// and `clearcoat_normal_texture` is the coat's own normal map (scaled by
+    /// `clearcoat_normal_scale`). Per-vertex colours multiply `color` and `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
     #[derive(Clone, Copy, Debug, PartialEq)]
