@@ -374,6 +374,18 @@ void check_materials() {
     show("c++", "material.abbe_number", cpp.abbe_number);
     show("c", "material.transmission_texture", c.transmission_texture);
     show("c++", "material.transmission_texture", cpp.transmission_texture);
+    show("c", "material.clearcoat", c.clearcoat);
+    show("c++", "material.clearcoat", cpp.clearcoat);
+    show("c", "material.clearcoat_roughness", c.clearcoat_roughness);
+    show("c++", "material.clearcoat_roughness", cpp.clearcoat_roughness);
+    show("c", "material.clearcoat_texture", c.clearcoat_texture);
+    show("c++", "material.clearcoat_texture", cpp.clearcoat_texture);
+    show("c", "material.clearcoat_roughness_texture", c.clearcoat_roughness_texture);
+    show("c++", "material.clearcoat_roughness_texture", cpp.clearcoat_roughness_texture);
+    show("c", "material.clearcoat_normal_texture", c.clearcoat_normal_texture);
+    show("c++", "material.clearcoat_normal_texture", cpp.clearcoat_normal_texture);
+    show("c", "material.clearcoat_normal_scale", c.clearcoat_normal_scale);
+    show("c++", "material.clearcoat_normal_scale", cpp.clearcoat_normal_scale);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -439,6 +451,22 @@ void check_materials() {
         MltMaterial cs = c;
         cs.abbe_number = -1.0f;
         message("c", "material.abbe_number", cs);
+    }
+    {
+        mlt::Material s;
+        s.clearcoat = 2.0f;
+        message("c++", "material.clearcoat", s.to_c());
+        MltMaterial cs = c;
+        cs.clearcoat = 2.0f;
+        message("c", "material.clearcoat", cs);
+    }
+    {
+        mlt::Material s;
+        s.clearcoat_roughness = 2.0f;
+        message("c++", "material.clearcoat_roughness", s.to_c());
+        MltMaterial cs = c;
+        cs.clearcoat_roughness = 2.0f;
+        message("c", "material.clearcoat_roughness", cs);
     }
     // END GENERATED material checks
 }

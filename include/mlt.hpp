@@ -490,6 +490,23 @@ struct Material {
     /// Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
     /// transmissionTexture); usually linear.
     TextureRef transmission_texture;
+    /// Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with
+    /// its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none.
+    float clearcoat = 0.0f;
+    /// Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an
+    /// exact mirror).
+    float clearcoat_roughness = 0.0f;
+    /// Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's
+    /// clearcoatTexture); usually linear.
+    TextureRef clearcoat_texture;
+    /// Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture);
+    /// usually linear.
+    TextureRef clearcoat_roughness_texture;
+    /// Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture);
+    /// without it the coat follows the interpolated normal, not normal_texture.
+    TextureRef clearcoat_normal_texture;
+    /// Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).
+    float clearcoat_normal_scale = 1.0f;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -548,6 +565,12 @@ struct Material {
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
         c.transmission_texture = transmission_texture.to_c();
+        c.clearcoat = clearcoat;
+        c.clearcoat_roughness = clearcoat_roughness;
+        c.clearcoat_texture = clearcoat_texture.to_c();
+        c.clearcoat_roughness_texture = clearcoat_roughness_texture.to_c();
+        c.clearcoat_normal_texture = clearcoat_normal_texture.to_c();
+        c.clearcoat_normal_scale = clearcoat_normal_scale;
         // END GENERATED material to C
         return c;
     }
@@ -572,6 +595,12 @@ struct Material {
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
         m.transmission_texture = TextureRef::from_c(c.transmission_texture);
+        m.clearcoat = c.clearcoat;
+        m.clearcoat_roughness = c.clearcoat_roughness;
+        m.clearcoat_texture = TextureRef::from_c(c.clearcoat_texture);
+        m.clearcoat_roughness_texture = TextureRef::from_c(c.clearcoat_roughness_texture);
+        m.clearcoat_normal_texture = TextureRef::from_c(c.clearcoat_normal_texture);
+        m.clearcoat_normal_scale = c.clearcoat_normal_scale;
         // END GENERATED material from C
         return m;
     }

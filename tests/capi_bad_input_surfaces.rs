@@ -227,6 +227,15 @@ fn scene_create_bad_surfaces() {
         h.host.materials[0].transmission = 1.01
             => ["desc.materials[0].transmission is 1.01", "[0, 1]"],
         h.host.materials[0].alpha = -0.5 => ["desc.materials[0].alpha is -0.5", "[0, 1]"],
+        h.host.materials[0].clearcoat = 1.5 => ["desc.materials[0].clearcoat is 1.5", "[0, 1]"],
+        h.host.materials[1].clearcoat = -0.25
+            => ["desc.materials[1].clearcoat is -0.25", "[0, 1]"],
+        h.host.materials[0].clearcoat_roughness = f32::NAN
+            => ["desc.materials[0].clearcoat_roughness", "NaN"],
+        h.host.materials[1].clearcoat_roughness = 2.0
+            => ["desc.materials[1].clearcoat_roughness is 2", "[0, 1]"],
+        h.host.materials[0].clearcoat_normal_texture.texture = 3
+            => ["desc.materials[0].clearcoat_normal_texture.texture is 3", "3 textures"],
         h.host.materials[0].alpha_cutoff = -0.25
             => ["desc.materials[0].alpha_cutoff is -0.25", "negative"],
         h.host.materials[0].alpha_mode = 3
@@ -310,6 +319,9 @@ fn scene_create_bad_surfaces() {
         h.host.materials[0].alpha => "desc.materials[0].alpha" + "finite",
         h.host.materials[0].alpha_cutoff => "desc.materials[0].alpha_cutoff" + "finite",
         h.host.materials[0].normal_scale => "desc.materials[0].normal_scale" + "finite",
+        h.host.materials[0].clearcoat => "desc.materials[0].clearcoat" + "finite",
+        h.host.materials[1].clearcoat_normal_scale
+            => "desc.materials[1].clearcoat_normal_scale" + "finite",
         h.host.materials[0].base_color_texture.rotation
             => "desc.materials[0].base_color_texture.rotation" + "finite",
         h.host.materials[0].base_color_texture.offset[1]

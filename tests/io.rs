@@ -312,6 +312,120 @@ fn gltf_transmission_texture_is_read() {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// sky-spheres.gltf with `KHR_materials_clearcoat` (required) on its metal, whose
+/// `extension` JSON is given, written to a folder of its own named `name`.
+fn sky_spheres_with_clearcoat(name: &str, extension: &str) -> PathBuf {
+    let text = std::fs::read_to_string(scenes().join("sky-spheres.gltf")).unwrap();
+    let coated = text
+        .replacen(
+            r#""extensionsUsed": ["#,
+            r#""extensionsRequired": ["KHR_materials_clearcoat"], "extensionsUsed": ["KHR_materials_clearcoat", "#,
+            1,
+        )
+        .replacen(
+            r#""name": "metal","#,
+            &format!(r#""name": "metal", "extensions": {{"KHR_materials_clearcoat": {extension}}},"#),
+            1,
+        );
+    assert_eq!(
+        coated.matches("KHR_materials_clearcoat").count(),
+        3,
+        "{coated}"
+    );
+    let dir = temp_path(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        scenes().join("sky-spheres.bin"),
+        dir.join("sky-spheres.bin"),
+    )
+    .unwrap();
+    let path = dir.join("sky-spheres.gltf");
+    std::fs::write(&path, coated).unwrap();
+    path
+}
+
+/// A file that requires `KHR_materials_clearcoat` loads, with its factors, its textures
+/// (and their transforms) and its normal map's scale.
+#[test]
+fn gltf_clearcoat_is_read() {
+    let path = sky_spheres_with_clearcoat(
+        "clearcoat",
+        r#"{"clearcoatFactor": 0.75, "clearcoatRoughnessFactor": 0.125,
+            "clearcoatTexture": {"index": 0, "texCoord": 0},
+            "clearcoatRoughnessTexture": {"index": 1,
+                "extensions": {"KHR_texture_transform": {"offset": [0.25, 0.5], "rotation": 0.5, "scale": [2, 3]}}},
+            "clearcoatNormalTexture": {"index": 1, "scale": 0.5}}"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, metal) = material_named(&data, "metal");
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!((metal.clearcoat, metal.clearcoat_roughness), (0.75, 0.125));
+    let normal_map = clay.normal_texture.unwrap().texture;
+    assert_ne!(metal.clearcoat_texture.unwrap().texture, normal_map);
+    let roughness = metal.clearcoat_roughness_texture.unwrap();
+    assert_eq!(roughness.texture, normal_map);
+    assert_eq!(
+        (roughness.offset, roughness.rotation, roughness.scale),
+        ([0.25, 0.5], 0.5, [2.0, 3.0])
+    );
+    assert_eq!(metal.clearcoat_normal_texture.unwrap().texture, normal_map);
+    assert_eq!(metal.clearcoat_normal_scale, 0.5);
+    assert_eq!(metal.normal_texture, None);
+    assert_eq!((clay.clearcoat, clay.clearcoat_texture), (0.0, None));
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+}
+
+/// Bad clear coat values are refused by the loader, naming the field.
+#[test]
+fn gltf_bad_clearcoat_values_are_refused() {
+    for (extension, expected) in [
+        (r#"{"clearcoatFactor": 1.5}"#, "clearcoatFactor is 1.5"),
+        (r#"{"clearcoatFactor": -0.1}"#, "clearcoatFactor is -0.1"),
+        (
+            r#"{"clearcoatRoughnessFactor": "rough"}"#,
+            "clearcoatRoughnessFactor",
+        ),
+        (
+            r#"{"clearcoatTexture": {"index": 9}}"#,
+            "clearcoatTexture has index 9",
+        ),
+        (
+            r#"{"clearcoatNormalTexture": {"index": 1, "scale": "x"}}"#,
+            "scale",
+        ),
+    ] {
+        let path = sky_spheres_with_clearcoat("bad-clearcoat", extension);
+        let error = io::load_scene(&path).unwrap_err().to_string();
+        assert!(
+            error.contains("KHR_materials_clearcoat") && error.contains(expected),
+            "{extension}: {error}"
+        );
+    }
+}
+
+/// MTL's PBR clear coat: `Pc` (its factor) and `Pcr` (its roughness); a NaN roughness is
+/// refused when the scene is made, naming the field.
+#[test]
+fn mtl_clearcoat_is_read_and_bad_values_refused() {
+    let obj =
+        b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\nusemtl nan\nf 1 2 3\n";
+    let mtl =
+        b"newmtl paint\nKd 0.5 0.1 0.1\nPc 0.8\nPcr 0.05\nnewmtl nan\nPr 0.5\nPc 1\nPcr nan\n";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    let (_, paint) = material_named(&data, "paint");
+    assert_eq!(paint.kind, MaterialKind::MetallicRoughness);
+    assert_eq!((paint.clearcoat, paint.clearcoat_roughness), (0.8, 0.05));
+    let Err(error) = Scene::new(&data.desc(mlt::Backend::Bvh)) else {
+        panic!("a NaN clear coat roughness was accepted");
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("clearcoat_roughness") && error.contains("NaN"),
+        "{error}"
+    );
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");

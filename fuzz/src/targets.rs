@@ -213,6 +213,7 @@ const MATERIAL_LIMITS: &[(&str, f64, f64)] = &[
     ("ior", 1.0, 3.0),
     ("alpha_cutoff", 0.0, 1.0),
     ("normal_scale", -2.0, 2.0),
+    ("clearcoat_normal_scale", -2.0, 2.0),
     ("abbe_number", 0.0, 90.0),
 ];
 

@@ -138,6 +138,23 @@ class Material:
     #: Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
     #: transmissionTexture); usually linear.
     transmission_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with
+    #: its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none.
+    clearcoat: float = 0.0
+    #: Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an
+    #: exact mirror).
+    clearcoat_roughness: float = 0.0
+    #: Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's
+    #: clearcoatTexture); usually linear.
+    clearcoat_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture);
+    #: usually linear.
+    clearcoat_roughness_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture);
+    #: without it the coat follows the interpolated normal, not normal_texture.
+    clearcoat_normal_texture: Optional[TextureRef] = None
+    #: Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).
+    clearcoat_normal_scale: float = 1.0
     # END GENERATED material
 
     @classmethod

@@ -40,7 +40,12 @@
 //!   interface (front side outside with index 1, back side inside with index `ior`), so its
 //!   reflectance seen from the back includes total internal reflection; the opaque part is
 //!   seen from the outside on either side. For `ior` ≥ 1 both are glTF's F from the front.
+//!
+//! A clear coat (`KHR_materials_clearcoat`, the `clearcoat` module) lies over all of it,
+//! with its own roughness and normal; it is composed into the sampling, evaluation, density
+//! and lobe choice at the points marked "Clear coat", and skipped where its factor is 0.
 
+use super::clearcoat::{Clearcoat, CoatView};
 use super::dielectric::{refract, refracted};
 use super::microfacet::TrowbridgeReitz;
 use super::multiple_scattering::{CoatReflectance, EnergyCompensation};
@@ -67,6 +72,8 @@ pub(crate) struct MetallicRoughness {
     pub transmission: f32,
     /// Whether the metal's reflection gains the multiple-scattering compensation lobe.
     pub energy_compensation: bool,
+    /// The clear coat over all of it (factor 0: none).
+    pub clearcoat: Clearcoat,
 }
 
 /// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
@@ -80,6 +87,7 @@ pub(crate) struct Microfacet {
 
 /// The surface as seen from `wo`: a frame around the normal on wo's side and the indices on
 /// wo's side and the other (front outside with index 1, back inside with index `ior`).
+#[derive(Clone, Copy)]
 struct View {
     basis: OrthonormalBasis,
     /// `wo` in the frame: z > 0.
@@ -133,6 +141,9 @@ struct LobeChoice {
     transmission: f32,
     /// The metal's multiple-scattering compensation.
     multiple: f32,
+    /// The sum of the lobes' albedo estimates (before normalizing), which the clear coat's
+    /// share is weighed against.
+    total: f32,
 }
 
 /// Every lobe that can scatter is picked at least this often (before normalizing), so a
@@ -214,10 +225,16 @@ impl MetallicRoughness {
         } else {
             BsdfLobes::SPECULAR
         };
-        if self.diffuse_tint().is_black() && self.compensation().is_none() {
+        let base = if self.diffuse_tint().is_black() && self.compensation().is_none() {
             scattering
         } else {
             scattering | BsdfLobes::DIFFUSE
+        };
+        // Clear coat: its lobe beside the base's.
+        match self.clearcoat {
+            coat if !coat.is_present() => base,
+            coat if coat.is_smooth() => base | BsdfLobes::SPECULAR,
+            _ => base | BsdfLobes::GLOSSY,
         }
     }
 
@@ -235,6 +252,27 @@ impl MetallicRoughness {
     ) -> Option<ScatterSample> {
         let view = View::of(self.ior, normal, wo)?;
         let choice = self.lobe_choice(&view);
+        // Clear coat.
+        if self.clearcoat.is_present() {
+            return self.coated_sample(&view, choice, normal, wo, u, u_lobe, mode);
+        }
+        self.sample_base(&view, choice, normal, wo, u, u_lobe, mode)
+    }
+
+    /// `sample` without the clear coat.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn sample_base(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        normal: Vec3A,
+        wo: Vec3A,
+        u: [f32; 2],
+        u_lobe: f32,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let view = *view;
         let lobe = choice.pick(u_lobe);
         let Some(distribution) = self.distribution() else {
             return match lobe {
@@ -274,6 +312,13 @@ impl MetallicRoughness {
         let Some(view) = View::of(self.ior, normal, wo) else {
             return Spectrum::ZERO;
         };
+        // Clear coat.
+        if self.clearcoat.is_present() {
+            let Some(coat) = self.clearcoat.view(normal, wo) else {
+                return Spectrum::ZERO;
+            };
+            return self.coated_eval(&view, &coat, view.local(wi), wi, mode);
+        }
         self.eval_local(&view, view.local(wi), mode)
     }
 
@@ -284,6 +329,13 @@ impl MetallicRoughness {
             return 0.0;
         };
         let choice = self.lobe_choice(&view);
+        // Clear coat.
+        if self.clearcoat.is_present() {
+            let Some(coat) = self.clearcoat.view(normal, wo) else {
+                return 0.0;
+            };
+            return self.coated_pdf(&view, choice, &coat, view.local(wi), wi);
+        }
         self.pdf_local(&view, choice, view.local(wi))
     }
 
@@ -300,6 +352,23 @@ impl MetallicRoughness {
     ) -> Option<ScatterSample> {
         let view = View::of(self.ior, normal, wo)?;
         let choice = self.lobe_choice(&view);
+        // Clear coat.
+        if self.clearcoat.is_present() {
+            return self.coated_scatter(&view, choice, normal, wo, wi, mode);
+        }
+        self.scatter_base(&view, choice, wi, mode)
+    }
+
+    /// `scatter` without the clear coat.
+    #[inline]
+    fn scatter_base(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let view = *view;
         let local = view.local(wi);
         if local.z == 0.0 {
             return None;
@@ -327,6 +396,15 @@ impl MetallicRoughness {
         wo: Vec3A,
         lobe: SpecularLobe,
     ) -> Option<Vec3A> {
+        // Clear coat: a smooth one's mirror about its own normal (a smooth base's mirror
+        // about another normal is a second reflection this cannot name; path-space MLT and
+        // ERPT, the callers, refuse smooth coats).
+        if lobe == SpecularLobe::Reflection
+            && self.clearcoat.is_present()
+            && self.clearcoat.is_smooth()
+        {
+            return Some(reflect(wo, self.clearcoat.normal.unwrap_or(normal)));
+        }
         if self.roughness > 0.0 {
             return None;
         }
@@ -542,6 +620,7 @@ impl MetallicRoughness {
             diffuse: diffuse / total,
             transmission: transmission / total,
             multiple: multiple / total,
+            total,
         }
     }
 
@@ -716,6 +795,229 @@ impl MetallicRoughness {
     }
 }
 
+/// The largest f32 below 1: the base's lobe choice rescaled out of the coat's stays below 1.
+const BELOW_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Clear coat: the coat (see the `clearcoat` module) composed with the base. The coat's lobe
+/// is picked with probability p = c F(μo) / (c F(μo) + (1 − c F(μo)) · the base's estimates'
+/// sum), the base's lobes with 1 − p as among themselves; a direction with a density has
+/// the mixture's, and the Dirac lobes keep their own, times p or 1 − p. A smooth coat over
+/// a smooth base with the same normal has one mirror direction: the two Dirac lobes are
+/// one there.
+impl MetallicRoughness {
+    /// The probability of picking the coat's lobe.
+    #[inline]
+    fn coat_probability(coat: &CoatView, choice: &LobeChoice) -> f32 {
+        let estimate = coat.albedo_estimate();
+        estimate / (estimate + (1.0 - estimate) * choice.total)
+    }
+
+    /// Whether the smooth coat's mirror and a smooth base's are the same Dirac lobe.
+    #[inline]
+    fn mirrors_coincide(&self) -> bool {
+        self.roughness == 0.0 && self.clearcoat.is_smooth() && self.clearcoat.normal.is_none()
+    }
+
+    /// f of the lobes with a density: the base's under the coat, and the coat's.
+    #[inline]
+    fn coated_eval(
+        &self,
+        view: &View,
+        coat: &CoatView,
+        local: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> Spectrum {
+        self.eval_local(view, local, mode) * coat.base_scale(wi, mode)
+            + Spectrum::splat(coat.eval(wi, mode))
+    }
+
+    /// The mixture's density of `wi` (`local` in the base's frame).
+    #[inline]
+    fn coated_pdf(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        coat: &CoatView,
+        local: Vec3A,
+        wi: Vec3A,
+    ) -> f32 {
+        let p = Self::coat_probability(coat, &choice);
+        p * coat.pdf(wi) + (1.0 - p) * self.pdf_local(view, choice, local)
+    }
+
+    /// The coated material's scattering into a direction `wi` with a density.
+    fn coated_density_scatter(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        coat: &CoatView,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let local = view.local(wi);
+        if local.z == 0.0 {
+            return None;
+        }
+        let pdf = self.coated_pdf(view, choice, coat, local, wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        let f = self.coated_eval(view, coat, local, wi, mode);
+        // As `rough_scatter`: the radiance scaling on refraction.
+        let radiance_scale = match mode {
+            TransportMode::Radiance if local.z < 0.0 => view.eta() * view.eta(),
+            _ => 1.0,
+        };
+        Some(ScatterSample {
+            wi,
+            weight: f * (local.z.abs() / pdf),
+            pdf,
+            specular: false,
+            radiance_scale,
+        })
+    }
+
+    /// A Dirac scattering of the base (`base`: its weight and probability among the base's
+    /// lobes) under the coat.
+    fn coated_base_dirac(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        coat: &CoatView,
+        base: ScatterSample,
+        mode: TransportMode,
+    ) -> ScatterSample {
+        if self.mirrors_coincide() && view.local(base.wi).z > 0.0 {
+            return self.merged_mirror(view, choice, coat, base.wi, mode);
+        }
+        let p = Self::coat_probability(coat, &choice);
+        ScatterSample {
+            weight: base.weight * (coat.base_scale(base.wi, mode) / (1.0 - p)),
+            pdf: base.pdf * (1.0 - p),
+            ..base
+        }
+    }
+
+    /// The smooth coat's mirror reflection (merged with a smooth base's about the same
+    /// normal).
+    fn coat_mirror(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        coat: &CoatView,
+        mode: TransportMode,
+    ) -> ScatterSample {
+        let wi = coat.mirror();
+        if self.mirrors_coincide() {
+            return self.merged_mirror(view, choice, coat, wi, mode);
+        }
+        let p = Self::coat_probability(coat, &choice);
+        ScatterSample {
+            wi,
+            weight: Spectrum::splat(coat.mirror_reflectance(wi, mode) / p),
+            pdf: p,
+            specular: true,
+            radiance_scale: 1.0,
+        }
+    }
+
+    /// The one mirror lobe of a smooth coat over a smooth base with the same normal.
+    fn merged_mirror(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        coat: &CoatView,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> ScatterSample {
+        let p = Self::coat_probability(coat, &choice);
+        let base = self.specular_reflection(view, wi, choice);
+        let pdf = p + (1.0 - p) * base.pdf;
+        let reflectance = base.weight * (base.pdf * coat.base_scale(wi, mode))
+            + Spectrum::splat(coat.mirror_reflectance(wi, mode));
+        ScatterSample {
+            wi,
+            weight: reflectance * (1.0 / pdf),
+            pdf,
+            specular: true,
+            radiance_scale: 1.0,
+        }
+    }
+
+    /// `sample` with the coat.
+    #[allow(clippy::too_many_arguments)]
+    fn coated_sample(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        normal: Vec3A,
+        wo: Vec3A,
+        u: [f32; 2],
+        u_lobe: f32,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let coat = self.clearcoat.view(normal, wo)?;
+        let p = Self::coat_probability(&coat, &choice);
+        if u_lobe < p {
+            if coat.is_smooth() {
+                coat.sample(u)?;
+                return Some(self.coat_mirror(view, choice, &coat, mode));
+            }
+            let wi = coat.sample(u)?;
+            return self.coated_density_scatter(view, choice, &coat, wi, mode);
+        }
+        let u_base = ((u_lobe - p) / (1.0 - p)).min(BELOW_ONE);
+        let base = self.sample_base(view, choice, normal, wo, u, u_base, mode)?;
+        if base.specular {
+            return Some(self.coated_base_dirac(view, choice, &coat, base, mode));
+        }
+        self.coated_density_scatter(view, choice, &coat, base.wi, mode)
+    }
+
+    /// `scatter` with the coat: a `wi` within [`MIRROR_TOLERANCE`] of a smooth coat's
+    /// mirror direction is its reflection, one of a smooth base's is the base's (on the
+    /// other side its refraction), others have a density.
+    fn coated_scatter(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        normal: Vec3A,
+        wo: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> Option<ScatterSample> {
+        let coat = self.clearcoat.view(normal, wo)?;
+        let local = view.local(wi);
+        if local.z == 0.0 {
+            return None;
+        }
+        if coat.is_smooth()
+            && wi.dot(coat.mirror()) > 1.0 - MIRROR_TOLERANCE
+            && coat.stays_on_wo_side(wi)
+        {
+            return Some(self.coat_mirror(view, choice, &coat, mode));
+        }
+        if self.distribution().is_none() {
+            let base = if local.z < 0.0 {
+                (choice.transmission > 0.0)
+                    .then(|| self.specular_transmission(view, wi, choice, mode))
+            } else {
+                let mirror = Vec3A::new(-view.wo.x, -view.wo.y, view.wo.z);
+                (local.dot(mirror) > 1.0 - MIRROR_TOLERANCE)
+                    .then(|| self.specular_reflection(view, wi, choice))
+            };
+            if let Some(base) = base {
+                return Some(self.coated_base_dirac(view, choice, &coat, base, mode));
+            }
+            if local.z < 0.0 {
+                return None;
+            }
+        }
+        self.coated_density_scatter(view, choice, &coat, wi, mode)
+    }
+}
+
 /// The lobe `sample` picked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Lobe {
@@ -789,6 +1091,7 @@ mod tests {
             ior,
             transmission,
             energy_compensation: false,
+            clearcoat: Clearcoat::NONE,
         }
     }
 

@@ -9,12 +9,14 @@
 //! textures applied), and ask it for its `BsdfLobes` instead of matching on the material's
 //! kind; the free functions below are its arithmetic, one `match` per operation.
 
+mod clearcoat;
 mod dielectric;
 mod metallic_roughness;
 mod microfacet;
 mod multiple_scattering;
 mod scattering;
 
+pub(crate) use clearcoat::Clearcoat;
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
@@ -231,9 +233,12 @@ impl Bsdf {
     /// Whether every lobe is glossy (Veach's classes extended by a third: a glossy vertex
     /// has a density, so it connects, and a direction found through a moved microfacet
     /// follows its lobe).
+    /// A clear coat makes the vertex `D` even when every lobe is glossy: the microfacet
+    /// functions below are the base's, and the coat's lobe has a frame of its own.
     #[inline]
     pub fn is_glossy(&self) -> bool {
         self.lobes() == BsdfLobes::GLOSSY
+            && !matches!(self.model, BsdfModel::MetallicRoughness(m) if m.clearcoat.is_present())
     }
 
     /// The microfacet that scatters `wo` into `wi`.

@@ -46,6 +46,12 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         energy_compensation,
         abbe_number,
         transmission_texture,
+        clearcoat,
+        clearcoat_roughness,
+        clearcoat_texture,
+        clearcoat_roughness_texture,
+        clearcoat_normal_texture,
+        clearcoat_normal_scale,
         // END GENERATED material from C
     }
 }

@@ -162,7 +162,9 @@ pub struct MltTextureRef {
 /// `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
 /// by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
 /// normal map; `emission_texture` multiplies `emission`; `transmission_texture`'s red
-/// channel multiplies `transmission`. Per-vertex colours
+/// channel multiplies `transmission`; `clearcoat_texture` (red) and
+/// `clearcoat_roughness_texture` (green) multiply the clear coat's factor and roughness, and
+/// `clearcoat_normal_texture` is the coat's own normal map. Per-vertex colours
 /// (`MltSceneDesc.colors`) multiply `color` and `alpha` too.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
@@ -227,6 +229,28 @@ pub struct MltMaterial {
     /// transmissionTexture); usually linear. An index into `MltSceneDesc.textures` and its
     /// transform. Default `MLT_NO_TEXTURE` (-1).
     pub transmission_texture: MltTextureRef,
+    /// Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with
+    /// its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none. It must
+    /// be in [0, 1]. Default 0.0.
+    pub clearcoat: f32,
+    /// Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an
+    /// exact mirror). It must be in [0, 1]. Default 0.0.
+    pub clearcoat_roughness: f32,
+    /// Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's
+    /// clearcoatTexture); usually linear. An index into `MltSceneDesc.textures` and its transform.
+    /// Default `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_texture: MltTextureRef,
+    /// Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture);
+    /// usually linear. An index into `MltSceneDesc.textures` and its transform. Default
+    /// `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_roughness_texture: MltTextureRef,
+    /// Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture);
+    /// without it the coat follows the interpolated normal, not normal_texture. An index into
+    /// `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+    pub clearcoat_normal_texture: MltTextureRef,
+    /// Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale). Any finite
+    /// number. Default 1.0.
+    pub clearcoat_normal_scale: f32,
     // END GENERATED material
 }
 

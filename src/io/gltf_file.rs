@@ -21,6 +21,11 @@ pub(crate) const LUMENS_PER_WATT: f32 = 683.0;
 /// The deepest node hierarchy a glTF file may have.
 const MAX_NODE_DEPTH: usize = 1024;
 
+/// Extensions the gltf crate does not know that this loader reads from the materials' JSON
+/// itself: a file that requires them is accepted (the crate refuses required extensions
+/// it does not know).
+const EXTENSIONS_READ_HERE: &[&str] = &["KHR_materials_clearcoat"];
+
 pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let fail =
         |what: String| IoError::new(format!("cannot load glTF file {}: {what}", path.display()));
@@ -79,6 +84,9 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
             )));
         }
     }
+    let mut json = json;
+    json.extensions_required
+        .retain(|name| !EXTENSIONS_READ_HERE.contains(&name.as_str()));
     let document = ::gltf::Document::from_json(json).map_err(|e| fail(e.to_string()))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
@@ -139,6 +147,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         data: SceneData::default(),
         material_map: HashMap::new(),
         texture_map: HashMap::new(),
+        textures: document.textures().collect(),
     };
     for node in scene.nodes() {
         loader.visit(&node, Mat4::IDENTITY, &mut Vec::new())?;
@@ -169,6 +178,8 @@ struct Loader<'a> {
     /// (glTF texture index, sRGB) → index in `data.textures`: an image used both as colour
     /// and as data becomes two textures.
     texture_map: HashMap<(usize, bool), u32>,
+    /// The file's textures, for the extensions read from JSON, which name them by index.
+    textures: Vec<::gltf::texture::Texture<'a>>,
 }
 
 impl Loader<'_> {
@@ -782,6 +793,9 @@ impl Loader<'_> {
                 converted.abbe_number = (20.0 / dispersion) as f32;
             }
         }
+        if let Some(extension) = material.extension_value("KHR_materials_clearcoat") {
+            self.clearcoat(material, extension, &mut converted)?;
+        }
         // KHR_materials_unlit (not parsed by the gltf crate): the base colour (times its
         // texture) is emitted as radiance and nothing is scattered, so the surface looks its
         // colour to every path and is one consistent light in every algorithm. The base
@@ -820,6 +834,119 @@ impl Loader<'_> {
         let id = self.data.push_material(name, converted);
         self.material_map.insert(material.index(), id);
         Ok(id)
+    }
+}
+
+impl Loader<'_> {
+    /// `KHR_materials_clearcoat` (not parsed by the gltf crate): the factors, each a number
+    /// in [0, 1] (default 0), and the three textures (the normal map with its scale).
+    fn clearcoat(
+        &mut self,
+        material: &::gltf::Material,
+        extension: &serde_json::Value,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let label = material
+            .index()
+            .map_or("(default)".into(), |i| i.to_string());
+        let what = |field: &str| format!("material {label}: KHR_materials_clearcoat's {field}");
+        let factor = |field: &str| -> Result<f32, IoError> {
+            match extension.get(field) {
+                None => Ok(0.0),
+                Some(value) => value
+                    .as_f64()
+                    .filter(|v| (0.0..=1.0).contains(v))
+                    .map(|v| v as f32)
+                    .ok_or_else(|| {
+                        self.fail(format!(
+                            "{} is {value}; it must be a number in [0, 1]",
+                            what(field)
+                        ))
+                    }),
+            }
+        };
+        converted.clearcoat = factor("clearcoatFactor")?;
+        converted.clearcoat_roughness = factor("clearcoatRoughnessFactor")?;
+        if let Some(info) = extension.get("clearcoatTexture") {
+            converted.clearcoat_texture = Some(self.texture_info(info, &what("clearcoatTexture"))?);
+        }
+        if let Some(info) = extension.get("clearcoatRoughnessTexture") {
+            converted.clearcoat_roughness_texture =
+                Some(self.texture_info(info, &what("clearcoatRoughnessTexture"))?);
+        }
+        if let Some(info) = extension.get("clearcoatNormalTexture") {
+            let name = what("clearcoatNormalTexture");
+            converted.clearcoat_normal_texture = Some(self.texture_info(info, &name)?);
+            converted.clearcoat_normal_scale = match info.get("scale") {
+                None => 1.0,
+                Some(value) => value
+                    .as_f64()
+                    .filter(|v| v.is_finite())
+                    .map(|v| v as f32)
+                    .ok_or_else(|| {
+                        self.fail(format!("{name}'s scale is {value}; it must be a number"))
+                    })?,
+            };
+        }
+        Ok(())
+    }
+
+    /// A texture named by a textureInfo read from JSON (`{"index": i, "texCoord": 0}`, with
+    /// its `KHR_texture_transform`), as linear data.
+    fn texture_info(
+        &mut self,
+        info: &serde_json::Value,
+        what: &str,
+    ) -> Result<TextureRef, IoError> {
+        let texture = info
+            .get("index")
+            .and_then(serde_json::Value::as_u64)
+            .and_then(|i| self.textures.get(usize::try_from(i).ok()?))
+            .cloned()
+            .ok_or_else(|| {
+                self.fail(format!(
+                    "{what} has index {}; it must name one of the {} textures",
+                    info.get("index").map_or("none".into(), |v| v.to_string()),
+                    self.textures.len()
+                ))
+            })?;
+        let transform = info
+            .get("extensions")
+            .and_then(|e| e.get("KHR_texture_transform"));
+        // KHR_texture_transform's texCoord overrides the textureInfo's, as `texture_ref` does.
+        let texcoord = transform
+            .and_then(|t| t.get("texCoord"))
+            .or_else(|| info.get("texCoord"))
+            .map_or(Some(0), |v| v.as_u64().and_then(|v| u32::try_from(v).ok()))
+            .ok_or_else(|| self.fail(format!("{what}'s texCoord must be a set index")))?;
+        let mut reference = self.texture_ref(texture, texcoord, None, false)?;
+        if let Some(transform) = transform {
+            let numbers = |field: &str, default: &[f32]| -> Result<Vec<f32>, IoError> {
+                let Some(value) = transform.get(field) else {
+                    return Ok(default.to_vec());
+                };
+                let values: Option<Vec<f32>> = match value {
+                    serde_json::Value::Array(items) => {
+                        items.iter().map(|v| v.as_f64().map(|v| v as f32)).collect()
+                    }
+                    other => other.as_f64().map(|v| vec![v as f32]),
+                };
+                values
+                    .filter(|v| v.len() == default.len() && v.iter().all(|x| x.is_finite()))
+                    .ok_or_else(|| {
+                        self.fail(format!(
+                            "{what}'s KHR_texture_transform {field} is {value}; it must be {} finite numbers",
+                            default.len()
+                        ))
+                    })
+            };
+            let offset = numbers("offset", &[0.0, 0.0])?;
+            let scale = numbers("scale", &[1.0, 1.0])?;
+            reference.offset = [offset[0], offset[1]];
+            reference.rotation = numbers("rotation", &[0.0])?[0];
+            reference.scale = [scale[0], scale[1]];
+        }
+        Ok(reference)
     }
 }
 

@@ -26,6 +26,9 @@
 //!   α = roughness²); `Ks`'s colour itself is not used (the dielectric's Fresnel is);
 //! - anything else: Lambertian with albedo `Kd` (0.8 grey if absent);
 //! - `Ke` on any material makes its triangles area lights;
+//! - the PBR extension's `Pc` (clear coat thickness, taken as its factor in [0, 1]) and
+//!   `Pcr` (its roughness, 0 if absent) on a metallic-roughness material: its clear coat;
+//!   `Pc` alone makes the material metallic-roughness;
 //! - `Vd` (mlt's own keyword; MTL has none for it) on a dielectric or metallic-roughness
 //!   material: its Abbe number, the dispersion `Material::abbe_number` describes.
 //!
@@ -77,8 +80,9 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   roughness factors and textures, `normalTexture` with its scale, emission =
 ///   `emissiveFactor` × `KHR_materials_emissive_strength` × `emissiveTexture`,
 ///   `KHR_materials_transmission` (factor; its texture is ignored), `KHR_materials_ior`,
-///   `KHR_texture_transform`, `KHR_materials_unlit` (the base colour emitted, nothing
-///   scattered), alpha modes (`BLEND` as stochastic coverage,
+///   `KHR_texture_transform`, `KHR_materials_clearcoat` (factors, textures and the coat's
+///   own normal map; files may require it), `KHR_materials_unlit` (the base colour
+///   emitted, nothing scattered), alpha modes (`BLEND` as stochastic coverage,
 ///   [`crate::AlphaMode::Blend`]). Images (PNG, JPEG; embedded, data URIs or files) become
 ///   textures: base colour and emission decoded as sRGB, the others linear, with the
 ///   sampler's wrap modes and nearest or bilinear filtering. Attributes: `NORMAL`,

@@ -149,8 +149,12 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
     };
     let (roughness, metallic) = (number("Pr")?, number("Pm")?);
     let abbe_number = number("Vd")?.unwrap_or(0.0);
+    // The PBR extension's clear coat: `Pc` its thickness (here its factor), `Pcr` its
+    // roughness.
+    let (clearcoat, clearcoat_roughness) = (number("Pc")?, number("Pcr")?);
     let pbr = roughness.is_some()
         || metallic.is_some()
+        || clearcoat.is_some()
         || m.unknown_param.contains_key("map_Pr")
         || m.unknown_param.contains_key("map_Pm");
     let glossy = matches!(illum, None | Some(2))
@@ -185,8 +189,14 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         Material::diffuse(diffuse)
     };
     let material = match material.kind {
-        MaterialKind::Dielectric | MaterialKind::MetallicRoughness => Material {
+        MaterialKind::Dielectric => Material {
             abbe_number,
+            ..material
+        },
+        MaterialKind::MetallicRoughness => Material {
+            abbe_number,
+            clearcoat: clearcoat.unwrap_or(0.0),
+            clearcoat_roughness: clearcoat_roughness.unwrap_or(0.0),
             ..material
         },
         _ => material,

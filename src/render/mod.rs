@@ -387,7 +387,7 @@ fn with_estimator<R>(
         return Err(crate::error::Error::new(
             crate::error::MLT_STATUS_UNSUPPORTED,
             format!(
-                "{:?} cannot render material {material}: at roughness 0 it is a smooth coat over a diffuse or transmissive base (a Dirac lobe beside a diffuse one), which Veach's path-space mutations do not handle; give it a roughness above 0, or use another algorithm",
+                "{:?} cannot render material {material}: at roughness 0 it is a smooth coat over a diffuse or transmissive base, or its clear coat is smooth (a Dirac lobe beside a diffuse or glossy one), which Veach's path-space mutations do not handle; give it (or its clear coat) a roughness above 0, or use another algorithm",
                 settings.algorithm
             ),
         ));

@@ -1,6 +1,6 @@
 //! Surface materials: what a triangle does with light.
 
-use crate::bsdf::{BsdfModel, MetallicRoughness};
+use crate::bsdf::{BsdfModel, Clearcoat, MetallicRoughness};
 use crate::error::{Error, Result};
 use crate::params::{ChoiceParameter, Range, declare_parameters, in_unit_interval};
 use crate::spectral::Channels;
@@ -55,8 +55,10 @@ declare_parameters! {
     /// (blue) as glTF defines; `normal_texture` is a tangent-space normal map (glTF's
     /// convention, +Y up in the texture) whose x and y are scaled by `normal_scale`;
     /// `emission_texture` multiplies `emission`; `transmission_texture`'s red channel
-    /// multiplies `transmission`. Per-vertex colours multiply `color` and
-    /// `alpha` too.
+    /// multiplies `transmission`; `clearcoat_texture`'s red and
+    /// `clearcoat_roughness_texture`'s green multiply the clear coat's factor and roughness,
+    /// and `clearcoat_normal_texture` is the coat's own normal map (scaled by
+    /// `clearcoat_normal_scale`). Per-vertex colours multiply `color` and `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
     #[derive(Clone, Copy, Debug, PartialEq)]
@@ -152,6 +154,31 @@ declare_parameters! {
         },
         transmission_texture: Option<TextureRef> = None => {
             doc: "Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's transmissionTexture); usually linear.",
+        },
+        /// Metallic-roughness only: a clear coat over the whole material, in [0, 1] (0: none).
+        clearcoat: f32 = 0.0 => {
+            doc: "Metallic-roughness: a clear coat over the material, a white GGX reflection of index 1.5 with its own roughness and normal (KHR_materials_clearcoat's clearcoatFactor); 0 is none.",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        /// The clear coat's perceptual roughness in [0, 1].
+        clearcoat_roughness: f32 = 0.0 => {
+            doc: "Metallic-roughness: the clear coat's perceptual roughness (GGX alpha = its square; 0 is an exact mirror).",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        clearcoat_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: red multiplies the clear coat (KHR_materials_clearcoat's clearcoatTexture); usually linear.",
+        },
+        clearcoat_roughness_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: green multiplies the clear coat's roughness (clearcoatRoughnessTexture); usually linear.",
+        },
+        clearcoat_normal_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: the clear coat's own tangent-space normal map (clearcoatNormalTexture); without it the coat follows the interpolated normal, not normal_texture.",
+        },
+        /// Scales the clear coat's normal map's x and y; finite.
+        clearcoat_normal_scale: f32 = 1.0 => {
+            doc: "Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).",
         },
     }
 }
@@ -311,6 +338,11 @@ impl Material {
                 ior,
                 transmission,
                 energy_compensation: self.energy_compensation,
+                clearcoat: Clearcoat {
+                    factor: self.clearcoat,
+                    roughness: self.clearcoat_roughness,
+                    normal: None,
+                },
             }),
         }
     }

@@ -445,7 +445,9 @@ impl Scene {
 
     /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
     /// somewhere (metallic-roughness at roughness 0 with a dielectric part: a smooth coat
-    /// over a diffuse base), which path-space MLT and ERPT do not explore correctly.
+    /// over a diffuse base), which path-space MLT and ERPT do not explore correctly, or
+    /// that has a smooth clear coat somewhere (a Dirac lobe over any base, beside a smooth
+    /// base's own mirror about another normal).
     pub(crate) fn mixed_lobe_material(&self) -> Option<usize> {
         self.materials.iter().position(|m| {
             if m.kind != MaterialKind::MetallicRoughness {
@@ -465,10 +467,13 @@ impl Scene {
             let transmission = m.transmission * texture_min(m.transmission_texture, 0);
             let smoothest =
                 m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
-            roughness == 0.0 && {
-                let lobes = smoothest.lobes();
-                lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
-            }
+            let smooth_coat = m.clearcoat > 0.0
+                && m.clearcoat_roughness * texture_min(m.clearcoat_roughness_texture, 1) == 0.0;
+            smooth_coat
+                || roughness == 0.0 && {
+                    let lobes = smoothest.lobes();
+                    lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
+                }
         })
     }
 

@@ -6,7 +6,7 @@
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
 use super::material::{Material, TextureRef};
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, BsdfModel, Clearcoat};
 use crate::error::{Error, Result};
 use crate::spectral::{Channels, FittedColour};
 use crate::spectrum::Spectrum;
@@ -298,14 +298,28 @@ impl SurfacePoint<'_> {
         let normal =
             self.attributes
                 .shading_normal(self.triangle, self.barycentrics, geometric_normal);
+        let m = self.material;
+        self.normal_mapped(normal, &m.normal_texture, m.normal_scale, geometric_normal)
+    }
+
+    /// `normal` (the interpolated one) bent by the tangent-space normal map `texture`
+    /// (glTF's convention, x and y scaled by `scale`); `normal` itself without a map or
+    /// tangents, or where the map would bend it behind the triangle.
+    #[inline]
+    fn normal_mapped(
+        &self,
+        normal: Vec3A,
+        texture: &Option<TextureRef>,
+        scale: f32,
+        geometric_normal: Vec3A,
+    ) -> Vec3A {
         let (Some(texture), Some(tangent)) = (
-            &self.material.normal_texture,
+            texture,
             self.attributes.tangent(self.triangle, self.barycentrics),
         ) else {
             return normal;
         };
         let texel = self.lookup(texture);
-        let scale = self.material.normal_scale;
         let local = Vec3A::new(
             (texel.x * 2.0 - 1.0) * scale,
             (texel.y * 2.0 - 1.0) * scale,
@@ -324,6 +338,39 @@ impl SurfacePoint<'_> {
             mapped
         } else {
             normal
+        }
+    }
+
+    /// The clear coat here: its factor and roughness times their textures, and its own
+    /// normal (its normal map over the interpolated normal, never the base's map), `None`
+    /// where that is `shading_normal` itself.
+    #[inline]
+    fn clearcoat(&self, shading_normal: Vec3A, geometric_normal: Vec3A) -> Clearcoat {
+        let m = self.material;
+        let mut factor = m.clearcoat;
+        if let Some(texture) = &m.clearcoat_texture {
+            factor *= self.lookup(texture).x;
+        }
+        if factor <= 0.0 {
+            return Clearcoat::NONE;
+        }
+        let mut roughness = m.clearcoat_roughness;
+        if let Some(texture) = &m.clearcoat_roughness_texture {
+            roughness *= self.lookup(texture).y;
+        }
+        let interpolated =
+            self.attributes
+                .shading_normal(self.triangle, self.barycentrics, geometric_normal);
+        let normal = self.normal_mapped(
+            interpolated,
+            &m.clearcoat_normal_texture,
+            m.clearcoat_normal_scale,
+            geometric_normal,
+        );
+        Clearcoat {
+            factor,
+            roughness,
+            normal: (normal != shading_normal).then_some(normal),
         }
     }
 
@@ -356,14 +403,15 @@ impl SurfacePoint<'_> {
         if let Some(texture) = &m.transmission_texture {
             transmission *= self.lookup(texture).x;
         }
-        let model =
+        let mut model =
             m.textured_bsdf_model(color, metallic, roughness, transmission, m.ior_in(channels));
-        Bsdf::new(
-            model,
-            self.shading_normal(geometric_normal),
-            geometric_normal,
-        )
-        .with_dispersion(dispersive)
+        let shading_normal = self.shading_normal(geometric_normal);
+        if let BsdfModel::MetallicRoughness(model) = &mut model
+            && model.clearcoat.is_present()
+        {
+            model.clearcoat = self.clearcoat(shading_normal, geometric_normal);
+        }
+        Bsdf::new(model, shading_normal, geometric_normal).with_dispersion(dispersive)
     }
 }
 
