@@ -374,6 +374,12 @@ void check_materials() {
     show("c++", "material.abbe_number", cpp.abbe_number);
     show("c", "material.transmission_texture", c.transmission_texture);
     show("c++", "material.transmission_texture", cpp.transmission_texture);
+    show("c", "material.thickness", c.thickness);
+    show("c++", "material.thickness", cpp.thickness);
+    show("c", "material.attenuation_color", c.attenuation_color);
+    show("c++", "material.attenuation_color", cpp.attenuation_color);
+    show("c", "material.attenuation_distance", c.attenuation_distance);
+    show("c++", "material.attenuation_distance", cpp.attenuation_distance);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -439,6 +445,31 @@ void check_materials() {
         MltMaterial cs = c;
         cs.abbe_number = -1.0f;
         message("c", "material.abbe_number", cs);
+    }
+    {
+        mlt::Material s;
+        s.thickness = -1.0f;
+        message("c++", "material.thickness", s.to_c());
+        MltMaterial cs = c;
+        cs.thickness = -1.0f;
+        message("c", "material.thickness", cs);
+    }
+    {
+        mlt::Material s;
+        s.attenuation_color = {2.0f, 1.0f, 1.0f};
+        message("c++", "material.attenuation_color", s.to_c());
+        MltMaterial cs = c;
+        const std::array<float, 3> bad{2.0f, 1.0f, 1.0f};
+        for (std::size_t i = 0; i < bad.size(); ++i) cs.attenuation_color[i] = bad[i];
+        message("c", "material.attenuation_color", cs);
+    }
+    {
+        mlt::Material s;
+        s.attenuation_distance = 0.0f;
+        message("c++", "material.attenuation_distance", s.to_c());
+        MltMaterial cs = c;
+        cs.attenuation_distance = 0.0f;
+        message("c", "material.attenuation_distance", cs);
     }
     // END GENERATED material checks
 }

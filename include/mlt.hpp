@@ -487,6 +487,16 @@ struct Material {
     /// Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
     /// transmissionTexture); usually linear.
     TextureRef transmission_texture;
+    /// Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+    /// an absorbing volume (KHR_materials_volume's thicknessFactor).
+    float thickness = 0.0f;
+    /// The volume's colour after attenuation_distance of travel inside it, linear RGB
+    /// (KHR_materials_volume's attenuationColor).
+    std::array<float, 3> attenuation_color{1.0f, 1.0f, 1.0f};
+    /// The distance inside the volume after which white light has the attenuation colour; the
+    /// largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+    /// attenuationDistance).
+    float attenuation_distance = 3.4028235e38f;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -545,6 +555,9 @@ struct Material {
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
         c.transmission_texture = transmission_texture.to_c();
+        c.thickness = thickness;
+        detail::copy_to(c.attenuation_color, attenuation_color);
+        c.attenuation_distance = attenuation_distance;
         // END GENERATED material to C
         return c;
     }
@@ -569,6 +582,9 @@ struct Material {
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
         m.transmission_texture = TextureRef::from_c(c.transmission_texture);
+        m.thickness = c.thickness;
+        m.attenuation_color = detail::to_array(c.attenuation_color);
+        m.attenuation_distance = c.attenuation_distance;
         // END GENERATED material from C
         return m;
     }

@@ -214,6 +214,8 @@ const MATERIAL_LIMITS: &[(&str, f64, f64)] = &[
     ("alpha_cutoff", 0.0, 1.0),
     ("normal_scale", -2.0, 2.0),
     ("abbe_number", 0.0, 90.0),
+    ("thickness", 0.0, 2.0),
+    ("attenuation_distance", 0.01, 10.0),
 ];
 
 /// A texture slot: mostly none; else a texture's index, or the index past the last (refused),

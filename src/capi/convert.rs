@@ -46,6 +46,9 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         energy_compensation,
         abbe_number,
         transmission_texture,
+        thickness,
+        attenuation_color,
+        attenuation_distance,
         // END GENERATED material from C
     }
 }

@@ -222,6 +222,19 @@ pub struct MltMaterial {
     /// transmissionTexture); usually linear. An index into `MltSceneDesc.textures` and its
     /// transform. Default `MLT_NO_TEXTURE` (-1).
     pub transmission_texture: MltTextureRef,
+    /// Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+    /// an absorbing volume (KHR_materials_volume's thicknessFactor). A thickness must not be
+    /// negative (0: thin-walled). Default 0.0.
+    pub thickness: f32,
+    /// The volume's colour after attenuation_distance of travel inside it, linear RGB
+    /// (KHR_materials_volume's attenuationColor). An attenuation colour is a transmittance, in [0,
+    /// 1]. Default 1.0, 1.0, 1.0.
+    pub attenuation_color: [f32; 3],
+    /// The distance inside the volume after which white light has the attenuation colour; the
+    /// largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+    /// attenuationDistance). An attenuation distance must be greater than 0 (the largest float: no
+    /// absorption). Default 3.4028235e38.
+    pub attenuation_distance: f32,
     // END GENERATED material
 }
 

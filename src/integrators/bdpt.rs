@@ -111,6 +111,18 @@ impl Vertex {
         matches!(self.kind, VertexKind::Light(e) if e.at_infinity())
     }
 
+    /// The triangle the vertex lies on (a surface or an area light), which tells the
+    /// volumes of the segments that end here (`Scene::transmittance`); `None` for the lens
+    /// and lights that are not triangles.
+    #[inline]
+    fn on_triangle(&self) -> Option<u32> {
+        match self.kind {
+            VertexKind::Surface => Some(self.triangle),
+            VertexKind::Light(e) if e.is_area() => Some(self.triangle),
+            _ => None,
+        }
+    }
+
     /// The normal to offset shadow rays by (none for the lens and point lights).
     #[inline]
     fn offset_normal(&self) -> Vec3A {
@@ -289,6 +301,13 @@ impl Bdpt<'_> {
                 if mode == TransportMode::Radiance
                     && let Some(light) = self.scene.lights.infinite_emitter()
                 {
+                    beta *= self.scene.transmittance(
+                        path[count - 1].on_triangle(),
+                        None,
+                        ray.direction,
+                        f32::INFINITY,
+                        channels,
+                    );
                     path[count] = Vertex {
                         kind: VertexKind::Light(light),
                         p: ray.origin,
@@ -308,6 +327,13 @@ impl Bdpt<'_> {
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
+            beta *= self.scene.transmittance(
+                path[count - 1].on_triangle(),
+                Some(hit.triangle),
+                ray.direction,
+                hit.t,
+                channels,
+            );
             let mut vertex = Vertex {
                 kind: VertexKind::Surface,
                 p: si.p,
@@ -760,7 +786,14 @@ impl Bdpt<'_> {
             let contribution = qs.beta
                 * sampled.beta
                 * self.f(&qs, lens, TransportMode::Importance, channels)
-                * direction.dot(qs.normal).abs();
+                * direction.dot(qs.normal).abs()
+                * self.scene.transmittance(
+                    qs.on_triangle(),
+                    None,
+                    -direction,
+                    distance2.sqrt(),
+                    channels,
+                );
             if contribution.is_black() || !self.visible(&qs, &sampled, counters) {
                 return None;
             }
@@ -800,7 +833,13 @@ impl Bdpt<'_> {
             let f = self
                 .bsdf(&pt, channels)
                 .eval(pt.wo, sample.wi, TransportMode::Radiance);
-            let contribution = pt.beta * f * sampled.beta * sample.geometry(pt.normal);
+            let contribution = pt.beta
+                * f
+                * sampled.beta
+                * sample.geometry(pt.normal)
+                * self
+                    .scene
+                    .light_transmittance(pt.triangle, &sample, channels);
             if contribution.is_black() {
                 return None;
             }
@@ -838,7 +877,14 @@ impl Bdpt<'_> {
                 * self.f(&qs, pt.p, TransportMode::Importance, channels)
                 * self.f(&pt, qs.p, TransportMode::Radiance, channels)
                 * pt.beta
-                * geometry;
+                * geometry
+                * self.scene.transmittance(
+                    qs.on_triangle(),
+                    pt.on_triangle(),
+                    w,
+                    distance2.sqrt(),
+                    channels,
+                );
             if contribution.is_black() || !self.visible(&qs, &pt, counters) {
                 return None;
             }

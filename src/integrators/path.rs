@@ -57,6 +57,9 @@ impl PathTracer<'_> {
         // divides out of the throughput (as pbrt-v4 and Mitsuba do): a path inside glass
         // carries (1/η)² the throughput with no less to contribute.
         let mut radiance_scale = 1.0f32;
+        // The triangle the current ray leaves (`None`: the lens), which with the one it
+        // reaches tells the volume it travels through.
+        let mut leaving: Option<u32> = None;
 
         // `depth` = scattering vertices before the surface this iteration hits.
         let mut depth = 0;
@@ -65,6 +68,8 @@ impl PathTracer<'_> {
             let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
+                    throughput *=
+                        scene.transmittance(leaving, None, ray.direction, f32::INFINITY, &channels);
                     let emission = scene.lights.infinite_radiance(ray.direction, &channels);
                     let weight = if previous_specular {
                         1.0
@@ -80,6 +85,8 @@ impl PathTracer<'_> {
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
+            throughput *=
+                scene.transmittance(leaving, Some(hit.triangle), ray.direction, hit.t, &channels);
             let normal = si.geometric_normal;
             let wo = -ray.direction;
             let p = si.p;
@@ -117,7 +124,7 @@ impl PathTracer<'_> {
             // Only a lobe with a density (diffuse, glossy) can meet a light sample.
             if bsdf.lobes().has_non_specular() && depth + 1 >= self.min_depth {
                 radiance +=
-                    throughput * self.sample_light(p, normal, wo, &bsdf, u_light, &channels, rays);
+                    throughput * self.sample_light(&si, wo, &bsdf, u_light, &channels, rays);
             }
 
             let Some(sample) = bsdf.sample(wo, u_bsdf, u_lobe, TransportMode::Radiance) else {
@@ -141,6 +148,7 @@ impl PathTracer<'_> {
                 break;
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
+            leaving = Some(si.triangle);
         }
         channels.rgb_of(radiance)
     }
@@ -154,8 +162,7 @@ impl PathTracer<'_> {
     #[allow(clippy::too_many_arguments)]
     fn sample_light(
         &self,
-        p: Vec3A,
-        normal: Vec3A,
+        si: &SurfaceInteraction,
         wo: Vec3A,
         bsdf: &Bsdf,
         [u_select, u_point @ ..]: [f32; 3],
@@ -163,6 +170,7 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
+        let (p, normal) = (si.p, si.geometric_normal);
         let Some(light) = scene.sample_li(p, u_select, u_point, channels) else {
             return Spectrum::ZERO;
         };
@@ -185,7 +193,9 @@ impl PathTracer<'_> {
         } else {
             power_heuristic(light_pdf, bsdf.pdf(wo, wi))
         };
-        f * light.radiance * (wi.dot(normal).abs() * weight / light_pdf)
+        f * light.radiance
+            * scene.light_transmittance(si.triangle, &light, channels)
+            * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
 

@@ -739,6 +739,9 @@ impl Loader<'_> {
                 converted.abbe_number = (20.0 / dispersion) as f32;
             }
         }
+        if let Some(extension) = material.extension_value("KHR_materials_volume") {
+            self.read_volume(&material, extension, &mut converted)?;
+        }
         if converted.has_textures() && !self.attributes.texcoords {
             // Without texture coordinates every lookup would read one texel; glTF files
             // with textures always carry them, so this is a broken file.
@@ -757,6 +760,61 @@ impl Loader<'_> {
         let id = self.data.push_material(name, converted);
         self.material_map.insert(material.index(), id);
         Ok(id)
+    }
+}
+
+impl Loader<'_> {
+    /// `KHR_materials_volume` (read here, not by the gltf crate, to check its values):
+    /// `thicknessFactor` (>= 0; 0 is thin-walled), `attenuationColor` (RGB in [0, 1]) and
+    /// `attenuationDistance` (> 0; absent: infinity, no absorption). The thickness texture
+    /// is not read: a path tracer measures the distances through the mesh itself, and the
+    /// factor alone tells a thin wall from a volume.
+    fn read_volume(
+        &self,
+        material: &::gltf::Material,
+        extension: &::gltf::json::Value,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let fail = |what: &str| {
+            self.fail(format!(
+                "material {}: KHR_materials_volume's {what}",
+                material
+                    .index()
+                    .map_or("(default)".into(), |i| i.to_string())
+            ))
+        };
+        let number = |key: &str| {
+            extension
+                .get(key)
+                .map(|v| v.as_f64().filter(|x| x.is_finite()))
+        };
+        converted.thickness = match number("thicknessFactor") {
+            None => 0.0,
+            Some(Some(t)) if t >= 0.0 => t.min(f32::MAX as f64) as f32,
+            Some(_) => return Err(fail("thicknessFactor must be a number >= 0")),
+        };
+        converted.attenuation_distance = match number("attenuationDistance") {
+            None => f32::MAX,
+            Some(Some(d)) if d > 0.0 => d.min(f32::MAX as f64) as f32,
+            Some(_) => return Err(fail("attenuationDistance must be a number > 0")),
+        };
+        if let Some(color) = extension.get("attenuationColor") {
+            let rgb: Option<Vec<f64>> = color.as_array().and_then(|values| {
+                values
+                    .iter()
+                    .map(|v| v.as_f64().filter(|c| (0.0..=1.0).contains(c)))
+                    .collect()
+            });
+            match rgb.as_deref() {
+                Some(&[r, g, b]) => {
+                    converted.attenuation_color = [r as f32, g as f32, b as f32];
+                }
+                _ => {
+                    return Err(fail("attenuationColor must be three numbers in [0, 1]"));
+                }
+            }
+        }
+        Ok(())
     }
 }
 
