@@ -327,11 +327,12 @@ impl Bdpt<'_> {
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
-            beta *= self.scene.transmittance(
+            // Between the vertices: the ray's origin is moved off the surface.
+            beta *= self.scene.transmittance_between(
                 path[count - 1].on_triangle(),
                 Some(hit.triangle),
-                ray.direction,
-                hit.t,
+                path[count - 1].p,
+                si.p,
                 channels,
             );
             let mut vertex = Vertex {

@@ -57,9 +57,10 @@ impl PathTracer<'_> {
         // divides out of the throughput (as pbrt-v4 and Mitsuba do): a path inside glass
         // carries (1/η)² the throughput with no less to contribute.
         let mut radiance_scale = 1.0f32;
-        // The triangle the current ray leaves (`None`: the lens), which with the one it
-        // reaches tells the volume it travels through.
-        let mut leaving: Option<u32> = None;
+        // The point the current ray leaves and its triangle (`None`: the lens), which with
+        // the one it reaches tell the volume it travels through and how far (the ray's
+        // origin is moved off the surface, so its `t` is not the distance).
+        let mut leaving: (Option<u32>, Vec3A) = (None, origin);
 
         // `depth` = scattering vertices before the surface this iteration hits.
         let mut depth = 0;
@@ -68,8 +69,13 @@ impl PathTracer<'_> {
             let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
-                    throughput *=
-                        scene.transmittance(leaving, None, ray.direction, f32::INFINITY, &channels);
+                    throughput *= scene.transmittance(
+                        leaving.0,
+                        None,
+                        ray.direction,
+                        f32::INFINITY,
+                        &channels,
+                    );
                     let emission = scene.lights.infinite_radiance(ray.direction, &channels);
                     let weight = if previous_specular {
                         1.0
@@ -85,8 +91,13 @@ impl PathTracer<'_> {
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
-            throughput *=
-                scene.transmittance(leaving, Some(hit.triangle), ray.direction, hit.t, &channels);
+            throughput *= scene.transmittance_between(
+                leaving.0,
+                Some(hit.triangle),
+                leaving.1,
+                si.p,
+                &channels,
+            );
             let normal = si.geometric_normal;
             let wo = -ray.direction;
             let p = si.p;
@@ -148,7 +159,7 @@ impl PathTracer<'_> {
                 break;
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
-            leaving = Some(si.triangle);
+            leaving = (Some(si.triangle), p);
         }
         channels.rgb_of(radiance)
     }

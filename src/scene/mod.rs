@@ -459,6 +459,27 @@ impl Scene {
         self.medium_transmittance(from, to, direction, distance, channels)
     }
 
+    /// `transmittance` of the segment from point `a` on `from` to point `b` on `to`.
+    #[inline(always)]
+    pub(crate) fn transmittance_between(
+        &self,
+        from: Option<u32>,
+        to: Option<u32>,
+        a: Vec3A,
+        b: Vec3A,
+        channels: &Channels,
+    ) -> Spectrum {
+        if !self.has_media {
+            return Spectrum::ONE;
+        }
+        let d = b - a;
+        let distance = d.length();
+        if distance == 0.0 {
+            return Spectrum::ONE;
+        }
+        self.medium_transmittance(from, to, d / distance, distance, channels)
+    }
+
     /// `transmittance` in a scene with volumes.
     #[inline(never)]
     fn medium_transmittance(
