@@ -740,7 +740,7 @@ impl Loader<'_> {
             }
         }
         if let Some(extension) = material.extension_value("KHR_materials_volume") {
-            self.read_volume(&material, extension, &mut converted)?;
+            self.read_volume(material, extension, &mut converted)?;
         }
         if converted.has_textures() && !self.attributes.texcoords {
             // Without texture coordinates every lookup would read one texel; glTF files
