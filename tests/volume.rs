@@ -9,7 +9,8 @@
 //! - On the surfaces scene with its rough glass sphere made absorbing, every algorithm
 //!   agrees with BDPT, and BDPT with the path tracer (and each check would fail a 2% error).
 //!
-//! Runs in about 30 s on 2 cores (`cargo test --test volume`).
+//! As much work as tests/surfaces.rs (`cargo test --test volume`): 156 s measured on 2
+//! cores shared with a load of 11.
 
 mod common {
     pub mod references;
