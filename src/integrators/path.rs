@@ -69,13 +69,15 @@ impl PathTracer<'_> {
             let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
-                    throughput *= scene.transmittance(
-                        leaving.0,
-                        None,
-                        ray.direction,
-                        f32::INFINITY,
-                        &channels,
-                    );
+                    if scene.has_media() {
+                        throughput *= scene.transmittance(
+                            leaving.0,
+                            None,
+                            ray.direction,
+                            f32::INFINITY,
+                            &channels,
+                        );
+                    }
                     let emission = scene.lights.infinite_radiance(ray.direction, &channels);
                     let weight = if previous_specular {
                         1.0
@@ -91,13 +93,15 @@ impl PathTracer<'_> {
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
-            throughput *= scene.transmittance_between(
-                leaving.0,
-                Some(hit.triangle),
-                leaving.1,
-                si.p,
-                &channels,
-            );
+            if scene.has_media() {
+                throughput *= scene.transmittance_between(
+                    leaving.0,
+                    Some(hit.triangle),
+                    leaving.1,
+                    si.p,
+                    &channels,
+                );
+            }
             let normal = si.geometric_normal;
             let wo = -ray.direction;
             let p = si.p;
@@ -204,9 +208,11 @@ impl PathTracer<'_> {
         } else {
             power_heuristic(light_pdf, bsdf.pdf(wo, wi))
         };
-        f * light.radiance
-            * scene.light_transmittance(si.triangle, &light, channels)
-            * (wi.dot(normal).abs() * weight / light_pdf)
+        let mut arriving = f * light.radiance;
+        if scene.has_media() {
+            arriving *= scene.light_transmittance(si.triangle, &light, channels);
+        }
+        arriving * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
 

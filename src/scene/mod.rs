@@ -443,7 +443,8 @@ impl Scene {
     /// `direction` the unit direction from `from` to `to`, `distance` its length (infinite
     /// towards or from a light at infinity, or for a ray that escapes). Symmetric: the
     /// segment read from `to` to `from` has the same transmittance, as path-space
-    /// mutations need.
+    /// mutations need. The integrators' hot loops ask `has_media` first, so that a scene
+    /// without a volume costs them one branch per segment.
     #[inline(always)]
     pub(crate) fn transmittance(
         &self,
