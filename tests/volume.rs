@@ -10,7 +10,7 @@
 //!   agrees with BDPT, and BDPT with the path tracer (and each check would fail a 2% error).
 //!
 //! As much work as tests/surfaces.rs (`cargo test --test volume`): 156 s measured on 2
-//! cores shared with a load of 11.
+//! cores shared with other jobs (load 10 to 11), 99 s in another run.
 
 mod common {
     pub mod references;
