@@ -386,6 +386,12 @@ void check_materials() {
     show("c++", "material.clearcoat_normal_texture", cpp.clearcoat_normal_texture);
     show("c", "material.clearcoat_normal_scale", c.clearcoat_normal_scale);
     show("c++", "material.clearcoat_normal_scale", cpp.clearcoat_normal_scale);
+    show("c", "material.thickness", c.thickness);
+    show("c++", "material.thickness", cpp.thickness);
+    show("c", "material.attenuation_color", c.attenuation_color);
+    show("c++", "material.attenuation_color", cpp.attenuation_color);
+    show("c", "material.attenuation_distance", c.attenuation_distance);
+    show("c++", "material.attenuation_distance", cpp.attenuation_distance);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -467,6 +473,31 @@ void check_materials() {
         MltMaterial cs = c;
         cs.clearcoat_roughness = 2.0f;
         message("c", "material.clearcoat_roughness", cs);
+    }
+    {
+        mlt::Material s;
+        s.thickness = -1.0f;
+        message("c++", "material.thickness", s.to_c());
+        MltMaterial cs = c;
+        cs.thickness = -1.0f;
+        message("c", "material.thickness", cs);
+    }
+    {
+        mlt::Material s;
+        s.attenuation_color = {2.0f, 1.0f, 1.0f};
+        message("c++", "material.attenuation_color", s.to_c());
+        MltMaterial cs = c;
+        const std::array<float, 3> bad{2.0f, 1.0f, 1.0f};
+        for (std::size_t i = 0; i < bad.size(); ++i) cs.attenuation_color[i] = bad[i];
+        message("c", "material.attenuation_color", cs);
+    }
+    {
+        mlt::Material s;
+        s.attenuation_distance = 0.0f;
+        message("c++", "material.attenuation_distance", s.to_c());
+        MltMaterial cs = c;
+        cs.attenuation_distance = 0.0f;
+        message("c", "material.attenuation_distance", cs);
     }
     // END GENERATED material checks
 }

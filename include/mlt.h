@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 4
+#define MLT_VERSION_MINOR 5
 
 /**
  * Patch version.
@@ -588,6 +588,25 @@ typedef struct MltMaterial {
    * number. Default 1.0.
    */
   float clearcoat_normal_scale;
+  /**
+   * Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+   * an absorbing volume (KHR_materials_volume's thicknessFactor). A thickness must not be
+   * negative (0: thin-walled). Default 0.0.
+   */
+  float thickness;
+  /**
+   * The volume's colour after attenuation_distance of travel inside it, linear RGB
+   * (KHR_materials_volume's attenuationColor). An attenuation colour is a transmittance, in [0,
+   * 1]. Default 1.0, 1.0, 1.0.
+   */
+  float attenuation_color[3];
+  /**
+   * The distance inside the volume after which white light has the attenuation colour; the
+   * largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+   * attenuationDistance). An attenuation distance must be greater than 0 (the largest float: no
+   * absorption). Default 3.4028235e38.
+   */
+  float attenuation_distance;
 } MltMaterial;
 
 /**

@@ -507,6 +507,16 @@ struct Material {
     TextureRef clearcoat_normal_texture;
     /// Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).
     float clearcoat_normal_scale = 1.0f;
+    /// Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+    /// an absorbing volume (KHR_materials_volume's thicknessFactor).
+    float thickness = 0.0f;
+    /// The volume's colour after attenuation_distance of travel inside it, linear RGB
+    /// (KHR_materials_volume's attenuationColor).
+    std::array<float, 3> attenuation_color{1.0f, 1.0f, 1.0f};
+    /// The distance inside the volume after which white light has the attenuation colour; the
+    /// largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+    /// attenuationDistance).
+    float attenuation_distance = 3.4028235e38f;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -571,6 +581,9 @@ struct Material {
         c.clearcoat_roughness_texture = clearcoat_roughness_texture.to_c();
         c.clearcoat_normal_texture = clearcoat_normal_texture.to_c();
         c.clearcoat_normal_scale = clearcoat_normal_scale;
+        c.thickness = thickness;
+        detail::copy_to(c.attenuation_color, attenuation_color);
+        c.attenuation_distance = attenuation_distance;
         // END GENERATED material to C
         return c;
     }
@@ -601,6 +614,9 @@ struct Material {
         m.clearcoat_roughness_texture = TextureRef::from_c(c.clearcoat_roughness_texture);
         m.clearcoat_normal_texture = TextureRef::from_c(c.clearcoat_normal_texture);
         m.clearcoat_normal_scale = c.clearcoat_normal_scale;
+        m.thickness = c.thickness;
+        m.attenuation_color = detail::to_array(c.attenuation_color);
+        m.attenuation_distance = c.attenuation_distance;
         // END GENERATED material from C
         return m;
     }

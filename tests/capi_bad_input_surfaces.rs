@@ -248,6 +248,16 @@ fn scene_create_bad_surfaces() {
         h.host.materials[1].abbe_number = f32::NAN => ["desc.materials[1].abbe_number", "NaN"],
         h.host.materials[1].abbe_number = f32::INFINITY
             => ["desc.materials[1].abbe_number", "inf"],
+        h.host.materials[0].thickness = -1.0
+            => ["desc.materials[0].thickness is -1", "negative", "0: thin-walled"],
+        h.host.materials[0].attenuation_distance = 0.0
+            => ["desc.materials[0].attenuation_distance is 0", "greater than 0"],
+        h.host.materials[1].attenuation_distance = -2.0
+            => ["desc.materials[1].attenuation_distance is -2", "greater than 0"],
+        h.host.materials[0].attenuation_color = [0.5, 1.5, 0.5]
+            => ["desc.materials[0].attenuation_color", "1.5", "[0, 1]"],
+        h.host.materials[1].attenuation_color = [-0.25, 0.5, 0.5]
+            => ["desc.materials[1].attenuation_color", "-0.25", "[0, 1]"],
         h.host.materials[0].base_color_texture.texture = 3
             => ["desc.materials[0].base_color_texture.texture is 3", "3 textures"],
         h.host.materials[0].metallic_roughness_texture.texture = i32::MAX
@@ -317,6 +327,9 @@ fn scene_create_bad_surfaces() {
         h.host.materials[0].roughness => "desc.materials[0].roughness" + "finite",
         h.host.materials[1].transmission => "desc.materials[1].transmission" + "finite",
         h.host.materials[0].alpha => "desc.materials[0].alpha" + "finite",
+        h.host.materials[0].thickness => "desc.materials[0].thickness" + "finite",
+        h.host.materials[1].attenuation_distance
+            => "desc.materials[1].attenuation_distance" + "finite",
         h.host.materials[0].alpha_cutoff => "desc.materials[0].alpha_cutoff" + "finite",
         h.host.materials[0].normal_scale => "desc.materials[0].normal_scale" + "finite",
         h.host.materials[0].clearcoat => "desc.materials[0].clearcoat" + "finite",

@@ -814,7 +814,7 @@ fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
     format!(
         r#"{{
   "asset": {{ "version": "2.0" }},
-  "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_dispersion"],
+  "extensionsUsed": ["KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_dispersion", "KHR_materials_volume"],
   "scene": 0,
   "scenes": [{{ "nodes": [0, 3] }}],
   "nodes": [
@@ -835,7 +835,9 @@ fn gltf_json(buffer_uri: Option<&str>, buffer_len: usize) -> String {
     {{ "name": "glass",
        "extensions": {{ "KHR_materials_transmission": {{ "transmissionFactor": 1 }},
                         "KHR_materials_ior": {{ "ior": 1.33 }},
-                        "KHR_materials_dispersion": {{ "dispersion": 0.5 }} }} }}
+                        "KHR_materials_dispersion": {{ "dispersion": 0.5 }},
+                        "KHR_materials_volume": {{ "thicknessFactor": 0.25, "attenuationDistance": 2,
+                                                   "attenuationColor": [0.5, 0.75, 1] }} }} }}
   ],
   "buffers": [{{ {uri}"byteLength": {buffer_len} }}],
   "bufferViews": [
@@ -866,6 +868,19 @@ fn check_gltf_scene(data: &SceneData) {
     assert_eq!((glass.ior, glass.transmission), (1.33, 1.0));
     // KHR_materials_dispersion's 20 / V_d.
     assert_eq!((glass.abbe_number, lamp.abbe_number), (40.0, 0.0));
+    // KHR_materials_volume; a material without it has glTF's defaults (thin-walled, no
+    // absorption: an infinite distance is the largest float).
+    assert_eq!(glass.thickness, 0.25);
+    assert_eq!(glass.attenuation_color, [0.5, 0.75, 1.0]);
+    assert_eq!(glass.attenuation_distance, 2.0);
+    assert_eq!(
+        (
+            lamp.thickness,
+            lamp.attenuation_color,
+            lamp.attenuation_distance
+        ),
+        (0.0, [1.0; 3], f32::MAX)
+    );
     assert_eq!(glass.emission, [0.0; 3]);
     assert_eq!(data.material_ids, [lamp_id, lamp_id, glass_id, glass_id]);
 
@@ -1076,6 +1091,55 @@ fn gltf_with_negative_dispersion_is_refused() {
         error.contains("KHR_materials_dispersion") && error.contains(">= 0"),
         "{error}"
     );
+}
+
+/// Bad `KHR_materials_volume` values are refused with a message naming the value.
+#[test]
+fn gltf_with_bad_volumes_is_refused() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = gltf_json(Some(&uri), buffer.len());
+    for (good, bad, expected) in [
+        (
+            r#""thicknessFactor": 0.25"#,
+            r#""thicknessFactor": -1"#,
+            "thicknessFactor must be a number >= 0",
+        ),
+        (
+            r#""attenuationDistance": 2"#,
+            r#""attenuationDistance": 0"#,
+            "attenuationDistance must be a number > 0",
+        ),
+        (
+            r#""attenuationDistance": 2"#,
+            r#""attenuationDistance": -3"#,
+            "attenuationDistance must be a number > 0",
+        ),
+        (
+            r#""attenuationDistance": 2"#,
+            r#""attenuationDistance": "far""#,
+            "attenuationDistance must be a number > 0",
+        ),
+        (
+            r#"[0.5, 0.75, 1]"#,
+            r#"[0.5, 1.5, 1]"#,
+            "attenuationColor must be three numbers in [0, 1]",
+        ),
+        (
+            r#"[0.5, 0.75, 1]"#,
+            r#"[0.5, 0.75]"#,
+            "attenuationColor must be three numbers in [0, 1]",
+        ),
+    ] {
+        let path = temp_path("bad-volume.gltf");
+        std::fs::write(&path, json.replace(good, bad)).unwrap();
+        let error = io::load_scene(&path).unwrap_err().to_string();
+        std::fs::remove_file(&path).unwrap();
+        assert!(
+            error.contains("KHR_materials_volume") && error.contains(expected),
+            "{bad}: {error}"
+        );
+    }
 }
 
 #[test]

@@ -215,6 +215,8 @@ const MATERIAL_LIMITS: &[(&str, f64, f64)] = &[
     ("normal_scale", -2.0, 2.0),
     ("clearcoat_normal_scale", -2.0, 2.0),
     ("abbe_number", 0.0, 90.0),
+    ("thickness", 0.0, 2.0),
+    ("attenuation_distance", 0.01, 10.0),
 ];
 
 /// A texture slot: mostly none; else a texture's index, or the index past the last (refused),

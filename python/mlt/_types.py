@@ -155,6 +155,16 @@ class Material:
     clearcoat_normal_texture: Optional[TextureRef] = None
     #: Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).
     clearcoat_normal_scale: float = 1.0
+    #: Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+    #: an absorbing volume (KHR_materials_volume's thicknessFactor).
+    thickness: float = 0.0
+    #: The volume's colour after attenuation_distance of travel inside it, linear RGB
+    #: (KHR_materials_volume's attenuationColor).
+    attenuation_color: Vec3 = (1.0, 1.0, 1.0)
+    #: The distance inside the volume after which white light has the attenuation colour; the
+    #: largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+    #: attenuationDistance).
+    attenuation_distance: float = 3.4028235e38
     # END GENERATED material
 
     @classmethod

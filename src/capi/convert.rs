@@ -52,6 +52,9 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         clearcoat_roughness_texture,
         clearcoat_normal_texture,
         clearcoat_normal_scale,
+        thickness,
+        attenuation_color,
+        attenuation_distance,
         // END GENERATED material from C
     }
 }

@@ -246,6 +246,9 @@ impl From<&Material> for MltMaterial {
             clearcoat_roughness_texture,
             clearcoat_normal_texture,
             clearcoat_normal_scale,
+            thickness,
+            attenuation_color,
+            attenuation_distance,
             // END GENERATED material to C
         }
     }
@@ -526,7 +529,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 276]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 296]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, today.

@@ -6,7 +6,7 @@ use std::ffi::c_void;
 /// Major version of the mlt library this header belongs to.
 pub const MLT_VERSION_MAJOR: u32 = 0;
 /// Minor version.
-pub const MLT_VERSION_MINOR: u32 = 4;
+pub const MLT_VERSION_MINOR: u32 = 5;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
 /// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
@@ -251,6 +251,19 @@ pub struct MltMaterial {
     /// Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale). Any finite
     /// number. Default 1.0.
     pub clearcoat_normal_scale: f32,
+    /// Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses
+    /// an absorbing volume (KHR_materials_volume's thicknessFactor). A thickness must not be
+    /// negative (0: thin-walled). Default 0.0.
+    pub thickness: f32,
+    /// The volume's colour after attenuation_distance of travel inside it, linear RGB
+    /// (KHR_materials_volume's attenuationColor). An attenuation colour is a transmittance, in [0,
+    /// 1]. Default 1.0, 1.0, 1.0.
+    pub attenuation_color: [f32; 3],
+    /// The distance inside the volume after which white light has the attenuation colour; the
+    /// largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
+    /// attenuationDistance). An attenuation distance must be greater than 0 (the largest float: no
+    /// absorption). Default 3.4028235e38.
+    pub attenuation_distance: f32,
     // END GENERATED material
 }
 

@@ -111,6 +111,18 @@ impl Vertex {
         matches!(self.kind, VertexKind::Light(e) if e.at_infinity())
     }
 
+    /// The triangle the vertex lies on (a surface or an area light), which tells the
+    /// volumes of the segments that end here (`Scene::transmittance`); `None` for the lens
+    /// and lights that are not triangles.
+    #[inline]
+    fn on_triangle(&self) -> Option<u32> {
+        match self.kind {
+            VertexKind::Surface => Some(self.triangle),
+            VertexKind::Light(e) if e.is_area() => Some(self.triangle),
+            _ => None,
+        }
+    }
+
     /// The normal to offset shadow rays by (none for the lens and point lights).
     #[inline]
     fn offset_normal(&self) -> Vec3A {
@@ -289,6 +301,15 @@ impl Bdpt<'_> {
                 if mode == TransportMode::Radiance
                     && let Some(light) = self.scene.lights.infinite_emitter()
                 {
+                    if self.scene.has_media() {
+                        beta *= self.scene.transmittance(
+                            path[count - 1].on_triangle(),
+                            None,
+                            ray.direction,
+                            f32::INFINITY,
+                            channels,
+                        );
+                    }
                     path[count] = Vertex {
                         kind: VertexKind::Light(light),
                         p: ray.origin,
@@ -307,6 +328,16 @@ impl Bdpt<'_> {
             let bsdf = si.bsdf(self.scene, channels);
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
+            }
+            if self.scene.has_media() {
+                // Between the vertices: the ray's origin is moved off the surface.
+                beta *= self.scene.transmittance_between(
+                    path[count - 1].on_triangle(),
+                    Some(hit.triangle),
+                    path[count - 1].p,
+                    si.p,
+                    channels,
+                );
             }
             let mut vertex = Vertex {
                 kind: VertexKind::Surface,
@@ -757,10 +788,19 @@ impl Bdpt<'_> {
                 ..Vertex::EMPTY
             };
             // s >= 2 here, so qs is a surface vertex.
-            let contribution = qs.beta
+            let mut contribution = qs.beta
                 * sampled.beta
                 * self.f(&qs, lens, TransportMode::Importance, channels)
                 * direction.dot(qs.normal).abs();
+            if self.scene.has_media() {
+                contribution *= self.scene.transmittance(
+                    qs.on_triangle(),
+                    None,
+                    -direction,
+                    distance2.sqrt(),
+                    channels,
+                );
+            }
             if contribution.is_black() || !self.visible(&qs, &sampled, counters) {
                 return None;
             }
@@ -800,7 +840,12 @@ impl Bdpt<'_> {
             let f = self
                 .bsdf(&pt, channels)
                 .eval(pt.wo, sample.wi, TransportMode::Radiance);
-            let contribution = pt.beta * f * sampled.beta * sample.geometry(pt.normal);
+            let mut contribution = pt.beta * f * sampled.beta * sample.geometry(pt.normal);
+            if self.scene.has_media() {
+                contribution *= self
+                    .scene
+                    .light_transmittance(pt.triangle, &sample, channels);
+            }
             if contribution.is_black() {
                 return None;
             }
@@ -834,11 +879,20 @@ impl Bdpt<'_> {
             }
             let w = d / distance2.sqrt();
             let geometry = w.dot(qs.normal).abs() * w.dot(pt.normal).abs() / distance2;
-            let contribution = qs.beta
+            let mut contribution = qs.beta
                 * self.f(&qs, pt.p, TransportMode::Importance, channels)
                 * self.f(&pt, qs.p, TransportMode::Radiance, channels)
                 * pt.beta
                 * geometry;
+            if self.scene.has_media() {
+                contribution *= self.scene.transmittance(
+                    qs.on_triangle(),
+                    pt.on_triangle(),
+                    w,
+                    distance2.sqrt(),
+                    channels,
+                );
+            }
             if contribution.is_black() || !self.visible(&qs, &pt, counters) {
                 return None;
             }

@@ -57,6 +57,10 @@ impl PathTracer<'_> {
         // divides out of the throughput (as pbrt-v4 and Mitsuba do): a path inside glass
         // carries (1/η)² the throughput with no less to contribute.
         let mut radiance_scale = 1.0f32;
+        // The point the current ray leaves and its triangle (`None`: the lens), which with
+        // the one it reaches tell the volume it travels through and how far (the ray's
+        // origin is moved off the surface, so its `t` is not the distance).
+        let mut leaving: (Option<u32>, Vec3A) = (None, origin);
 
         // `depth` = scattering vertices before the surface this iteration hits.
         let mut depth = 0;
@@ -65,6 +69,15 @@ impl PathTracer<'_> {
             let Some(hit) = scene.closest_hit(&ray) else {
                 // The ray left the scene: the environment and the sun's disc.
                 if depth >= self.min_depth && scene.lights.has_infinite_light() {
+                    if scene.has_media() {
+                        throughput *= scene.transmittance(
+                            leaving.0,
+                            None,
+                            ray.direction,
+                            f32::INFINITY,
+                            &channels,
+                        );
+                    }
                     let emission = scene.lights.infinite_radiance(ray.direction, &channels);
                     let weight = if previous_specular {
                         1.0
@@ -79,6 +92,15 @@ impl PathTracer<'_> {
             let bsdf = si.bsdf(scene, &channels);
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
+            }
+            if scene.has_media() {
+                throughput *= scene.transmittance_between(
+                    leaving.0,
+                    Some(hit.triangle),
+                    leaving.1,
+                    si.p,
+                    &channels,
+                );
             }
             let normal = si.geometric_normal;
             let wo = -ray.direction;
@@ -117,7 +139,7 @@ impl PathTracer<'_> {
             // Only a lobe with a density (diffuse, glossy) can meet a light sample.
             if bsdf.lobes().has_non_specular() && depth + 1 >= self.min_depth {
                 radiance +=
-                    throughput * self.sample_light(p, normal, wo, &bsdf, u_light, &channels, rays);
+                    throughput * self.sample_light(&si, wo, &bsdf, u_light, &channels, rays);
             }
 
             let Some(sample) = bsdf.sample(wo, u_bsdf, u_lobe, TransportMode::Radiance) else {
@@ -141,6 +163,7 @@ impl PathTracer<'_> {
                 break;
             }
             ray = spawn_ray(scene, p, normal, sample.wi);
+            leaving = (Some(si.triangle), p);
         }
         channels.rgb_of(radiance)
     }
@@ -154,8 +177,7 @@ impl PathTracer<'_> {
     #[allow(clippy::too_many_arguments)]
     fn sample_light(
         &self,
-        p: Vec3A,
-        normal: Vec3A,
+        si: &SurfaceInteraction,
         wo: Vec3A,
         bsdf: &Bsdf,
         [u_select, u_point @ ..]: [f32; 3],
@@ -163,6 +185,7 @@ impl PathTracer<'_> {
         rays: &mut u64,
     ) -> Spectrum {
         let scene = self.scene;
+        let (p, normal) = (si.p, si.geometric_normal);
         let Some(light) = scene.sample_li(p, u_select, u_point, channels) else {
             return Spectrum::ZERO;
         };
@@ -185,7 +208,11 @@ impl PathTracer<'_> {
         } else {
             power_heuristic(light_pdf, bsdf.pdf(wo, wi))
         };
-        f * light.radiance * (wi.dot(normal).abs() * weight / light_pdf)
+        let mut arriving = f * light.radiance;
+        if scene.has_media() {
+            arriving *= scene.light_transmittance(si.triangle, &light, channels);
+        }
+        arriving * (wi.dot(normal).abs() * weight / light_pdf)
     }
 }
 

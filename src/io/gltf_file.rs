@@ -24,7 +24,12 @@ const MAX_NODE_DEPTH: usize = 1024;
 /// Extensions the gltf crate does not know that this loader reads from the materials' JSON
 /// itself: a file that requires them is accepted (the crate refuses required extensions
 /// it does not know).
-const EXTENSIONS_READ_HERE: &[&str] = &["KHR_materials_clearcoat"];
+const EXTENSIONS_READ_HERE: &[&str] = &[
+    "KHR_materials_clearcoat",
+    "KHR_materials_dispersion",
+    "KHR_materials_unlit",
+    "KHR_materials_volume",
+];
 
 pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     let fail =
@@ -796,6 +801,9 @@ impl Loader<'_> {
         if let Some(extension) = material.extension_value("KHR_materials_clearcoat") {
             self.clearcoat(material, extension, &mut converted)?;
         }
+        if let Some(extension) = material.extension_value("KHR_materials_volume") {
+            self.read_volume(material, extension, &mut converted)?;
+        }
         // KHR_materials_unlit (not parsed by the gltf crate): the base colour (times its
         // texture) is emitted as radiance and nothing is scattered, so the surface looks its
         // colour to every path and is one consistent light in every algorithm. The base
@@ -947,6 +955,58 @@ impl Loader<'_> {
             reference.scale = [scale[0], scale[1]];
         }
         Ok(reference)
+    }
+    /// `KHR_materials_volume` (read here, not by the gltf crate, to check its values):
+    /// `thicknessFactor` (>= 0; 0 is thin-walled), `attenuationColor` (RGB in [0, 1]) and
+    /// `attenuationDistance` (> 0; absent: infinity, no absorption). The thickness texture
+    /// is not read: a path tracer measures the distances through the mesh itself, and the
+    /// factor alone tells a thin wall from a volume.
+    fn read_volume(
+        &self,
+        material: &::gltf::Material,
+        extension: &::gltf::json::Value,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let fail = |what: &str| {
+            self.fail(format!(
+                "material {}: KHR_materials_volume's {what}",
+                material
+                    .index()
+                    .map_or("(default)".into(), |i| i.to_string())
+            ))
+        };
+        let number = |key: &str| {
+            extension
+                .get(key)
+                .map(|v| v.as_f64().filter(|x| x.is_finite()))
+        };
+        converted.thickness = match number("thicknessFactor") {
+            None => 0.0,
+            Some(Some(t)) if t >= 0.0 => t.min(f32::MAX as f64) as f32,
+            Some(_) => return Err(fail("thicknessFactor must be a number >= 0")),
+        };
+        converted.attenuation_distance = match number("attenuationDistance") {
+            None => f32::MAX,
+            Some(Some(d)) if d > 0.0 => d.min(f32::MAX as f64) as f32,
+            Some(_) => return Err(fail("attenuationDistance must be a number > 0")),
+        };
+        if let Some(color) = extension.get("attenuationColor") {
+            let rgb: Option<Vec<f64>> = color.as_array().and_then(|values| {
+                values
+                    .iter()
+                    .map(|v| v.as_f64().filter(|c| (0.0..=1.0).contains(c)))
+                    .collect()
+            });
+            match rgb.as_deref() {
+                Some(&[r, g, b]) => {
+                    converted.attenuation_color = [r as f32, g as f32, b as f32];
+                }
+                _ => {
+                    return Err(fail("attenuationColor must be three numbers in [0, 1]"));
+                }
+            }
+        }
+        Ok(())
     }
 }
 

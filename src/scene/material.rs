@@ -180,6 +180,32 @@ declare_parameters! {
         clearcoat_normal_scale: f32 = 1.0 => {
             doc: "Scales the clear coat's normal map's x and y (clearcoatNormalTexture.scale).",
         },
+        /// The volume behind the surface (`KHR_materials_volume`), for a dielectric and a
+        /// metallic-roughness material with transmission, on closed meshes: 0 is a thin wall
+        /// (no volume, no absorption); otherwise the light travelling inside is absorbed by
+        /// Beer–Lambert's law (see `attenuation_color`). The thickness is not used as a
+        /// length: a path tracer measures the real distances through the mesh.
+        thickness: f32 = 0.0 => {
+            doc: "Dielectric and transmissive metallic-roughness: 0 is thin-walled, above 0 the mesh encloses an absorbing volume (KHR_materials_volume's thicknessFactor).",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "a thickness must not be negative (0: thin-walled)".into(),
+        },
+        /// The colour white light becomes after travelling `attenuation_distance` inside the
+        /// volume: the absorption coefficient is −ln(colour) / distance per channel (per
+        /// wavelength in spectral renders, the colour upsampled as a reflectance).
+        attenuation_color: [f32; 3] = [1.0; 3] => {
+            doc: "The volume's colour after attenuation_distance of travel inside it, linear RGB (KHR_materials_volume's attenuationColor).",
+            range: Range::UNIT,
+            rule: |_| "an attenuation colour is a transmittance, in [0, 1]".into(),
+        },
+        /// The distance at which the light inside has the attenuation colour; the largest
+        /// float (`f32::MAX`, C's `FLT_MAX`) stands for glTF's default, infinity: no
+        /// absorption.
+        attenuation_distance: f32 = f32::MAX => {
+            doc: "The distance inside the volume after which white light has the attenuation colour; the largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's attenuationDistance).",
+            range: Range::above(0.0, f32::MAX as f64),
+            rule: |_| "an attenuation distance must be greater than 0 (the largest float: no absorption)".into(),
+        },
     }
 }
 

@@ -4,6 +4,7 @@ mod camera;
 mod light_desc;
 pub(crate) mod lights;
 mod material;
+pub(crate) mod medium;
 pub(crate) mod surface;
 mod tangents;
 
@@ -144,6 +145,10 @@ pub struct Scene {
     attributes: surface::SurfaceAttributes,
     textures: Vec<Texture>,
     pub(crate) materials: Vec<Material>,
+    /// Each material's absorbing volume, if it has one (see `medium`).
+    media: Vec<Option<medium::Medium>>,
+    /// Whether some material has a volume: else `transmittance` is 1 without a look.
+    has_media: bool,
     /// Each material's constant colour and emission with their spectral fits.
     material_colours: Vec<surface::MaterialColours>,
     /// Every light, in selection order: area lights (in the host's triangle order), punctual
@@ -389,9 +394,14 @@ impl Scene {
             accel_memory_bytes: accel.memory_bytes(),
             accel_build_seconds,
         };
+        let media: Vec<Option<medium::Medium>> =
+            desc.materials.iter().map(medium::Medium::of).collect();
+        let has_media = media.iter().any(Option::is_some);
         Ok(Scene {
             accel,
             shading,
+            media,
+            has_media,
             has_cutouts,
             slow_queries: has_cutouts,
             recording: None,
@@ -433,6 +443,109 @@ impl Scene {
         let normal = self.shading[triangle as usize].normal;
         self.surface_point(triangle, barycentrics)
             .bsdf(normal, channels)
+    }
+
+    /// The fraction of light that travels a path segment without being absorbed: the
+    /// transmittance of the volume the segment runs through (see `medium`: a segment is
+    /// inside the volume of a triangle whose back side it leaves or reaches), 1 outside
+    /// every volume. `from` and `to` are the internal triangles the segment's ends lie on
+    /// (`None`: the lens, a light that is not a triangle, a direction at infinity),
+    /// `direction` the unit direction from `from` to `to`, `distance` its length (infinite
+    /// towards or from a light at infinity, or for a ray that escapes). Symmetric: the
+    /// segment read from `to` to `from` has the same transmittance, as path-space
+    /// mutations need. The integrators' hot loops ask `has_media` first, so that a scene
+    /// without a volume costs them one branch per segment.
+    #[inline(always)]
+    pub(crate) fn transmittance(
+        &self,
+        from: Option<u32>,
+        to: Option<u32>,
+        direction: Vec3A,
+        distance: f32,
+        channels: &Channels,
+    ) -> Spectrum {
+        if !self.has_media {
+            return Spectrum::ONE;
+        }
+        self.medium_transmittance(from, to, direction, distance, channels)
+    }
+
+    /// `transmittance` of the segment from point `a` on `from` to point `b` on `to`.
+    #[inline(always)]
+    pub(crate) fn transmittance_between(
+        &self,
+        from: Option<u32>,
+        to: Option<u32>,
+        a: Vec3A,
+        b: Vec3A,
+        channels: &Channels,
+    ) -> Spectrum {
+        if !self.has_media {
+            return Spectrum::ONE;
+        }
+        let d = b - a;
+        let distance = d.length();
+        if distance == 0.0 {
+            return Spectrum::ONE;
+        }
+        self.medium_transmittance(from, to, d / distance, distance, channels)
+    }
+
+    /// `transmittance` in a scene with volumes.
+    #[inline(never)]
+    fn medium_transmittance(
+        &self,
+        from: Option<u32>,
+        to: Option<u32>,
+        direction: Vec3A,
+        distance: f32,
+        channels: &Channels,
+    ) -> Spectrum {
+        // The material whose volume lies behind `triangle` on the side `outward` points to.
+        let behind = |triangle: Option<u32>, outward: Vec3A| {
+            let shading = &self.shading[triangle? as usize];
+            let material = shading.material as usize;
+            (self.media[material].is_some() && outward.dot(shading.normal) < 0.0)
+                .then_some(material)
+        };
+        let material = match (behind(from, direction), behind(to, -direction)) {
+            (Some(a), Some(b)) => a.min(b),
+            (a, b) => match a.or(b) {
+                Some(m) => m,
+                None => return Spectrum::ONE,
+            },
+        };
+        match &self.media[material] {
+            Some(medium) => medium.transmittance(distance, channels),
+            None => Spectrum::ONE,
+        }
+    }
+
+    /// `transmittance` of the shadow segment from a point on internal triangle `triangle`
+    /// to the light vertex `light` sampled from it.
+    #[inline(always)]
+    pub(crate) fn light_transmittance(
+        &self,
+        triangle: u32,
+        light: &lights::LightLiSample,
+        channels: &Channels,
+    ) -> Spectrum {
+        if !self.has_media {
+            return Spectrum::ONE;
+        }
+        let (to, distance) = if light.light.at_infinity() {
+            (None, f32::INFINITY)
+        } else {
+            let to = light.light.is_area().then_some(light.triangle);
+            (to, light.distance2.sqrt())
+        };
+        self.medium_transmittance(Some(triangle), to, light.wi, distance, channels)
+    }
+
+    /// Whether some material encloses an absorbing volume (see `transmittance`).
+    #[inline]
+    pub(crate) fn has_media(&self) -> bool {
+        self.has_media
     }
 
     /// Whether internal triangle `triangle`'s material disperses light in `channels` (see

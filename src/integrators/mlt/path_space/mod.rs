@@ -276,6 +276,34 @@ impl PathSpace<'_> {
         !self.scene.blocked(&ray)
     }
 
+    /// What the volumes the path's edges run through let pass (`Scene::transmittance`):
+    /// a factor of its measurement contribution that no strategy samples, so every C_s has
+    /// it whole.
+    #[inline]
+    fn transmittance(&self, path: &[PathVertex]) -> Option<Spectrum> {
+        if !self.scene.has_media() {
+            return Some(Spectrum::ONE);
+        }
+        let n = path.len();
+        // The lens (last) and lights that are not triangles lie on no surface.
+        let on_triangle = |k: usize| {
+            let v = &path[k];
+            (k + 1 < n && v.light.is_none()).then_some(v.triangle)
+        };
+        let mut transmittance = Spectrum::ONE;
+        for k in 0..n.saturating_sub(1) {
+            let (w, distance2) = direction(&path[k], &path[k + 1])?;
+            transmittance *= self.scene.transmittance(
+                on_triangle(k),
+                on_triangle(k + 1),
+                w,
+                distance2.sqrt(),
+                &self.channels,
+            );
+        }
+        Some(transmittance)
+    }
+
     /// The pixel the path's last edge (from the lens) lands in.
     #[inline]
     pub fn pixel(&self, path: &[PathVertex]) -> Option<u32> {
@@ -440,7 +468,9 @@ impl PathSpace<'_> {
                 * self.bsdf(&path[s + 1], pt, qs, TransportMode::Radiance)?
                 * beta_eye
         };
-        let value = self.channels_of(path).rgb_of(value);
+        let value = self
+            .channels_of(path)
+            .rgb_of(value * self.transmittance(path)?);
         (value.max_component() > 0.0 && value.is_finite()).then_some((value, pixel))
     }
 }
@@ -1289,5 +1319,45 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The glass of cornell-glass filled with an absorbing volume: the contribution path
+    /// space evaluates, with the absorption along every edge, is BDPT's for every strategy.
+    /// (Rough glass is left to the image tests, tests/volume.rs: without a volume its two
+    /// evaluations already differ by up to 1.3% in rare paths, channel for channel alike,
+    /// which this test's 0.2% would not let pass.)
+    #[test]
+    fn unweighted_contributions_match_bdpt_through_an_absorbing_volume() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes");
+        let data = crate::io::load_scene(&dir.join("cornell-glass.obj")).unwrap();
+        let camera = crate::io::load_camera_json(&dir.join("cornell-glass.camera.json"))
+            .unwrap()
+            .camera;
+        let materials: Vec<_> = data
+            .materials
+            .iter()
+            .map(|m| match m.kind {
+                crate::scene::MaterialKind::Dielectric => crate::scene::Material {
+                    thickness: 1.0,
+                    attenuation_color: [0.3, 0.6, 0.9],
+                    attenuation_distance: 100.0,
+                    ..*m
+                },
+                _ => *m,
+            })
+            .collect();
+        let scene = Scene::new(&SceneDesc {
+            positions: &data.positions,
+            indices: &data.indices,
+            material_ids: &data.material_ids,
+            materials: &materials,
+            backend: Backend::Bvh,
+            ..Default::default()
+        })
+        .unwrap();
+        assert!(scene.has_media());
+        let compared = compare_with_bdpt("absorbing glass", &scene, &camera, 5, 10_000);
+        let through: u32 = compared.values().map(|c| c.1).sum();
+        assert!(through > 1000, "{through} paths through the glass");
     }
 }
