@@ -445,7 +445,10 @@ impl Loader<'_> {
             }
         }
 
-        let material = match self.variant_materials.get(&(mesh.index(), primitive.index())) {
+        let material = match self
+            .variant_materials
+            .get(&(mesh.index(), primitive.index()))
+        {
             Some(&index) => self.material(&self.materials[index].clone())?,
             None => self.material(&primitive.material())?,
         };
