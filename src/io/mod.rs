@@ -87,7 +87,8 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   MikkTSpace computes them); a primitive without normals in a scene that has some is
 ///   flat-shaded.
 ///   Primitives without a material get the glTF default material (white, metallic 1,
-///   roughness 1). Occlusion textures are ignored.
+///   roughness 1). `KHR_materials_variants`: the primitives' default materials here; see
+///   [`load_scene_variant`] to pick a variant. Occlusion textures are ignored.
 ///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into
 ///   [`SceneData::punctual_lights`]: at their node's world origin, pointing along its world
 ///   −Z, with `color × intensity / 683` (candela and lux over 683 lm/W, Blender's factor:
