@@ -1523,6 +1523,10 @@ fn gltf_bad_material_variants_are_errors() {
             "names variant -1",
         ),
         (r#"[{ "variants": [0] }]"#, "has no material index"),
+        (
+            r#"[{ "material": 1, "variants": [0] }, { "material": 2, "variants": [1, 0] }]"#,
+            "mapping 1 of the KHR_materials_variants of primitive 0 of mesh 0 names variant 0, which an earlier mapping names",
+        ),
     ] {
         let path = variants_gltf(mappings);
         for variant in [None, Some("red")] {

@@ -841,8 +841,8 @@ impl Loader<'_> {
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1), for 16-bit colour images.
 /// Reads `KHR_materials_variants`: the variant names at the root and every primitive's
-/// mappings, checked whether a variant is chosen or not. Returns, for the variant named
-/// `variant`, the material of each primitive that maps one to it (empty without a variant).
+/// mappings, checked whether a variant is chosen or not. Returns, for the (first) variant
+/// named `variant`, the material of each primitive that maps one to it (empty without a variant).
 fn variant_materials(
     document: &::gltf::Document,
     variant: Option<&str>,
@@ -897,6 +897,8 @@ fn variant_materials(
                 .get("mappings")
                 .and_then(|m| m.as_array())
                 .ok_or_else(|| format!("the {what} has no mappings array"))?;
+            // The specification lets each variant appear in one mapping of a primitive.
+            let mut mapped = vec![false; names.len()];
             for (m, mapping) in mappings.iter().enumerate() {
                 let material = mapping
                     .get("material")
@@ -920,8 +922,13 @@ fn variant_materials(
                                 "mapping {m} of the {what} names variant {index}, but there are {} variants",
                                 names.len()
                             )
-                        })?;
-                    if chosen == Some(index as usize) {
+                        })? as usize;
+                    if std::mem::replace(&mut mapped[index], true) {
+                        return Err(format!(
+                            "mapping {m} of the {what} names variant {index}, which an earlier mapping names"
+                        ));
+                    }
+                    if chosen == Some(index) {
                         chosen_materials
                             .insert((mesh.index(), primitive.index()), material as usize);
                     }

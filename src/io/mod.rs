@@ -104,8 +104,9 @@ pub fn load_scene(path: &Path) -> Result<SceneData, IoError> {
 /// material; `Some(name)` gives each primitive the material its mapping names for the variant
 /// `name` (its default where it maps none). A name the file does not define is an error that
 /// lists the file's variants, and so is a name given for a file without variants (OBJ files
-/// have none). Every mapping is checked either way: one naming a material or a variant the
-/// file does not have is an error.
+/// have none); of several variants of one name, the first is taken. Every mapping is
+/// checked either way: one naming a material or a variant the file does not have, or a
+/// variant an earlier mapping of the primitive names, is an error.
 pub fn load_scene_variant(path: &Path, variant: Option<&str>) -> Result<SceneData, IoError> {
     let extension = path
         .extension()
