@@ -606,6 +606,11 @@ fn bad_input_is_a_one_line_error_naming_it() {
         ("{dir}/malformed.obj", &["malformed.obj", "line 5"]),
         ("{cornell} --camera {dir}/camera.json", &["fov"]),
         ("{cornell} --out x.bmp", &["x.bmp"]),
+        (
+            "{cornell} --variant red",
+            &["only glTF files have material variants", "\"red\""],
+        ),
+        ("{sky} --variant red", &["no material variants", "\"red\""]),
         // Settings the kernel refuses (its message comes through), and clap's own errors.
         ("{cornell} --width 0", &["width"]),
         ("{cornell} --spp many", &["--spp"]),
@@ -680,6 +685,7 @@ fn bad_input_is_a_one_line_error_naming_it() {
     let substitute = |text: &str| {
         text.replace("{cornell}", &scene("cornell-box.obj").to_string_lossy())
             .replace("{glass}", &scene("cornell-glass.obj").to_string_lossy())
+            .replace("{sky}", &scene("sky-spheres.gltf").to_string_lossy())
             .replace("{ground}", &ground.to_string_lossy())
             .replace("{dir}", &dir.to_string_lossy())
     };

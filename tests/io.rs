@@ -1580,3 +1580,142 @@ Pm 1
     assert_eq!((pbr.roughness, pbr.metallic), (0.3, 1.0));
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
+
+/// A mesh of two quads, primitive 0 and 1, both "plain" by default, with the
+/// `KHR_materials_variants` variants "red" and "blue": "red" makes primitive 0 red and
+/// primitive 1 blue; "blue" makes primitive 0 blue and leaves primitive 1 plain.
+/// `mappings_0` is primitive 0's mappings array.
+fn variants_gltf(mappings_0: &str) -> PathBuf {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = format!(
+        r#"{{
+  "asset": {{ "version": "2.0" }},
+  "extensionsUsed": ["KHR_materials_variants"],
+  "extensions": {{ "KHR_materials_variants": {{ "variants": [{{ "name": "red" }}, {{ "name": "blue" }}] }} }},
+  "scenes": [{{ "nodes": [0] }}],
+  "nodes": [{{ "mesh": 0 }}],
+  "meshes": [{{ "primitives": [
+    {{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0,
+       "extensions": {{ "KHR_materials_variants": {{ "mappings": {mappings_0} }} }} }},
+    {{ "attributes": {{ "POSITION": 0 }}, "indices": 1, "material": 0,
+       "extensions": {{ "KHR_materials_variants": {{ "mappings": [{{ "material": 2, "variants": [0] }}] }} }} }}
+  ] }}],
+  "materials": [
+    {{ "name": "plain" }},
+    {{ "name": "red", "pbrMetallicRoughness": {{ "baseColorFactor": [1, 0, 0, 1] }} }},
+    {{ "name": "blue", "pbrMetallicRoughness": {{ "baseColorFactor": [0, 0, 1, 1] }} }}
+  ],
+  "buffers": [{{ "uri": "{uri}", "byteLength": {len} }}],
+  "bufferViews": [
+    {{ "buffer": 0, "byteOffset": 0, "byteLength": 48 }},
+    {{ "buffer": 0, "byteOffset": 48, "byteLength": 12 }}
+  ],
+  "accessors": [
+    {{ "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+       "min": [0, -1, -1], "max": [0, 1, 1] }},
+    {{ "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" }}
+  ]
+}}"#,
+        len = buffer.len()
+    );
+    let path = temp_path("variants.gltf");
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+const VARIANT_MAPPINGS: &str =
+    r#"[{ "material": 1, "variants": [0] }, { "material": 2, "variants": [1] }]"#;
+
+/// The material names of the triangles of primitive 0 and of primitive 1.
+fn primitive_materials(data: &SceneData) -> [&str; 2] {
+    let name = |triangle: usize| data.material_names[data.material_ids[triangle] as usize].as_str();
+    assert_eq!(data.triangle_count(), 4);
+    assert_eq!(name(0), name(1));
+    assert_eq!(name(2), name(3));
+    [name(0), name(2)]
+}
+
+/// `KHR_materials_variants`: without a variant every primitive keeps its default material;
+/// a variant gives each primitive the material its mapping names for it, and the default
+/// where it maps none.
+#[test]
+fn gltf_material_variants_pick_each_primitives_material() {
+    let path = variants_gltf(VARIANT_MAPPINGS);
+    let default = io::load_scene(&path).unwrap();
+    assert_eq!(primitive_materials(&default), ["plain", "plain"]);
+    assert_eq!(default.material_names, ["plain"]);
+    let red = io::load_scene_variant(&path, Some("red")).unwrap();
+    assert_eq!(primitive_materials(&red), ["red", "blue"]);
+    assert_eq!(material_named(&red, "red").1.color, [1.0, 0.0, 0.0]);
+    assert_eq!(material_named(&red, "blue").1.color, [0.0, 0.0, 1.0]);
+    let blue = io::load_scene_variant(&path, Some("blue")).unwrap();
+    assert_eq!(primitive_materials(&blue), ["blue", "plain"]);
+    Scene::new(&blue.desc(mlt::Backend::Bvh)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+}
+
+/// A variant the file does not define is an error listing the ones it does; so is a variant
+/// asked of a file without variants (glTF or OBJ); a mapping naming a material or a variant
+/// the file lacks is an error whether a variant is chosen or not.
+#[test]
+fn gltf_bad_material_variants_are_errors() {
+    let path = variants_gltf(VARIANT_MAPPINGS);
+    let error = io::load_scene_variant(&path, Some("green"))
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_file(&path).unwrap();
+    assert!(
+        error.contains(r#""green""#) && error.contains(r#""red", "blue""#),
+        "{error}"
+    );
+
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let path = temp_path("no-variants.gltf");
+    std::fs::write(&path, gltf_json(Some(&uri), buffer.len())).unwrap();
+    let error = io::load_scene_variant(&path, Some("red"))
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_file(&path).unwrap();
+    assert!(error.contains("no material variants"), "{error}");
+    let error = io::load_scene_variant(&scenes().join("door-ajar.obj"), Some("red"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("only glTF files have material variants"),
+        "{error}"
+    );
+
+    for (mappings, expected) in [
+        (
+            r#"[{ "material": 7, "variants": [0] }]"#,
+            "names material 7, but there are 3 materials",
+        ),
+        (
+            r#"[{ "material": 1, "variants": [2] }]"#,
+            "names variant 2, but there are 2 variants",
+        ),
+        (
+            r#"[{ "material": 1, "variants": [-1] }]"#,
+            "names variant -1",
+        ),
+        (r#"[{ "variants": [0] }]"#, "has no material index"),
+        (
+            r#"[{ "material": 1, "variants": [0] }, { "material": 2, "variants": [1, 0] }]"#,
+            "mapping 1 of the KHR_materials_variants of primitive 0 of mesh 0 names variant 0, which an earlier mapping names",
+        ),
+    ] {
+        let path = variants_gltf(mappings);
+        for variant in [None, Some("red")] {
+            let error = io::load_scene_variant(&path, variant)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                error.contains(expected) && error.contains("primitive 0 of mesh 0"),
+                "{error}"
+            );
+        }
+        std::fs::remove_file(&path).unwrap();
+    }
+}

@@ -94,6 +94,7 @@ class Scene:
         abbe_number: Optional[float] = None,
         backend: _Backend = "bvh",
         build_quality: _BuildQuality = "high",
+        variant: Optional[str] = None,
     ) -> Tuple[Scene, Optional[Camera]]: ...
     @property
     def info(self) -> SceneInfo: ...

@@ -63,6 +63,7 @@ class SceneFile:
     abbe_number: Optional[float] = None
     backend: str = "bvh"
     build_quality: str = "high"
+    variant: Optional[str] = None
 
     def __call__(self) -> _mlt.Scene:
         scene, _camera = _mlt.Scene.load(
@@ -74,6 +75,7 @@ class SceneFile:
             abbe_number=self.abbe_number,
             backend=self.backend,  # type: ignore[arg-type]
             build_quality=self.build_quality,  # type: ignore[arg-type]
+            variant=self.variant,
         )
         return scene
 

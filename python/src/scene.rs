@@ -191,12 +191,13 @@ impl Scene {
     /// `mlt-render` does). environment, sun and lights add lights as in `from_arrays` (a
     /// glTF's own punctual lights are kept); energy_compensation sets every material's
     /// (`--energy-compensation`); abbe_number gives every transmissive material without a
-    /// dispersion this Abbe number (`--abbe-number`).
+    /// dispersion this Abbe number (`--abbe-number`); variant picks a glTF file's material
+    /// variant by name (`KHR_materials_variants`, `--variant`; None: the default materials).
     ///
     /// Raises FileNotFoundError for a missing file and `LoadError` for one that cannot be
-    /// read.
+    /// read, or for a variant the file does not have (the message lists its variants).
     #[staticmethod]
-    #[pyo3(signature = (path, *, environment=None, sun=None, lights=None, energy_compensation=false, abbe_number=None, backend="bvh", build_quality="high"))]
+    #[pyo3(signature = (path, *, environment=None, sun=None, lights=None, energy_compensation=false, abbe_number=None, backend="bvh", build_quality="high", variant=None))]
     #[allow(clippy::too_many_arguments)]
     fn load<'py>(
         py: Python<'py>,
@@ -208,6 +209,7 @@ impl Scene {
         abbe_number: Option<f32>,
         backend: &str,
         build_quality: &str,
+        variant: Option<String>,
     ) -> PyResult<(Scene, Option<Bound<'py, PyAny>>)> {
         let backend = convert::backend(py, backend)?;
         let build_quality = convert::build_quality(py, build_quality)?;
@@ -220,7 +222,7 @@ impl Scene {
         }
         let mut lights = OwnedLights::extract(environment, sun, lights)?;
         let mut data = py
-            .detach(|| mlt::io::load_scene(&path))
+            .detach(|| mlt::io::load_scene_variant(&path, variant.as_deref()))
             .map_err(|e| errors::load_error(py, &e.message))?;
         data.override_materials(energy_compensation, abbe_number);
         // The file's punctual lights first, so their indices in errors are the file's.

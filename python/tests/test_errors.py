@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import base64
+import json
+import pathlib
 import pickle
 import re
 
@@ -149,6 +152,66 @@ def test_embree_without_the_feature_is_unsupported() -> None:
         build(backend="embree")
     assert caught.value.status == "unsupported" and caught.value.code == 2
     assert not isinstance(caught.value, ValueError)
+
+
+def variants_gltf(path: pathlib.Path, mappings: list[dict[str, object]]) -> pathlib.Path:
+    """A quad whose default material is plain and whose variant "lit" makes it emit; the
+    file's variants are "lit" and "plain"; `mappings` is the quad's mapping list."""
+    positions = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], "<f4")
+    indices = np.array([0, 1, 2, 0, 2, 3], "<u2")
+    buffer = positions.tobytes() + indices.tobytes()
+    document = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_materials_variants"],
+        "extensions": {"KHR_materials_variants": {"variants": [{"name": "lit"}, {"name": "plain"}]}},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [
+            {
+                "primitives": [
+                    {
+                        "attributes": {"POSITION": 0},
+                        "indices": 1,
+                        "material": 0,
+                        "extensions": {"KHR_materials_variants": {"mappings": mappings}},
+                    }
+                ]
+            }
+        ],
+        "materials": [{"name": "plain"}, {"name": "lamp", "emissiveFactor": [1, 1, 1]}],
+        "buffers": [
+            {
+                "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode(),
+                "byteLength": len(buffer),
+            }
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
+    path.write_text(json.dumps(document))
+    return path
+
+
+def test_material_variants_are_picked_by_name(tmp_path: pathlib.Path) -> None:
+    path = variants_gltf(tmp_path / "variants.gltf", [{"material": 1, "variants": [0]}])
+    assert mlt.Scene.load(path)[0].info.emitter_count == 0
+    assert mlt.Scene.load(path, variant="plain")[0].info.emitter_count == 0
+    assert mlt.Scene.load(path, variant="lit")[0].info.emitter_count == 2
+    with pytest.raises(mlt.LoadError, match=re.escape('no material variant "dim"; its variants are "lit", "plain"')):
+        mlt.Scene.load(path, variant="dim")
+    with pytest.raises(mlt.LoadError, match="only glTF files have material variants"):
+        mlt.Scene.load(SCENES / "cornell-box.obj", variant="lit")
+    with pytest.raises(mlt.LoadError, match="no material variants"):
+        mlt.Scene.load(SCENES / "sky-spheres.gltf", variant="lit")
+    path = variants_gltf(tmp_path / "bad.gltf", [{"material": 1, "variants": [2]}])
+    with pytest.raises(mlt.LoadError, match="names variant 2, but there are 2 variants"):
+        mlt.Scene.load(path)
 
 
 def test_loading_errors(tmp_path: object) -> None:

@@ -294,6 +294,10 @@ struct Args {
     /// Camera JSON (eye, target, up, fov_y_deg, width, height); overrides the scene's camera.
     #[arg(long, value_name = "FILE.json")]
     camera: Option<PathBuf>,
+    /// glTF: render the material variant of this name (KHR_materials_variants) instead of
+    /// the default materials.
+    #[arg(long, value_name = "NAME")]
+    variant: Option<String>,
     #[command(flatten)]
     settings: SettingsArgs,
     /// Compensate rough metals (glTF metallic-roughness) for the light that bounces between
@@ -396,7 +400,8 @@ fn run(args: &Args) -> Result<(), String> {
     check_output_directory(&args.out)?;
 
     let load_start = Instant::now();
-    let mut data = mlt::io::load_scene(&args.scene).map_err(|e| e.to_string())?;
+    let mut data = mlt::io::load_scene_variant(&args.scene, args.variant.as_deref())
+        .map_err(|e| e.to_string())?;
     data.override_materials(args.energy_compensation, args.abbe_number);
     for material in &mut data.materials {
         for &(name, value) in &args.material {

@@ -28,10 +28,13 @@ const EXTENSIONS_READ_HERE: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_dispersion",
     "KHR_materials_unlit",
+    "KHR_materials_variants",
     "KHR_materials_volume",
 ];
 
-pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
+/// Loads `path`, with each primitive's default material or, given `variant`, the material its
+/// `KHR_materials_variants` mapping gives that variant (the default where it maps none).
+pub(super) fn load_gltf(path: &Path, variant: Option<&str>) -> Result<SceneData, IoError> {
     let fail =
         |what: String| IoError::new(format!("cannot load glTF file {}: {what}", path.display()));
     let bytes = std::fs::read(path)
@@ -121,6 +124,8 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         .or_else(|| document.scenes().next())
         .ok_or_else(|| fail("it defines no scene".into()))?;
 
+    let variant_materials = variant_materials(&document, variant).map_err(fail)?;
+
     let images = if document.textures().next().is_some() {
         ::gltf::import_images(&document, Some(base), &buffers)
             .map_err(|e| fail(format!("cannot load its images: {e}")))?
@@ -153,6 +158,8 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
         material_map: HashMap::new(),
         texture_map: HashMap::new(),
         textures: document.textures().collect(),
+        variant_materials,
+        materials: document.materials().collect(),
     };
     for node in scene.nodes() {
         loader.visit(&node, Mat4::IDENTITY, &mut Vec::new())?;
@@ -185,6 +192,10 @@ struct Loader<'a> {
     texture_map: HashMap<(usize, bool), u32>,
     /// The file's textures, for the extensions read from JSON, which name them by index.
     textures: Vec<::gltf::texture::Texture<'a>>,
+    /// (mesh index, primitive index) → the glTF material the chosen variant gives it.
+    variant_materials: HashMap<(usize, usize), usize>,
+    /// The file's materials, by glTF index.
+    materials: Vec<::gltf::Material<'a>>,
 }
 
 impl Loader<'_> {
@@ -451,7 +462,13 @@ impl Loader<'_> {
             }
         }
 
-        let material = self.material(&primitive.material())?;
+        let material = match self
+            .variant_materials
+            .get(&(mesh.index(), primitive.index()))
+        {
+            Some(&index) => self.material(&self.materials[index].clone())?,
+            None => self.material(&primitive.material())?,
+        };
         let attribute = |what_attribute: &str| {
             self.fail(format!(
                 "the {what_attribute} data of {what} lies outside its buffer or has the wrong length"
@@ -1011,6 +1028,105 @@ impl Loader<'_> {
 }
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1), for 16-bit colour images.
+/// Reads `KHR_materials_variants`: the variant names at the root and every primitive's
+/// mappings, checked whether a variant is chosen or not. Returns, for the (first) variant
+/// named `variant`, the material of each primitive that maps one to it (empty without a variant).
+fn variant_materials(
+    document: &::gltf::Document,
+    variant: Option<&str>,
+) -> Result<HashMap<(usize, usize), usize>, String> {
+    const EXTENSION: &str = "KHR_materials_variants";
+    let names: Vec<&str> = match document.extension_value(EXTENSION) {
+        None => Vec::new(),
+        Some(root) => root
+            .get("variants")
+            .and_then(|v| v.as_array())
+            .ok_or_else(|| format!("its {EXTENSION} has no variants array"))?
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                v.get("name")
+                    .and_then(|n| n.as_str())
+                    .ok_or_else(|| format!("variant {i} of its {EXTENSION} has no name"))
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    let chosen = match variant {
+        None => None,
+        Some(wanted) if names.is_empty() => {
+            return Err(format!(
+                "it has no material variants ({EXTENSION}), so variant {wanted:?} cannot be chosen"
+            ));
+        }
+        Some(wanted) => Some(names.iter().position(|&n| n == wanted).ok_or_else(|| {
+            format!(
+                "it has no material variant {wanted:?}; its variants are {}",
+                names
+                    .iter()
+                    .map(|n| format!("{n:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })?),
+    };
+    let material_count = document.materials().len();
+    let mut chosen_materials = HashMap::new();
+    for mesh in document.meshes() {
+        for primitive in mesh.primitives() {
+            let Some(extension) = primitive.extension_value(EXTENSION) else {
+                continue;
+            };
+            let what = format!(
+                "{EXTENSION} of primitive {} of mesh {}",
+                primitive.index(),
+                mesh.index()
+            );
+            let mappings = extension
+                .get("mappings")
+                .and_then(|m| m.as_array())
+                .ok_or_else(|| format!("the {what} has no mappings array"))?;
+            // The specification lets each variant appear in one mapping of a primitive.
+            let mut mapped = vec![false; names.len()];
+            for (m, mapping) in mappings.iter().enumerate() {
+                let material = mapping
+                    .get("material")
+                    .and_then(|v| v.as_u64())
+                    .ok_or_else(|| format!("mapping {m} of the {what} has no material index"))?;
+                if material >= material_count as u64 {
+                    return Err(format!(
+                        "mapping {m} of the {what} names material {material}, but there are {material_count} materials"
+                    ));
+                }
+                let variants = mapping
+                    .get("variants")
+                    .and_then(|v| v.as_array())
+                    .ok_or_else(|| format!("mapping {m} of the {what} has no variants array"))?;
+                for index in variants {
+                    let index = index
+                        .as_u64()
+                        .filter(|&i| i < names.len() as u64)
+                        .ok_or_else(|| {
+                            format!(
+                                "mapping {m} of the {what} names variant {index}, but there are {} variants",
+                                names.len()
+                            )
+                        })? as usize;
+                    if std::mem::replace(&mut mapped[index], true) {
+                        return Err(format!(
+                            "mapping {m} of the {what} names variant {index}, which an earlier mapping names"
+                        ));
+                    }
+                    if chosen == Some(index) {
+                        chosen_materials
+                            .insert((mesh.index(), primitive.index()), material as usize);
+                    }
+                }
+            }
+        }
+    }
+    Ok(chosen_materials)
+}
+
 fn srgb_to_linear(value: f32) -> f32 {
     if value <= 0.04045 {
         value / 12.92

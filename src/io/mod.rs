@@ -91,7 +91,8 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   MikkTSpace computes them); a primitive without normals in a scene that has some is
 ///   flat-shaded.
 ///   Primitives without a material get the glTF default material (white, metallic 1,
-///   roughness 1). Occlusion textures are ignored.
+///   roughness 1). `KHR_materials_variants`: the primitives' default materials here; see
+///   [`load_scene_variant`] to pick a variant. Occlusion textures are ignored.
 ///   `KHR_lights_punctual` lights (files may list it in `extensionsRequired`) go into
 ///   [`SceneData::punctual_lights`]: at their node's world origin, pointing along its world
 ///   −Z, with `color × intensity / 683` (candela and lux over 683 lm/W, Blender's factor:
@@ -100,13 +101,32 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///
 /// A file without any triangle is an error.
 pub fn load_scene(path: &Path) -> Result<SceneData, IoError> {
+    load_scene_variant(path, None)
+}
+
+/// [`load_scene`], with glTF's `KHR_materials_variants`: `None` keeps each primitive's default
+/// material; `Some(name)` gives each primitive the material its mapping names for the variant
+/// `name` (its default where it maps none). A name the file does not define is an error that
+/// lists the file's variants, and so is a name given for a file without variants (OBJ files
+/// have none); of several variants of one name, the first is taken. Every mapping is
+/// checked either way: one naming a material or a variant the file does not have, or a
+/// variant an earlier mapping of the primitive names, is an error.
+pub fn load_scene_variant(path: &Path, variant: Option<&str>) -> Result<SceneData, IoError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase());
     let data = match extension.as_deref() {
-        Some("obj") => obj::load_obj(path)?,
-        Some("gltf") | Some("glb") => gltf_file::load_gltf(path)?,
+        Some("obj") => match variant {
+            None => obj::load_obj(path)?,
+            Some(name) => {
+                return Err(IoError::new(format!(
+                    "cannot load scene {}: only glTF files have material variants, so variant {name:?} cannot be chosen",
+                    path.display()
+                )));
+            }
+        },
+        Some("gltf") | Some("glb") => gltf_file::load_gltf(path, variant)?,
         _ => {
             return Err(IoError::new(format!(
                 "cannot load scene {}: unsupported file extension (expected .obj, .gltf or .glb)",
