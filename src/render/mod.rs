@@ -379,19 +379,6 @@ fn with_estimator<R>(
         min_depth,
         spectral: settings.spectral,
     };
-    if matches!(
-        settings.algorithm,
-        Algorithm::PathSpaceMlt | Algorithm::Erpt
-    ) && let Some(material) = scene.mixed_lobe_material()
-    {
-        return Err(crate::error::Error::new(
-            crate::error::MLT_STATUS_UNSUPPORTED,
-            format!(
-                "{:?} cannot render material {material}: at roughness 0 it is a smooth coat over a diffuse or transmissive base (a Dirac lobe beside a diffuse one), which Veach's path-space mutations do not handle; give it a roughness above 0, or use another algorithm",
-                settings.algorithm
-            ),
-        ));
-    }
     let multiplexed;
     let all_strategies;
     let estimator: Estimator = match settings.algorithm {

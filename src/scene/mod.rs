@@ -433,35 +433,6 @@ impl Scene {
         self.materials[material].disperses(channels)
     }
 
-    /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
-    /// somewhere (metallic-roughness at roughness 0 with a dielectric part: a smooth coat
-    /// over a diffuse base), which path-space MLT and ERPT do not explore correctly.
-    pub(crate) fn mixed_lobe_material(&self) -> Option<usize> {
-        self.materials.iter().position(|m| {
-            if m.kind != MaterialKind::MetallicRoughness {
-                return false;
-            }
-            let texture_min = |texture: Option<crate::TextureRef>, channel| {
-                texture.map_or(1.0, |t| {
-                    self.textures[t.texture as usize].channel_min(channel)
-                })
-            };
-            let packed = m.metallic_roughness_texture;
-            let (roughness, metallic) = (
-                m.roughness * texture_min(packed, 1),
-                m.metallic * texture_min(packed, 2),
-            );
-            // The least transmission leaves the most diffuse base beside the specular lobes.
-            let transmission = m.transmission * texture_min(m.transmission_texture, 0);
-            let smoothest =
-                m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
-            roughness == 0.0 && {
-                let lobes = smoothest.lobes();
-                lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
-            }
-        })
-    }
-
     /// Whether a candidate hit at barycentrics (u, v) of internal triangle `triangle` is a
     /// surface: false where an alpha cut-out removes it.
     #[inline]

@@ -169,7 +169,7 @@ impl PathSpace<'_> {
             }
             let (wo, _) = direction(v, &path[from])?;
             let (wi, _) = direction(v, &path[to])?;
-            let s = space.surface_bsdf(v).scatter(wo, wi, mode)?;
+            let s = space.scatter(v, wo, wi, mode)?;
             Some(if s.specular && !lobes_sampled {
                 1.0
             } else {
@@ -195,31 +195,64 @@ impl PathSpace<'_> {
         vertex_bsdf(self.scene, v.triangle, v.barycentrics, &self.channels)
     }
 
-    /// Veach's classification of a surface vertex: `S` (true) if its BSDF is purely
-    /// specular, else `D`: a glossy lobe has a density, so connections and the
+    /// Whether the path scatters at surface vertex `v` through a Dirac lobe: its BSDF's
+    /// only kind, or where it has both kinds the one the vertex records (see "Lobes" in the
+    /// module documentation).
+    #[inline]
+    fn scatters_through_dirac(bsdf: &Bsdf, v: &PathVertex) -> bool {
+        let lobes = bsdf.lobes();
+        if lobes.is_mixed() {
+            v.dirac
+        } else {
+            lobes.is_specular()
+        }
+    }
+
+    /// Veach's classification of a surface vertex: `S` (true) if the path scatters there
+    /// through a Dirac lobe (the BSDF's only kind, or the one the vertex records where it
+    /// has both), else `D`: a glossy lobe has a density, so connections and the
     /// bidirectional mutation treat it as a diffuse one. (The perturbations tell glossy
     /// vertices apart: see [`Self::class`].) Lights that are not triangles are `D`: they
     /// have no surface to scatter.
     #[inline]
     fn is_specular(&self, v: &PathVertex) -> bool {
-        v.light.is_none() && self.surface_bsdf(v).lobes().is_specular()
+        v.light.is_none() && Self::scatters_through_dirac(&self.surface_bsdf(v), v)
     }
 
     /// Veach's classes with a third for the perturbations: `S`, `G` (every lobe glossy:
     /// a perturbation moves its microfacet and traces on, as through a specular vertex, so
-    /// the path follows a sharp lobe instead of connecting across it) and `D`.
+    /// the path follows a sharp lobe instead of connecting across it) and `D` (which the
+    /// lobes with a density of a BSDF that also has a Dirac one are).
     #[inline]
     fn class(&self, v: &PathVertex) -> VertexClass {
         if v.light.is_some() {
             return VertexClass::Diffuse;
         }
         let bsdf = self.surface_bsdf(v);
-        if bsdf.lobes().is_specular() {
+        if Self::scatters_through_dirac(&bsdf, v) {
             VertexClass::Specular
         } else if bsdf.is_glossy() {
             VertexClass::Glossy
         } else {
             VertexClass::Diffuse
+        }
+    }
+
+    /// What sampling surface vertex `v`'s BSDF from `wo` into `wi` returns, through the
+    /// lobe the vertex records where it has both kinds (`Bsdf::scatter_lobe`).
+    #[inline]
+    fn scatter(
+        &self,
+        v: &PathVertex,
+        wo: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+    ) -> Option<crate::bsdf::ScatterSample> {
+        let bsdf = self.surface_bsdf(v);
+        if bsdf.lobes().is_mixed() {
+            bsdf.scatter_lobe(wo, wi, mode, v.dirac)
+        } else {
+            bsdf.scatter(wo, wi, mode)
         }
     }
 
@@ -302,7 +335,7 @@ impl PathSpace<'_> {
     ) -> Option<Spectrum> {
         let (wo, _) = direction(at, from)?;
         let (wi, _) = direction(at, to)?;
-        let s = self.surface_bsdf(at).scatter(wo, wi, mode)?;
+        let s = self.scatter(at, wo, wi, mode)?;
         Some(if s.specular && !lobes_sampled {
             s.weight * s.pdf
         } else {

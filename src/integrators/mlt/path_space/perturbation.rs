@@ -508,7 +508,9 @@ pub(crate) fn lens(
             y[0] = v;
             break 0;
         }
-        let v = space.trace(&ray, rays)?;
+        let mut v = space.trace(&ray, rays)?;
+        // x's lobe there, kept.
+        v.dirac = space_x.is_specular(&x[k]);
         let class = space.class(&v);
         if class != space_x.class(&x[k]) {
             return None;
@@ -616,7 +618,8 @@ pub(crate) fn caustic(
     y.extend_from_slice(x);
     let mut ray = spawn_ray(space.scene, x[c].p, x[c].normal, new);
     for k in c + 1..=n - 2 {
-        let v = space.trace(&ray, rays)?;
+        let mut v = space.trace(&ray, rays)?;
+        v.dirac = space_x.is_specular(&x[k]);
         let class = space.class(&v);
         if class != space_x.class(&x[k]) {
             return None;
