@@ -228,7 +228,7 @@ impl Bidirectional {
         y.extend(eye.iter().rev());
         y.extend_from_slice(suffix);
         debug_assert_eq!(y.len(), n_new);
-        if let Some(dirac) = suffix_dirac {
+        if let (Some(dirac), Some(_)) = (suffix_dirac, suffix.first()) {
             y[n_new - suffix.len()].dirac = dirac;
         }
         for k in [s.wrapping_sub(1), s] {
