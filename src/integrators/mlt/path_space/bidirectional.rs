@@ -33,7 +33,10 @@
 //! ```
 //!
 //! where |·| is luminance and splits that cannot produce the path (a connection at a
-//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term.
+//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term. Where a
+//! BSDF has a Dirac lobe beside a diffuse one, y records the lobe sampled at each vertex
+//! sampled from (x_a and x_b among them) and the diffuse one at the connection's ends; p_i
+//! includes the lobes' probabilities (parent module, "Lobes").
 //!
 //! A new light vertex is picked as `SceneLights::sample_vertex` picks it (a point on a
 //! triangle, a point or spot light, or a direction at infinity), and the light side's first

@@ -1409,6 +1409,126 @@ mod tests {
         );
     }
 
+    /// The perturbations keep the lobes of paths through smooth coats and are reversible
+    /// with reciprocal ratios: for BDPT's strategy paths of the coated box through a coat's
+    /// Dirac lobe, a lens, multi-chain or caustic perturbation with a fixed move gives y
+    /// with x's lobe at every vertex (and the same perturbations admitted), the opposite
+    /// move takes y back to x, and the product of the two ratios is 1.
+    #[test]
+    fn perturbations_through_smooth_coats_keep_the_lobes_and_are_reversible() {
+        use super::perturbation::{self, applicable};
+        let (scene, camera) = coated_box();
+        let camera = camera.model(32, 32);
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+            channels: Channels::Rgb,
+        };
+        let bdpt = Bdpt {
+            scene: &scene,
+            max_depth: 5,
+            min_depth: 0,
+            spectral: false,
+        };
+        let rotation =
+            glam::Quat::from_axis_angle(glam::Vec3::new(0.3, 0.8, -0.5).normalize(), 2e-4);
+        let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
+        let mut counters = SampleCounters::default();
+        let mut rng = Rng::new(13, 0);
+        let (mut x, mut y, mut back) = (Vec::new(), Vec::new(), Vec::new());
+        let mut checked = [0u32; 3];
+        for _ in 0..3_000 {
+            let [fx, fy] = rng.uniform2();
+            let (n_camera, n_light) = bdpt.trace_subpaths(
+                &camera,
+                fx * 32.0,
+                fy * 32.0,
+                7,
+                6,
+                &mut rng,
+                &mut scratch,
+                &mut counters,
+            );
+            for t in 1..=n_camera {
+                for s in 0..=n_light {
+                    if s + t < 2 || s + t - 2 > 5 || (s == 1 && t == 1) {
+                        continue;
+                    }
+                    let c = bdpt.connect(&camera, &mut scratch, s, t, &mut rng, &mut counters);
+                    if !c.is_some_and(|c| c.weight > 0.0) {
+                        continue;
+                    }
+                    bdpt.strategy_path(&scratch, s, t, &mut x);
+                    // Through a Dirac lobe, away from corners and grazing angles (too
+                    // ill-conditioned for the round trip's rounding).
+                    let n = x.len();
+                    let ill_conditioned = x.windows(2).enumerate().any(|(i, e)| {
+                        let Some((w, distance2)) = direction(&e[0], &e[1]) else {
+                            return true;
+                        };
+                        let grazing = |v: &PathVertex| w.dot(v.normal).abs() < 0.1;
+                        distance2 < 400.0
+                            || (i > 0 && grazing(&e[0]))
+                            || (i + 2 < n && grazing(&e[1]))
+                    });
+                    if !x.iter().any(|v| space.is_specular(v)) || ill_conditioned {
+                        continue;
+                    }
+                    let admits = applicable(&space, &x);
+                    for (which, count) in checked.iter_mut().enumerate() {
+                        let mut forward = FixedKernel {
+                            film_offset: [0.05, -0.03],
+                            rotation,
+                        };
+                        let mut reverse = FixedKernel {
+                            film_offset: [-0.05, 0.03],
+                            rotation: rotation.inverse(),
+                        };
+                        let perturb =
+                            |kernel: &mut FixedKernel,
+                             from: &[PathVertex],
+                             to: &mut Vec<PathVertex>| match which {
+                                0 => perturbation::lens(&space, kernel, false, from, to, &mut 0),
+                                1 => perturbation::lens(&space, kernel, true, from, to, &mut 0),
+                                _ => perturbation::caustic(&space, kernel, from, to, &mut 0),
+                            };
+                        let Some(p) = perturb(&mut forward, &x, &mut y) else {
+                            continue;
+                        };
+                        let lobes = |path: &[PathVertex]| -> Vec<bool> {
+                            path.iter().map(|v| space.is_specular(v)).collect()
+                        };
+                        assert_eq!(lobes(&y), lobes(&x), "{which}: {x:?} → {y:?}");
+                        assert_eq!(applicable(&space, &y), admits, "{which}");
+                        let Some(q) = perturb(&mut reverse, &y, &mut back) else {
+                            panic!("{which}: no way back from {y:?} to {x:?}");
+                        };
+                        if x.iter().zip(&back).any(|(a, b)| a.triangle != b.triangle) {
+                            continue;
+                        }
+                        for (a, b) in x.iter().zip(&back) {
+                            assert!(
+                                (a.p - b.p).length() < 2.0 && a.dirac == b.dirac,
+                                "{which}: {x:?} came back as {back:?}"
+                            );
+                        }
+                        assert!(
+                            (p.ratio * q.ratio - 1.0).abs() < 5e-2,
+                            "{which}: ratios {} and {}: {x:?} → {y:?}",
+                            p.ratio,
+                            q.ratio,
+                        );
+                        *count += 1;
+                    }
+                }
+            }
+        }
+        println!("{checked:?}");
+        for (which, count) in checked.into_iter().enumerate() {
+            assert!(count >= 100, "perturbation {which} checked {count} times");
+        }
+    }
+
     /// For every strategy of many BDPT samples, the contribution evaluated on the path the
     /// strategy built equals BDPT's own (its weighted value over its MIS weight), on the
     /// diffuse box and through glass.
