@@ -5,7 +5,8 @@
 //! against BDPT. Tolerances come from the spread of independent renders, and each check
 //! also asserts that a 2% brightness error would fail (`assert_estimates_agree`).
 //!
-//! Runs in about 27 s on 2 cores (`cargo test --test surfaces`).
+//! Runs in about 55 s on 2 cores (`cargo test --test surfaces`), half of it the smooth
+//! coats' test.
 
 mod common {
     pub mod references;
@@ -174,7 +175,7 @@ fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
     let bdpt = coated_estimate(
         RenderSettings {
             algorithm: Algorithm::Bdpt,
-            samples_per_pixel: 64,
+            samples_per_pixel: 48,
             ..Default::default()
         },
         16,
@@ -188,8 +189,8 @@ fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
             algorithm,
             perturb_in_sample_space,
             samples_per_pixel: 40,
-            mutations_per_pixel: 128,
-            bootstrap_samples: 1 << 16,
+            mutations_per_pixel: 64,
+            bootstrap_samples: 1 << 15,
             chains: 256,
             ..Default::default()
         };
