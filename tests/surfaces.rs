@@ -5,7 +5,8 @@
 //! against BDPT. Tolerances come from the spread of independent renders, and each check
 //! also asserts that a 2% brightness error would fail (`assert_estimates_agree`).
 //!
-//! Runs in about 27 s on 2 cores (`cargo test --test surfaces`).
+//! Runs in about 55 s on 2 cores (`cargo test --test surfaces`), half of it the smooth
+//! coats' test.
 
 mod common {
     pub mod references;
@@ -190,6 +191,92 @@ fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
         .unwrap_err()
         .to_string();
     assert!(error.contains("clear coat is smooth"), "{error}");
+}
+
+/// The Cornell box with smooth coats over its blocks (metallic-roughness at roughness 0,
+/// non-metal): the short block's over a red diffuse base, the tall block's over a base
+/// half diffuse and half transmissive (Dirac reflection and refraction beside the diffuse
+/// lobe), and the floor's over its white base. Path-space MLT and ERPT record at each such
+/// vertex which lobe the path scatters through (path_space/mod.rs, "Lobes").
+fn coated_box() -> mlt::Scene {
+    let mut mesh = common::scenes::canonical_mesh("cornell-box");
+    let coated = mesh.materials.len() as u32;
+    mesh.materials
+        .push(Material::metallic_roughness([0.7, 0.25, 0.15], 0.0, 0.0));
+    mesh.materials.push(Material {
+        transmission: 0.5,
+        ..Material::metallic_roughness([0.6, 0.8, 0.9], 0.0, 0.0)
+    });
+    mesh.materials
+        .push(Material::metallic_roughness([0.8; 3], 0.0, 0.0));
+    for (triangle, material) in mesh.material_ids.iter_mut().enumerate() {
+        match triangle {
+            0..2 => *material = coated + 2,
+            10..20 => *material = coated,
+            20..30 => *material = coated + 1,
+            _ => {}
+        }
+    }
+    mesh.scene()
+}
+
+/// `renders` independent renders of the coated box with `settings`.
+fn coated_estimate(settings: RenderSettings, renders: u64) -> Estimate {
+    let scene = coated_box();
+    let camera = canonical_camera("cornell-box");
+    let images: Vec<Vec<f32>> = (0..renders)
+        .map(|seed| {
+            let settings = RenderSettings {
+                width: SIZE,
+                height: SIZE,
+                max_depth: MAX_DEPTH,
+                seed: 700 + seed,
+                ..settings
+            };
+            render_image(&scene, &camera, &settings)
+        })
+        .collect();
+    Estimate::from_correlated_renders(SIZE as usize, SIZE as usize, &images)
+}
+
+/// Path-space MLT (its perturbations turning directions, and stepping them in their
+/// samplings' coordinates) and ERPT agree with BDPT on smooth coats over diffuse and
+/// transmissive bases.
+#[test]
+fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
+    let bdpt = coated_estimate(
+        RenderSettings {
+            algorithm: Algorithm::Bdpt,
+            samples_per_pixel: 48,
+            ..Default::default()
+        },
+        16,
+    );
+    for (algorithm, perturb_in_sample_space) in [
+        (Algorithm::PathSpaceMlt, false),
+        (Algorithm::PathSpaceMlt, true),
+        (Algorithm::Erpt, false),
+    ] {
+        let settings = RenderSettings {
+            algorithm,
+            perturb_in_sample_space,
+            samples_per_pixel: 40,
+            mutations_per_pixel: 64,
+            bootstrap_samples: 1 << 15,
+            chains: 256,
+            ..Default::default()
+        };
+        assert_estimates_agree(
+            &format!(
+                "coated box {algorithm:?} (perturbing in sample space: {perturb_in_sample_space}) against BDPT"
+            ),
+            &coated_estimate(settings, 16),
+            &bdpt,
+            4,
+            5.0,
+            6.0,
+        );
+    }
 }
 
 /// Writes the BDPT reference at 256², for looking at (`MLT_WRITE_SURFACES=DIR`).

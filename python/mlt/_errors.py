@@ -34,8 +34,8 @@ class InvalidArgumentError(MltError, ValueError):
 
 
 class UnsupportedError(MltError):
-    """Valid, but not supported by this build or algorithm (the Embree backend without the
-    feature, a material path-space MLT cannot render): ``status == "unsupported"``."""
+    """Valid, but not supported by this build (the Embree backend without the feature):
+    ``status == "unsupported"``."""
 
 
 class LoadError(MltError):

@@ -151,8 +151,7 @@ fn settings_or_default(settings: Option<&Bound<'_, PyAny>>) -> PyResult<mlt::Ren
 /// stopped.
 ///
 /// The image depends on the settings' seed, never on the thread count. Raises
-/// `InvalidArgumentError` for invalid settings or camera, `UnsupportedError` for a
-/// scene the algorithm cannot render.
+/// `InvalidArgumentError` for invalid settings or camera.
 #[pyfunction]
 #[pyo3(signature = (scene, camera, settings=None, *, progress=None, cancel=None))]
 pub fn render<'py>(

@@ -373,18 +373,55 @@ impl MetallicRoughness {
         if local.z == 0.0 {
             return None;
         }
-        if self.distribution().is_none() {
-            if local.z < 0.0 {
-                return (choice.transmission > 0.0)
-                    .then(|| self.specular_transmission(&view, wi, choice, mode));
-            }
-            let mirror = Vec3A::new(-view.wo.x, -view.wo.y, view.wo.z);
-            if choice.diffuse == 0.0 || local.dot(mirror) > 1.0 - MIRROR_TOLERANCE {
-                return Some(self.specular_reflection(&view, wi, choice));
-            }
-            return self.diffuse_scatter(&view, choice, local, wi);
+        let mirror = Vec3A::new(-view.wo.x, -view.wo.y, view.wo.z);
+        let dirac = self.distribution().is_none()
+            && (local.z < 0.0
+                || choice.diffuse == 0.0
+                || local.dot(mirror) > 1.0 - MIRROR_TOLERANCE);
+        self.scatter_local(&view, choice, local, wi, mode, dirac)
+    }
+
+    /// What `sample` would return for scattering from `wo` into `wi` through a Dirac lobe
+    /// (`dirac`: the mirror or refracted direction, which `wi` is taken to be) or through
+    /// the lobes with a density. `None` where the material has no such lobe towards `wi`.
+    pub fn scatter_lobe(
+        &self,
+        normal: Vec3A,
+        wo: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+        dirac: bool,
+    ) -> Option<ScatterSample> {
+        let view = View::of(self.ior, normal, wo)?;
+        let choice = self.lobe_choice(&view);
+        let local = view.local(wi);
+        if local.z == 0.0 {
+            return None;
         }
-        self.rough_scatter(&view, choice, local, wi, mode)
+        self.scatter_local(&view, choice, local, wi, mode, dirac)
+    }
+
+    /// `scatter_lobe` with `local` the view's frame's `wi`.
+    #[inline]
+    fn scatter_local(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        local: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+        dirac: bool,
+    ) -> Option<ScatterSample> {
+        match (self.distribution().is_some(), dirac) {
+            (true, false) => self.rough_scatter(view, choice, local, wi, mode),
+            (true, true) => None,
+            (false, true) if local.z < 0.0 => (choice.transmission > 0.0)
+                .then(|| self.specular_transmission(view, wi, choice, mode)),
+            (false, true) => Some(self.specular_reflection(view, wi, choice)),
+            // The base reflects only.
+            (false, false) if local.z < 0.0 => None,
+            (false, false) => self.diffuse_scatter(view, choice, local, wi),
+        }
     }
 
     /// The direction a roughness-0 material scatters `wo` into through `lobe`: the mirror

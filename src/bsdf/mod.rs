@@ -217,6 +217,25 @@ impl Bsdf {
         self.corrected(sample, wo, mode)
     }
 
+    /// What `sample` would return for scattering from `wo` into `wi` through a Dirac lobe
+    /// (`dirac`; `wi` is taken to be its direction) or through the lobes with a density,
+    /// for a BSDF that has both (`BsdfLobes::is_mixed`); `scatter` for the others, whose
+    /// lobes say which.
+    #[inline]
+    pub fn scatter_lobe(
+        &self,
+        wo: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+        dirac: bool,
+    ) -> Option<ScatterSample> {
+        let sample = match &self.model {
+            BsdfModel::MetallicRoughness(m) => m.scatter_lobe(self.normal, wo, wi, mode, dirac),
+            model => scatter(model, self.normal, wo, wi, mode),
+        };
+        self.corrected(sample, wo, mode)
+    }
+
     /// The direction a specular lobe scatters `wo` into (see [`specular_direction`]);
     /// `None` also where it would leak through the surface.
     #[inline]

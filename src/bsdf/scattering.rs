@@ -52,7 +52,6 @@ impl BsdfLobes {
 
     /// Whether all of `other`'s lobes are among these.
     #[inline]
-    #[cfg_attr(not(test), allow(dead_code))]
     pub fn contains(self, other: BsdfLobes) -> bool {
         self.0 & other.0 == other.0
     }
@@ -68,6 +67,13 @@ impl BsdfLobes {
     #[inline]
     pub fn is_specular(self) -> bool {
         !self.has_non_specular()
+    }
+
+    /// Whether a Dirac lobe is beside one with a density (a smooth coat over a diffuse
+    /// base): which of them scatters is then part of a path's state in path-space MLT.
+    #[inline]
+    pub fn is_mixed(self) -> bool {
+        self.contains(BsdfLobes::SPECULAR) && self.has_non_specular()
     }
 }
 

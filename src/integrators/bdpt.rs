@@ -924,6 +924,12 @@ impl Bdpt<'_> {
             }
             _ => PathVertex::on_triangle(v.p, v.normal, v.triangle, v.barycentrics),
         };
+        // Each inner vertex records whether its subpath scattered there through a Dirac
+        // lobe; the connection's ends scatter through the lobes with a density.
+        let with_lobe = |v: &Vertex, inner: bool| PathVertex {
+            dirac: inner && v.specular,
+            ..as_path_vertex(v)
+        };
         out.clear();
         for i in 0..s {
             let v = if s == 1 {
@@ -931,7 +937,7 @@ impl Bdpt<'_> {
             } else {
                 &scratch.light[i]
             };
-            out.push(as_path_vertex(v));
+            out.push(with_lobe(v, i > 0 && i + 1 < s));
         }
         for i in (0..t).rev() {
             let v = if t == 1 {
@@ -939,7 +945,7 @@ impl Bdpt<'_> {
             } else {
                 &scratch.camera[i]
             };
-            out.push(as_path_vertex(v));
+            out.push(with_lobe(v, i > 0 && i + 1 < t));
         }
     }
 }

@@ -36,6 +36,12 @@ pub(crate) struct PathVertex {
     /// `Some` for a first vertex on a light that is not an emissive triangle (a point on an
     /// emissive triangle is `None`, told by its triangle, as any surface vertex).
     pub light: Option<Emitter>,
+    /// Which lobe scatters the path here where the BSDF has a Dirac lobe beside one with a
+    /// density (a smooth coat over a diffuse base): the Dirac one (true) or the other.
+    /// Whether a Dirac scattering reflects or refracts follows from the sides of the
+    /// directions. Read only at such BSDFs: elsewhere the BSDF alone says which (see
+    /// `PathSpace::is_specular`). False at the path's ends.
+    pub dirac: bool,
 }
 
 impl PathVertex {
@@ -56,6 +62,7 @@ impl PathVertex {
             triangle,
             barycentrics,
             light: None,
+            dirac: false,
         }
     }
 
@@ -68,6 +75,7 @@ impl PathVertex {
             triangle: 0,
             barycentrics: [0.0; 2],
             light: None,
+            dirac: false,
         }
     }
 
@@ -80,6 +88,7 @@ impl PathVertex {
             triangle: 0,
             barycentrics: [0.0; 2],
             light: Some(emitter),
+            dirac: false,
         }
     }
 
@@ -105,6 +114,7 @@ impl PathVertex {
                 triangle: 0,
                 barycentrics: [0.0; 2],
                 light: Some(emitter),
+                dirac: false,
             }
         }
     }

@@ -382,12 +382,12 @@ fn with_estimator<R>(
     if matches!(
         settings.algorithm,
         Algorithm::PathSpaceMlt | Algorithm::Erpt
-    ) && let Some(material) = scene.mixed_lobe_material()
+    ) && let Some(material) = scene.uncharted_clearcoat_material()
     {
         return Err(crate::error::Error::new(
             crate::error::MLT_STATUS_UNSUPPORTED,
             format!(
-                "{:?} cannot render material {material}: at roughness 0 it is a smooth coat over a diffuse or transmissive base, or its clear coat is smooth (a Dirac lobe beside a diffuse or glossy one), which Veach's path-space mutations do not handle; give it (or its clear coat) a roughness above 0, or use another algorithm",
+                "{:?} cannot render material {material}: its clear coat is smooth, or lies over a smooth coat beside a diffuse or transmissive base (Dirac lobes beside others, which these path-space mutations handle without a clear coat only); give the clear coat and the base a roughness above 0, or use another algorithm",
                 settings.algorithm
             ),
         ));

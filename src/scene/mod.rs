@@ -556,14 +556,14 @@ impl Scene {
         self.materials[material].disperses(channels)
     }
 
-    /// The first material whose BSDF can mix a Dirac lobe with a diffuse or glossy one
-    /// somewhere (metallic-roughness at roughness 0 with a dielectric part: a smooth coat
-    /// over a diffuse base), which path-space MLT and ERPT do not explore correctly, or
-    /// that has a smooth clear coat somewhere (a Dirac lobe over any base, beside a smooth
-    /// base's own mirror about another normal).
-    pub(crate) fn mixed_lobe_material(&self) -> Option<usize> {
+    /// The first material with a clear coat that path-space MLT and ERPT cannot yet
+    /// explore: a coat that is smooth somewhere (a Dirac lobe over any base, beside a
+    /// smooth base's own mirror about another normal), or a coat over a base that has a
+    /// Dirac lobe beside a diffuse one somewhere (their per-vertex lobe does not know the
+    /// coat's share).
+    pub(crate) fn uncharted_clearcoat_material(&self) -> Option<usize> {
         self.materials.iter().position(|m| {
-            if m.kind != MaterialKind::MetallicRoughness {
+            if m.kind != MaterialKind::MetallicRoughness || m.clearcoat <= 0.0 {
                 return false;
             }
             let texture_min = |texture: Option<crate::TextureRef>, channel| {
@@ -580,8 +580,8 @@ impl Scene {
             let transmission = m.transmission * texture_min(m.transmission_texture, 0);
             let smoothest =
                 m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
-            let smooth_coat = m.clearcoat > 0.0
-                && m.clearcoat_roughness * texture_min(m.clearcoat_roughness_texture, 1) == 0.0;
+            let smooth_coat =
+                m.clearcoat_roughness * texture_min(m.clearcoat_roughness_texture, 1) == 0.0;
             smooth_coat
                 || roughness == 0.0 && {
                     let lobes = smoothest.lobes();

@@ -33,7 +33,10 @@
 //! ```
 //!
 //! where |·| is luminance and splits that cannot produce the path (a connection at a
-//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term.
+//! specular vertex, a lens side hitting a delta light) have p_i = 0 and no term. Where a
+//! BSDF has a Dirac lobe beside a diffuse one, y records the lobe sampled at each vertex
+//! sampled from (x_a and x_b among them) and the diffuse one at the connection's ends; p_i
+//! includes the lobes' probabilities (parent module, "Lobes").
 //!
 //! A new light vertex is picked as `SceneLights::sample_vertex` picks it (a point on a
 //! triangle, a point or spot light, or a direction at infinity), and the light side's first
@@ -198,26 +201,44 @@ impl Bidirectional {
         let space = space_y;
 
         // Light side: the kept prefix, then `from_light` sampled vertices.
+        // Each vertex sampled from records the lobe it sampled (see "Lobes" in the parent
+        // module's documentation), and the connection's ends the lobes with a density.
         y.clear();
         y.extend_from_slice(&x[..(a + 1) as usize]);
         for _ in 0..from_light {
-            let next = self.extend_light_side(space, y, rng, rays)?;
+            let (next, dirac) = self.extend_light_side(space, y, rng, rays)?;
+            if let Some(end) = y.last_mut() {
+                end.dirac = dirac;
+            }
             y.push(next);
         }
         // Lens side: sampled backwards from the kept suffix into `eye` (lens-side order).
         let suffix = &x[b as usize..];
         eye.clear();
+        let mut suffix_dirac = None;
         for i in 0..from_eye {
             // The last vertex sampled from the lens side is the light when the light side
             // is empty: a ray that leaves the scene then ends on the lights at infinity.
             let is_light = y.is_empty() && i + 1 == from_eye;
-            let next = self.extend_eye_side(space, suffix, eye, is_light, rng, rays)?;
+            let (next, dirac) = self.extend_eye_side(space, suffix, eye, is_light, rng, rays)?;
+            match eye.last_mut() {
+                Some(end) => end.dirac = dirac,
+                None => suffix_dirac = Some(dirac),
+            }
             eye.push(next);
         }
         let s = y.len();
         y.extend(eye.iter().rev());
         y.extend_from_slice(suffix);
         debug_assert_eq!(y.len(), n_new);
+        if let (Some(dirac), Some(_)) = (suffix_dirac, suffix.first()) {
+            y[n_new - suffix.len()].dirac = dirac;
+        }
+        for k in [s.wrapping_sub(1), s] {
+            if let Some(end) = y.get_mut(k) {
+                end.dirac = false;
+            }
+        }
         if s >= 1 && s < y.len() {
             let lens_index = y.len() - 1;
             if !space.visible(&y[s - 1], &y[s], s == lens_index, rays) {
@@ -240,14 +261,15 @@ impl Bidirectional {
     }
 
     /// The next vertex of the light side whose vertices so far are `path` (none: a new
-    /// light point).
+    /// light point), and whether the side's last vertex scattered towards it through a
+    /// Dirac lobe.
     fn extend_light_side(
         &self,
         space: &PathSpace,
         path: &[PathVertex],
         rng: &mut Rng,
         rays: &mut u64,
-    ) -> Option<PathVertex> {
+    ) -> Option<(PathVertex, bool)> {
         let scene = space.scene;
         match path {
             [] => {
@@ -258,13 +280,9 @@ impl Bidirectional {
                 // With the densities `unweighted_contribution` gives x_0 (`sample_vertex`'s,
                 // which are `sample_emission`'s).
                 let v = scene.lights.sample_vertex(rng.uniform(), rng.uniform2())?;
-                Some(PathVertex::on_light(
-                    v.light,
-                    v.point,
-                    v.normal,
-                    v.triangle,
-                    v.barycentrics,
-                ))
+                let light =
+                    PathVertex::on_light(v.light, v.point, v.normal, v.triangle, v.barycentrics);
+                Some((light, false))
             }
             [light] => {
                 let emitter = light.emitter();
@@ -273,20 +291,21 @@ impl Bidirectional {
                         .lights
                         .sample_le_ray(emitter, light.p, light.normal, rng.uniform2())?;
                 let ray = emission_ray(scene, emitter, origin, light.normal, direction);
-                space.trace(&ray, rays)
+                Some((space.trace(&ray, rays)?, false))
             }
             [.., previous, end] => {
                 let wo = arrival_back(space, previous, false, end);
-                let wi = sample_direction(space, wo, end, TransportMode::Importance, rng)?;
-                space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)
+                let (wi, dirac) = sample_direction(space, wo, end, TransportMode::Importance, rng)?;
+                let next = space.trace(&spawn_ray(scene, end.p, end.normal, wi), rays)?;
+                Some((next, dirac))
             }
         }
     }
 
     /// The next vertex of the lens side: `eye` holds its sampled vertices so far (nearest
-    /// the lens first), continuing the kept `suffix` (empty: a new lens point). With
-    /// `is_light`, the vertex is the path's light (a ray leaving the scene is then on the
-    /// lights at infinity).
+    /// the lens first), continuing the kept `suffix` (empty: a new lens point), and whether
+    /// the side's end scattered towards it through a Dirac lobe. With `is_light`, the vertex
+    /// is the path's light (a ray leaving the scene is then on the lights at infinity).
     fn extend_eye_side(
         &self,
         space: &PathSpace,
@@ -295,7 +314,7 @@ impl Bidirectional {
         is_light: bool,
         rng: &mut Rng,
         rays: &mut u64,
-    ) -> Option<PathVertex> {
+    ) -> Option<(PathVertex, bool)> {
         let camera = space.camera;
         // The end of the lens side and the vertex before it (towards the lens; none if the
         // end is the lens).
@@ -310,7 +329,7 @@ impl Bidirectional {
             (end, suffix.get(1))
         } else {
             let lens = camera.sample_lens(rng.uniform2());
-            return Some(PathVertex::point(lens, camera.forward));
+            return Some((PathVertex::point(lens, camera.forward), false));
         };
         let Some(previous) = previous else {
             // The end is the lens: a new film position, uniform over the film.
@@ -318,23 +337,25 @@ impl Bidirectional {
             let direction =
                 camera.direction_through(end.p, u * camera.width as f32, v * camera.height as f32);
             let ray = Ray::new(end.p, direction, 0.0, f32::INFINITY);
-            return if is_light {
+            let next = if is_light {
                 space.trace_or_escape(&ray, rays)
             } else {
                 space.trace(&ray, rays)
             };
+            return Some((next?, false));
         };
         let previous_is_lens = suffix
             .last()
             .is_some_and(|lens| std::ptr::eq(lens, previous));
         let wo = arrival_back(space, previous, previous_is_lens, end);
-        let wi = sample_direction(space, wo, end, TransportMode::Radiance, rng)?;
+        let (wi, dirac) = sample_direction(space, wo, end, TransportMode::Radiance, rng)?;
         let ray = spawn_ray(space.scene, end.p, end.normal, wi);
-        if is_light {
+        let next = if is_light {
             space.trace_or_escape(&ray, rays)
         } else {
             space.trace(&ray, rays)
-        }
+        };
+        Some((next?, dirac))
     }
 }
 
@@ -360,7 +381,8 @@ fn arrival_back(
     (origin - at.p).normalize()
 }
 
-/// A scattering direction at `at`, arrived at along `-wo`, sampled by its BSDF.
+/// A scattering direction at `at`, arrived at along `-wo`, sampled by its BSDF, and
+/// whether it sampled a Dirac lobe.
 #[inline]
 fn sample_direction(
     space: &PathSpace,
@@ -368,11 +390,11 @@ fn sample_direction(
     at: &PathVertex,
     mode: TransportMode,
     rng: &mut Rng,
-) -> Option<Vec3A> {
+) -> Option<(Vec3A, bool)> {
     let s = space
         .surface_bsdf(at)
         .sample(wo, rng.uniform2(), rng.uniform(), mode)?;
-    Some(s.wi)
+    Some((s.wi, s.specular))
 }
 
 #[cfg(test)]

@@ -7,7 +7,10 @@
 //! direction turned at random) is almost always outside the lobe. So the perturbations
 //! know a third class, G (`PathSpace::class`: every lobe glossy), and trace through glossy
 //! vertices as through specular ones, moving each one's microfacet by a small step instead
-//! of keeping its lobe exactly (below). "Chain" means a run of S and G vertices.
+//! of keeping its lobe exactly (below). "Chain" means a run of S and G vertices. On a
+//! surface with a Dirac lobe beside a diffuse one the class is the lobe the path records
+//! there (parent module, "Lobes"): a retraced vertex keeps x's, and a move that finds a
+//! surface without it is refused.
 //!
 //! - **Lens perturbation** (paths `… D D (S|G)* E`, or `L (S|G)* E`): move the film point by
 //!   a random offset, trace from the (unchanged) lens point through the chain to a diffuse
@@ -508,7 +511,9 @@ pub(crate) fn lens(
             y[0] = v;
             break 0;
         }
-        let v = space.trace(&ray, rays)?;
+        let mut v = space.trace(&ray, rays)?;
+        // x's lobe there, kept.
+        v.dirac = space_x.is_specular(&x[k]);
         let class = space.class(&v);
         if class != space_x.class(&x[k]) {
             return None;
@@ -616,7 +621,8 @@ pub(crate) fn caustic(
     y.extend_from_slice(x);
     let mut ray = spawn_ray(space.scene, x[c].p, x[c].normal, new);
     for k in c + 1..=n - 2 {
-        let v = space.trace(&ray, rays)?;
+        let mut v = space.trace(&ray, rays)?;
+        v.dirac = space_x.is_specular(&x[k]);
         let class = space.class(&v);
         if class != space_x.class(&x[k]) {
             return None;
