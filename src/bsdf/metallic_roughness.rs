@@ -45,6 +45,7 @@ use super::dielectric::{refract, refracted};
 use super::microfacet::TrowbridgeReitz;
 use super::multiple_scattering::{CoatReflectance, EnergyCompensation};
 use super::scattering::{ScatterSample, TransportMode, reflect};
+use super::sheen::{self, Sheen};
 use super::{BsdfLobes, SpecularLobe};
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
@@ -67,6 +68,16 @@ pub(crate) struct MetallicRoughness {
     pub transmission: f32,
     /// Whether the metal's reflection gains the multiple-scattering compensation lobe.
     pub energy_compensation: bool,
+    /// `KHR_materials_specular`: the strength of the dielectric's specular reflection, in
+    /// [0, 1] (F0 and F90 are scaled by it).
+    pub specular: f32,
+    /// `KHR_materials_specular`: the colour scaling the dielectric's F0 (not negative; F0
+    /// times it is clamped to 1), each lane at most `specular_color_max`.
+    pub specular_color: Spectrum,
+    /// The specular colour's largest RGB channel: what the base beneath is weighted by.
+    pub specular_color_max: f32,
+    /// `KHR_materials_sheen`: the sheen layer over the whole material, if it has one.
+    pub sheen: Option<Sheen>,
 }
 
 /// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
@@ -133,6 +144,8 @@ struct LobeChoice {
     transmission: f32,
     /// The metal's multiple-scattering compensation.
     multiple: f32,
+    /// The sheen layer's lobe (0 without sheen).
+    sheen: f32,
 }
 
 /// Every lobe that can scatter is picked at least this often (before normalizing), so a
@@ -159,19 +172,22 @@ fn schlick_spectrum(f0: Spectrum, cos: f32) -> Spectrum {
     f0 + (Spectrum::ONE - f0) * ((m * m) * (m * m) * m)
 }
 
-/// The reflectance of a dielectric interface for light arriving at cosine `cos_o` (to the
-/// microfacet) on the side of index η_o, with `eta` = η_o / η_t: Schlick's with the cosine
-/// on the side of the lower index, 1 under total internal reflection.
+/// Schlick's Fresnel with a normal reflectance per lane, rounded as [`schlick`] is.
 #[inline]
-fn interface_reflectance(f0: f32, cos_o: f32, eta: f32) -> f32 {
+fn schlick_lanes(f0: Spectrum, cos: f32) -> Spectrum {
+    let m = (1.0 - cos).clamp(0.0, 1.0);
+    f0 + (Spectrum::ONE - f0) * (m * m) * (m * m) * m
+}
+
+/// The cosine on the side of the lower index for light arriving at cosine `cos_o` on the
+/// side of index η_o, with `eta` = η_o / η_t; `None` under total internal reflection.
+#[inline]
+fn rarer_cosine(cos_o: f32, eta: f32) -> Option<f32> {
     if eta <= 1.0 {
-        return schlick(f0, cos_o);
+        return Some(cos_o);
     }
     let sin_t2 = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
-    if sin_t2 >= 1.0 {
-        return 1.0;
-    }
-    schlick(f0, (1.0 - sin_t2).sqrt())
+    (sin_t2 < 1.0).then(|| (1.0 - sin_t2).sqrt())
 }
 
 #[inline]
@@ -214,7 +230,8 @@ impl MetallicRoughness {
         } else {
             BsdfLobes::SPECULAR
         };
-        if self.diffuse_tint().is_black() && self.compensation().is_none() {
+        if self.diffuse_tint().is_black() && self.compensation().is_none() && self.sheen.is_none()
+        {
             scattering
         } else {
             scattering | BsdfLobes::DIFFUSE
@@ -250,6 +267,10 @@ impl MetallicRoughness {
                     let wi = refracted(self.ior, normal, wo)?;
                     Some(self.specular_transmission(&view, wi, choice, mode))
                 }
+                Lobe::Sheen => {
+                    let local = sheen::uniform_hemisphere(u);
+                    self.diffuse_scatter(&view, choice, local, view.basis.to_world(local))
+                }
             };
         };
         let local = match lobe {
@@ -264,6 +285,7 @@ impl MetallicRoughness {
                 let m = distribution.sample_visible_normal(view.wo, u);
                 refract_through(view.wo, m, view.eta()).filter(|wi| wi.z < 0.0)
             }
+            Lobe::Sheen => Some(sheen::uniform_hemisphere(u)).filter(|wi| wi.z > 0.0),
         }?;
         self.rough_scatter(&view, choice, local, view.basis.to_world(local), mode)
     }
@@ -310,7 +332,8 @@ impl MetallicRoughness {
                     .then(|| self.specular_transmission(&view, wi, choice, mode));
             }
             let mirror = Vec3A::new(-view.wo.x, -view.wo.y, view.wo.z);
-            if choice.diffuse == 0.0 || local.dot(mirror) > 1.0 - MIRROR_TOLERANCE {
+            let has_density = choice.diffuse > 0.0 || choice.sheen > 0.0;
+            if !has_density || local.dot(mirror) > 1.0 - MIRROR_TOLERANCE {
                 return Some(self.specular_reflection(&view, wi, choice));
             }
             return self.diffuse_scatter(&view, choice, local, wi);
@@ -457,21 +480,53 @@ impl MetallicRoughness {
         r * r
     }
 
-    /// The Fresnel reflectance of the opaque part of the dielectric: the interface seen
-    /// from the outside, whichever side `wo` is on.
+    /// The dielectric's normal reflectance per lane with `KHR_materials_specular`'s colour,
+    /// min(F0 · specular_color, 1) (before the strength `specular`).
+    #[inline]
+    fn specular_f0(&self) -> Spectrum {
+        (Spectrum::splat(self.f0()) * self.specular_color).min(Spectrum::ONE)
+    }
+
+    /// The largest channel of [`Self::specular_f0`] (by the RGB colour).
+    #[inline]
+    fn specular_f0_max(&self) -> f32 {
+        (self.f0() * self.specular_color_max).min(1.0)
+    }
+
+    /// The dielectric interface's reflectance by lane at cosine `cos` to `wo` (η = `eta`):
+    /// `specular` × Schlick's with the specular F0, 1 under total internal reflection.
+    #[inline]
+    fn dielectric_reflectance(&self, cos: f32, eta: f32) -> Spectrum {
+        match rarer_cosine(cos, eta) {
+            Some(rarer) => schlick_lanes(self.specular_f0(), rarer) * self.specular,
+            None => Spectrum::ONE,
+        }
+    }
+
+    /// The largest channel of [`Self::dielectric_reflectance`]: what the layers it covers
+    /// (the diffuse base, the transmission) are weighted by, one minus it.
+    #[inline]
+    fn dielectric_reflectance_max(&self, cos: f32, eta: f32) -> f32 {
+        match rarer_cosine(cos, eta) {
+            Some(rarer) => self.specular * schlick(self.specular_f0_max(), rarer),
+            None => 1.0,
+        }
+    }
+
+    /// The largest channel of the Fresnel reflectance of the opaque part of the dielectric:
+    /// the interface seen from the outside, whichever side `wo` is on.
     #[inline]
     fn opaque_reflectance(&self, cos: f32) -> f32 {
-        interface_reflectance(self.f0(), cos, 1.0 / self.ior)
+        self.dielectric_reflectance_max(cos, 1.0 / self.ior)
     }
 
     /// The reflection's Fresnel factor at a microfacet (or the normal) at cosine `cos` to
     /// `wo`: the metal's, and the dielectric's opaque and transmissive parts'.
     #[inline]
     fn reflectance(&self, cos: f32, eta: f32) -> Spectrum {
-        let dielectric = (1.0 - self.transmission) * self.opaque_reflectance(cos)
-            + self.transmission * interface_reflectance(self.f0(), cos, eta);
-        schlick_spectrum(self.base_color, cos) * self.metallic
-            + Spectrum::splat((1.0 - self.metallic) * dielectric)
+        let dielectric = self.dielectric_reflectance(cos, 1.0 / self.ior) * (1.0 - self.transmission)
+            + self.dielectric_reflectance(cos, eta) * self.transmission;
+        schlick_spectrum(self.base_color, cos) * self.metallic + dielectric * (1.0 - self.metallic)
     }
 
     /// The metal's multiple-scattering compensation, if it has one: asked for, rough and
@@ -509,7 +564,7 @@ impl MetallicRoughness {
     /// Fresnel factors at the macro normal times the tints.
     fn lobe_choice(&self, view: &View) -> LobeChoice {
         let cos_o = view.wo.z;
-        let transmitted = 1.0 - interface_reflectance(self.f0(), cos_o, view.eta());
+        let transmitted = 1.0 - self.dielectric_reflectance_max(cos_o, view.eta());
         let reflection = mean(self.reflectance(cos_o, view.eta()));
         // The base's albedo is (1 − R(cos_o)) of its tint; 1 − F(cos_o) is close to it and
         // cheaper (estimates only need to be positive where the lobe scatters).
@@ -536,35 +591,78 @@ impl MetallicRoughness {
         let multiple = self.compensation().map_or(0.0, |c| {
             mean(self.multiple_scattering_tint(&c)) * (1.0 - c.albedo(cos_o))
         });
-        let total = reflection + diffuse + transmission + multiple;
+        // ---- sheen layer: its lobe's estimate ----
+        let sheen = self
+            .sheen
+            .map_or(0.0, |s| s.estimate(cos_o).max(MIN_LOBE_WEIGHT));
+        let total = reflection + diffuse + transmission + multiple + sheen;
         LobeChoice {
             reflection: reflection / total,
             diffuse: diffuse / total,
             transmission: transmission / total,
             multiple: multiple / total,
+            sheen: sheen / total,
         }
     }
 
     /// The reflectance of the coat over the diffuse base: the dielectric's reflection seen
-    /// from the outside.
+    /// from the outside, by its largest channel (before the strength `specular`).
     #[inline]
     fn coat(&self) -> CoatReflectance {
-        CoatReflectance::new(self.roughness, self.f0())
+        CoatReflectance::new(self.roughness, self.specular_f0_max())
     }
 
     /// The diffuse base's f at cosines `cos_o`, `cos_i` (same side), scaled by what the
     /// coat does not reflect at either: (1 − R(μo)) (1 − R(μi)) / (1 − R_avg), whose
-    /// cosine-weighted integral over μi is 1 − R(μo) (see the module's documentation).
+    /// cosine-weighted integral over μi is 1 − R(μo) (see the module's documentation), R
+    /// the coat's reflectance times `specular`. A coat that reflects everything (R = 1)
+    /// leaves nothing.
     #[inline]
     fn diffuse_f(&self, cos_o: f32, cos_i: f32) -> Spectrum {
         let coat = self.coat();
-        let through = (1.0 - coat.reflectance(cos_o)) * (1.0 - coat.reflectance(cos_i))
-            / (1.0 - coat.average());
+        let through_average = 1.0 - self.specular * coat.average();
+        if through_average <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let through = (1.0 - self.specular * coat.reflectance(cos_o))
+            * (1.0 - self.specular * coat.reflectance(cos_i))
+            / through_average;
         self.diffuse_tint() * (through * FRAC_1_PI)
     }
 
-    /// f of the lobes with a density, `wi` in the view's frame.
+    /// f of the lobes with a density, `wi` in the view's frame: the layers beneath the
+    /// sheen, scaled by what it leaves them, and the sheen's lobe.
+    #[inline]
     fn eval_local(&self, view: &View, wi: Vec3A, mode: TransportMode) -> Spectrum {
+        let f = self.base_eval_local(view, wi, mode);
+        // ---- sheen layer ----
+        match &self.sheen {
+            None => f,
+            Some(sheen) => f * sheen.scaling(view.wo.z, wi.z) + sheen.f(view.wo, wi),
+        }
+    }
+
+    /// The density of `sample` through the lobes with a density, `wi` in the view's frame.
+    #[inline]
+    fn pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
+        let pdf = self.base_pdf_local(view, choice, wi);
+        // ---- sheen layer: its lobe, uniform over wo's hemisphere ----
+        if choice.sheen > 0.0 && wi.z > 0.0 {
+            pdf + choice.sheen * sheen::UNIFORM_HEMISPHERE_PDF
+        } else {
+            pdf
+        }
+    }
+
+    /// What the sheen layer leaves of a Dirac lobe's weight into `wi`.
+    #[inline]
+    fn sheen_scaling(&self, view: &View, wi: Vec3A) -> f32 {
+        self.sheen
+            .map_or(1.0, |s| s.scaling(view.wo.z, view.local(wi).z))
+    }
+
+    /// f of the lobes beneath the sheen with a density, `wi` in the view's frame.
+    fn base_eval_local(&self, view: &View, wi: Vec3A, mode: TransportMode) -> Spectrum {
         let wo = view.wo;
         if wi.z > 0.0 {
             let mut f = self.diffuse_f(wo.z, wi.z);
@@ -595,21 +693,22 @@ impl MetallicRoughness {
             TransportMode::Importance => view.eta_t * view.eta_t,
         };
         // Schlick's F at the cosine on the side of the lower index, as
-        // `interface_reflectance`, but taken from the pair: recomputing it from Snell's law
+        // `dielectric_reflectance`, but taken from the pair: recomputing it from Snell's law
         // near the critical angle would cancel catastrophically (and break reciprocity).
         let rarer_cos = if view.eta_o <= view.eta_t {
             cos_oh
         } else {
             -cos_ih
         };
-        let transmitted = 1.0 - schlick(self.f0(), rarer_cos);
+        let transmitted = 1.0 - self.specular * schlick(self.specular_f0_max(), rarer_cos);
         let microfacets = distribution.d(h) * distribution.g2(wo, wi) * (cos_oh * cos_ih).abs()
             / (wo.z * wi.z.abs() * denominator * denominator);
         self.transmission_tint() * (transmitted * eta_scale * microfacets)
     }
 
-    /// The density of `sample` through the lobes with a density, `wi` in the view's frame.
-    fn pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
+    /// The density of `sample` through the lobes beneath the sheen with a density, `wi` in
+    /// the view's frame.
+    fn base_pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
         let wo = view.wo;
         if wi.z > 0.0 {
             let mut pdf = (choice.diffuse + choice.multiple) * cosine_hemisphere_pdf(wi.z);
@@ -663,7 +762,8 @@ impl MetallicRoughness {
         })
     }
 
-    /// Roughness 0's diffuse base scattering into `wi` (`local` in the view's frame).
+    /// Roughness 0's diffuse base (and sheen) scattering into `wi` (`local` in the view's
+    /// frame).
     fn diffuse_scatter(
         &self,
         view: &View,
@@ -671,6 +771,10 @@ impl MetallicRoughness {
         local: Vec3A,
         wi: Vec3A,
     ) -> Option<ScatterSample> {
+        // ---- sheen layer: the lobes with a density are the base's and the sheen's ----
+        if self.sheen.is_some() {
+            return self.rough_scatter(view, choice, local, wi, TransportMode::Radiance);
+        }
         let pdf = choice.diffuse * cosine_hemisphere_pdf(local.z);
         (pdf > 0.0).then(|| ScatterSample {
             wi,
@@ -685,7 +789,8 @@ impl MetallicRoughness {
     fn specular_reflection(&self, view: &View, wi: Vec3A, choice: LobeChoice) -> ScatterSample {
         ScatterSample {
             wi,
-            weight: self.reflectance(view.wo.z, view.eta()) / choice.reflection,
+            weight: self.reflectance(view.wo.z, view.eta())
+                * (self.sheen_scaling(view, wi) / choice.reflection),
             pdf: choice.reflection,
             specular: true,
             radiance_scale: 1.0,
@@ -705,7 +810,8 @@ impl MetallicRoughness {
             TransportMode::Radiance => eta * eta,
             TransportMode::Importance => 1.0,
         };
-        let transmitted = 1.0 - interface_reflectance(self.f0(), view.wo.z, eta);
+        let transmitted = 1.0 - self.dielectric_reflectance_max(view.wo.z, eta);
+        let transmitted = transmitted * self.sheen_scaling(view, wi);
         ScatterSample {
             wi,
             weight: self.transmission_tint() * (transmitted * scale / choice.transmission),
@@ -723,6 +829,7 @@ enum Lobe {
     Diffuse,
     Transmission,
     MultipleScattering,
+    Sheen,
 }
 
 impl LobeChoice {
@@ -736,6 +843,7 @@ impl LobeChoice {
             (Lobe::Diffuse, self.diffuse),
             (Lobe::Transmission, self.transmission),
             (Lobe::MultipleScattering, self.multiple),
+            (Lobe::Sheen, self.sheen),
         ] {
             cumulative += probability;
             if u < cumulative {
@@ -744,6 +852,7 @@ impl LobeChoice {
         }
         // Rounding left u past the sum: the last lobe that has a probability.
         [
+            (Lobe::Sheen, self.sheen),
             (Lobe::MultipleScattering, self.multiple),
             (Lobe::Transmission, self.transmission),
             (Lobe::Diffuse, self.diffuse),
@@ -789,6 +898,10 @@ mod tests {
             ior,
             transmission,
             energy_compensation: false,
+            specular: 1.0,
+            specular_color: Spectrum::ONE,
+            specular_color_max: 1.0,
+            sheen: None,
         }
     }
 

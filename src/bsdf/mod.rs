@@ -14,8 +14,10 @@ mod metallic_roughness;
 mod microfacet;
 mod multiple_scattering;
 mod scattering;
+mod sheen;
 
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
+pub(crate) use sheen::Sheen;
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 

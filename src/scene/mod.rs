@@ -453,8 +453,17 @@ impl Scene {
             );
             // The least transmission leaves the most diffuse base beside the specular lobes.
             let transmission = m.transmission * texture_min(m.transmission_texture, 0);
-            let smoothest =
-                m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
+            // A sheen (with any of its texture's colours) adds a lobe with a density.
+            let layers = m.untextured_layers();
+            let smoothest = m.textured_bsdf_model(
+                Spectrum::from(m.color),
+                metallic,
+                0.0,
+                transmission,
+                m.ior,
+                &layers,
+                &crate::spectral::Channels::Rgb,
+            );
             roughness == 0.0 && {
                 let lobes = smoothest.lobes();
                 lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()

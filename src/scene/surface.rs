@@ -5,7 +5,7 @@
 //! Attributes are stored per triangle corner in the backend's internal triangle order, so a
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
-use super::material::{Material, TextureRef};
+use super::material::{Material, SpecularAndSheen, TextureRef};
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::spectral::{Channels, FittedColour};
@@ -311,6 +311,36 @@ impl SurfacePoint<'_> {
         }
     }
 
+    /// The specular and sheen parameters here, times their textures.
+    #[inline]
+    fn specular_and_sheen(&self) -> SpecularAndSheen {
+        let m = self.material;
+        let mut layers = m.untextured_layers();
+        let uv = self.texcoord();
+        let rgb = |t: Vec4| [t.x, t.y, t.z];
+        let times = |c: [f32; 3], t: [f32; 3]| [c[0] * t[0], c[1] * t[1], c[2] * t[2]];
+        if let Some(texture) = &m.specular_texture {
+            layers.specular *= lookup(self.textures, texture, uv).w;
+        }
+        if let Some(texture) = &m.specular_color_texture {
+            layers.specular_color = times(
+                layers.specular_color,
+                rgb(lookup(self.textures, texture, uv)),
+            );
+        }
+        // Without sheen the sheen's textures change nothing: no lookups.
+        if layers.sheen_color != [0.0; 3] {
+            if let Some(texture) = &m.sheen_color_texture {
+                layers.sheen_color =
+                    times(layers.sheen_color, rgb(lookup(self.textures, texture, uv)));
+            }
+            if let Some(texture) = &m.sheen_roughness_texture {
+                layers.sheen_roughness *= lookup(self.textures, texture, uv).w;
+            }
+        }
+        layers
+    }
+
     /// The BSDF here, on a triangle with front geometric normal `geometric_normal`.
     #[inline]
     pub fn bsdf(&self, geometric_normal: Vec3A, channels: &Channels) -> Bsdf {
@@ -323,6 +353,8 @@ impl SurfacePoint<'_> {
                 m.roughness,
                 m.transmission,
                 m.ior_in(channels),
+                &m.untextured_layers(),
+                channels,
             );
             return Bsdf::new(model, geometric_normal, geometric_normal)
                 .with_dispersion(dispersive);
@@ -340,8 +372,16 @@ impl SurfacePoint<'_> {
         if let Some(texture) = &m.transmission_texture {
             transmission *= lookup(self.textures, texture, self.texcoord()).x;
         }
-        let model =
-            m.textured_bsdf_model(color, metallic, roughness, transmission, m.ior_in(channels));
+        let layers = self.specular_and_sheen();
+        let model = m.textured_bsdf_model(
+            color,
+            metallic,
+            roughness,
+            transmission,
+            m.ior_in(channels),
+            &layers,
+            channels,
+        );
         Bsdf::new(
             model,
             self.shading_normal(geometric_normal),
