@@ -230,8 +230,7 @@ impl MetallicRoughness {
         } else {
             BsdfLobes::SPECULAR
         };
-        if self.diffuse_tint().is_black() && self.compensation().is_none() && self.sheen.is_none()
-        {
+        if self.diffuse_tint().is_black() && self.compensation().is_none() && self.sheen.is_none() {
             scattering
         } else {
             scattering | BsdfLobes::DIFFUSE
@@ -524,7 +523,8 @@ impl MetallicRoughness {
     /// `wo`: the metal's, and the dielectric's opaque and transmissive parts'.
     #[inline]
     fn reflectance(&self, cos: f32, eta: f32) -> Spectrum {
-        let dielectric = self.dielectric_reflectance(cos, 1.0 / self.ior) * (1.0 - self.transmission)
+        let dielectric = self.dielectric_reflectance(cos, 1.0 / self.ior)
+            * (1.0 - self.transmission)
             + self.dielectric_reflectance(cos, eta) * self.transmission;
         schlick_spectrum(self.base_color, cos) * self.metallic + dielectric * (1.0 - self.metallic)
     }
@@ -1177,18 +1177,24 @@ mod tests {
     }
 
     /// The albedo ∫ f |cos| dωi (importance mode: the scattered share of the incident
-    /// flux), estimated by sampling.
+    /// flux), estimated by sampling, the directions' `u` stratified on a square grid of
+    /// about `draws` cells (a low sheen roughness's peak at grazing angles makes plain
+    /// sampling noisy).
     fn albedo(m: &MetallicRoughness, wo: Vec3A, draws: usize, rng: &mut Rng) -> Spectrum {
         let n = normal();
+        let k = (draws as f64).sqrt() as usize;
         let mut sum = Spectrum::ZERO;
-        for _ in 0..draws {
-            let u = rng.uniform2();
-            let u_lobe = rng.uniform();
-            if let Some(s) = m.sample(n, wo, u, u_lobe, TransportMode::Importance) {
-                sum += s.weight;
+        for i in 0..k {
+            for j in 0..k {
+                let [a, b] = rng.uniform2();
+                let u = [(i as f32 + a) / k as f32, (j as f32 + b) / k as f32];
+                let u_lobe = rng.uniform();
+                if let Some(s) = m.sample(n, wo, u, u_lobe, TransportMode::Importance) {
+                    sum += s.weight;
+                }
             }
         }
-        sum * (1.0 / draws as f32)
+        sum * (1.0 / (k * k) as f32)
     }
 
     /// No material, white or tinted, scatters more than it receives.
@@ -1205,8 +1211,10 @@ mod tests {
             .collect();
         all.extend(white);
         for m in all {
+            // A sheen's peak at grazing angles needs more draws for the same noise.
+            let draws = if m.sheen.is_some() { 250_000 } else { 40_000 };
             for theta in ANGLES.into_iter().chain([89.5]) {
-                let a = albedo(&m, direction(theta), 40_000, &mut rng);
+                let a = albedo(&m, direction(theta), draws, &mut rng);
                 assert!(a.max_component() <= 1.01, "{m:?} θ {theta}: albedo {a}");
             }
         }
@@ -1625,14 +1633,15 @@ mod tests {
 
     /// Sheen over a diffuse base, a metal, transmission and their mixtures, white
     /// everywhere: never more than arrives, at any angle, at any sheen roughness (the
-    /// lowest is where the specification's lobe alone would reflect up to 2.9 times).
+    /// lowest is where the specification's lobe alone would reflect up to 2.9 times). The
+    /// true albedos come within 1% of 1 at grazing angles (0.990 at 88° over a rough
+    /// dielectric at the lowest sheen roughness, by 4 million stratified draws).
     #[test]
     fn white_furnace_with_sheen_is_at_most_one() {
         let mut rng = Rng::new(45, 12);
         for sheen_roughness in [0.0f32, 0.15, 0.4, 1.0] {
             for roughness in [0.0f32, 0.3, 1.0] {
-                for (metallic, transmission) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.3, 0.3)]
-                {
+                for (metallic, transmission) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.3, 0.3)] {
                     let m = MetallicRoughness {
                         base_color: Spectrum::ONE,
                         sheen: white_sheen(sheen_roughness),
@@ -1640,7 +1649,7 @@ mod tests {
                         ..material(roughness, metallic, transmission, 1.5)
                     };
                     for theta in [0.0f32, 50.0, 80.0, 88.0, 89.7, 135.0, 178.0] {
-                        let a = albedo(&m, direction(theta), 30_000, &mut rng);
+                        let a = albedo(&m, direction(theta), 250_000, &mut rng);
                         assert!(
                             a.max_component() <= 1.01,
                             "sheen roughness {sheen_roughness} {m:?} θ {theta}: {a}"
@@ -1712,15 +1721,19 @@ mod tests {
                     for j in 0..k {
                         let [a, b] = rng.uniform2();
                         let u = [(i as f32 + a) / k as f32, (j as f32 + b) / k as f32];
-                        if let Some(s) = m.sample(n, wo, u, rng.uniform(), TransportMode::Importance)
+                        if let Some(s) =
+                            m.sample(n, wo, u, rng.uniform(), TransportMode::Importance)
                         {
                             sum += s.weight[0] as f64;
                         }
                     }
                 }
                 let ours = sum / (k * k) as f64;
-                let specification = specification_sheen_albedo(sheen_roughness as f64, theta as f64);
-                println!("sheen roughness {sheen_roughness} θ {theta}: {ours:.5} vs {specification:.5}");
+                let specification =
+                    specification_sheen_albedo(sheen_roughness as f64, theta as f64);
+                println!(
+                    "sheen roughness {sheen_roughness} θ {theta}: {ours:.5} vs {specification:.5}"
+                );
                 assert!(
                     (ours / specification - 1.0).abs() < 0.005,
                     "sheen roughness {sheen_roughness} θ {theta}: {ours} vs the specification's {specification}"

@@ -17,9 +17,9 @@ mod scattering;
 mod sheen;
 
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
-pub(crate) use sheen::Sheen;
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
+pub(crate) use sheen::Sheen;
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
