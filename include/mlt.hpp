@@ -487,6 +487,30 @@ struct Material {
     /// Metallic-roughness: red multiplies the transmission (KHR_materials_transmission's
     /// transmissionTexture); usually linear.
     TextureRef transmission_texture;
+    /// Metallic-roughness: strength of the dielectric's specular reflection, 0 a pure diffuse base
+    /// (KHR_materials_specular's specularFactor).
+    float specular = 1.0f;
+    /// Metallic-roughness: scales the dielectric's F0 per channel, linear RGB, may exceed 1 (F0
+    /// times it is clamped to 1; KHR_materials_specular's specularColorFactor).
+    std::array<float, 3> specular_color{1.0f, 1.0f, 1.0f};
+    /// Metallic-roughness: alpha multiplies the specular strength (KHR_materials_specular's
+    /// specularTexture); usually linear.
+    TextureRef specular_texture;
+    /// Metallic-roughness: RGB multiplies the specular colour (KHR_materials_specular's
+    /// specularColorTexture); usually 8-bit sRGB.
+    TextureRef specular_color_texture;
+    /// Metallic-roughness: colour of a sheen layer over the material (velvet, cloth), linear RGB;
+    /// black is none (KHR_materials_sheen's sheenColorFactor).
+    std::array<float, 3> sheen_color{0.0f, 0.0f, 0.0f};
+    /// Metallic-roughness: the sheen's roughness (Charlie distribution, alpha = roughness squared,
+    /// at least 0.07 squared; KHR_materials_sheen's sheenRoughnessFactor).
+    float sheen_roughness = 0.0f;
+    /// Metallic-roughness: RGB multiplies the sheen colour (KHR_materials_sheen's
+    /// sheenColorTexture); usually 8-bit sRGB.
+    TextureRef sheen_color_texture;
+    /// Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
+    /// sheenRoughnessTexture); usually linear.
+    TextureRef sheen_roughness_texture;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -545,6 +569,14 @@ struct Material {
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
         c.transmission_texture = transmission_texture.to_c();
+        c.specular = specular;
+        detail::copy_to(c.specular_color, specular_color);
+        c.specular_texture = specular_texture.to_c();
+        c.specular_color_texture = specular_color_texture.to_c();
+        detail::copy_to(c.sheen_color, sheen_color);
+        c.sheen_roughness = sheen_roughness;
+        c.sheen_color_texture = sheen_color_texture.to_c();
+        c.sheen_roughness_texture = sheen_roughness_texture.to_c();
         // END GENERATED material to C
         return c;
     }
@@ -569,6 +601,14 @@ struct Material {
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
         m.transmission_texture = TextureRef::from_c(c.transmission_texture);
+        m.specular = c.specular;
+        m.specular_color = detail::to_array(c.specular_color);
+        m.specular_texture = TextureRef::from_c(c.specular_texture);
+        m.specular_color_texture = TextureRef::from_c(c.specular_color_texture);
+        m.sheen_color = detail::to_array(c.sheen_color);
+        m.sheen_roughness = c.sheen_roughness;
+        m.sheen_color_texture = TextureRef::from_c(c.sheen_color_texture);
+        m.sheen_roughness_texture = TextureRef::from_c(c.sheen_roughness_texture);
         // END GENERATED material from C
         return m;
     }

@@ -312,6 +312,93 @@ fn gltf_transmission_texture_is_read() {
     Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
 }
 
+/// The sky-spheres scene with its clay given `KHR_materials_specular` and
+/// `KHR_materials_sheen` (`clay_extensions`, JSON members), both listed as required, written
+/// beside its buffer.
+fn sky_spheres_with_clay_extensions(name: &str, clay_extensions: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(scenes().join("sky-spheres.gltf")).unwrap();
+    let edited = text
+        .replacen(
+            r#""name": "clay","#,
+            &format!(r#""name": "clay", "extensions": {{ {clay_extensions} }},"#),
+            1,
+        )
+        .replacen(
+            r#""extensionsUsed": ["#,
+            r#""extensionsRequired": ["KHR_materials_specular", "KHR_materials_sheen"], "extensionsUsed": ["KHR_materials_specular", "KHR_materials_sheen","#,
+            1,
+        );
+    let dir = temp_path(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        scenes().join("sky-spheres.bin"),
+        dir.join("sky-spheres.bin"),
+    )
+    .unwrap();
+    let path = dir.join("sky-spheres.gltf");
+    std::fs::write(&path, edited).unwrap();
+    path
+}
+
+/// `KHR_materials_specular` and `KHR_materials_sheen` are read, factors and textures (with
+/// their texture transforms, colours as sRGB), and a file that requires them loads;
+/// values out of the specifications' ranges are clear errors.
+#[test]
+fn gltf_specular_and_sheen_are_read() {
+    let path = sky_spheres_with_clay_extensions(
+        "specular-sheen",
+        r#""KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 0.5],
+              "specularTexture": { "index": 1 }, "specularColorTexture": { "index": 1 } },
+            "KHR_materials_sheen": { "sheenColorFactor": [0.9, 0.4, 0.1], "sheenRoughnessFactor": 0.3,
+              "sheenColorTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "scale": [30.0, -30.0] } } },
+              "sheenRoughnessTexture": { "index": 1 } }"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!(clay.specular, 0.5);
+    assert_eq!(clay.specular_color, [2.0, 1.0, 0.5]);
+    assert_eq!(clay.sheen_color, [0.9, 0.4, 0.1]);
+    assert_eq!(clay.sheen_roughness, 0.3);
+    let colour = clay.sheen_color_texture.expect("the sheen colour texture");
+    assert_eq!(colour.scale, [30.0, -30.0]);
+    let linear = clay.normal_texture.unwrap().texture;
+    // Colours are sRGB, strengths and roughnesses linear: one image, two textures.
+    assert_eq!(clay.specular_texture.unwrap().texture, linear);
+    assert_eq!(clay.sheen_roughness_texture.unwrap().texture, linear);
+    assert_ne!(colour.texture, linear);
+    assert_eq!(clay.specular_color_texture.unwrap().texture, colour.texture);
+    let (_, glass) = material_named(&data, "glass");
+    assert_eq!((glass.specular, glass.sheen_color), (1.0, [0.0; 3]));
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+
+    for (bad, needle) in [
+        (
+            r#""KHR_materials_specular": { "specularFactor": -0.5 }"#,
+            "specularFactor",
+        ),
+        (
+            r#""KHR_materials_specular": { "specularColorFactor": [1.0, -1.0, 1.0] }"#,
+            "specularColorFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenColorFactor": [1.5, 0.0, 0.0] }"#,
+            "sheenColorFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenRoughnessFactor": "rough" }"#,
+            "sheenRoughnessFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenColorTexture": { "index": 99 } }"#,
+            "sheenColorTexture",
+        ),
+    ] {
+        let path = sky_spheres_with_clay_extensions("specular-sheen-bad", bad);
+        let error = io::load_scene(&path).err().expect(bad).to_string();
+        assert!(error.contains(needle), "{bad}: {error}");
+    }
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");

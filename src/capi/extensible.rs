@@ -198,10 +198,11 @@ impl Extensible for MltMaterial {
     const TYPE_NAME: &'static str = "MltMaterial";
     const INITIALIZER: &'static str = "mlt_material_default";
     /// Before the metallic-roughness model and textures (mlt 0.2's header): 36 bytes; before
-    /// the transmission texture (0.3's): 168.
+    /// the transmission texture (0.3's): 168; before specular and sheen (0.4's): 192.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltMaterial, metallic),
         offset_of!(MltMaterial, transmission_texture),
+        offset_of!(MltMaterial, specular),
     ];
     fn defaults() -> Self {
         (&Material::default()).into()
@@ -239,6 +240,14 @@ impl From<&Material> for MltMaterial {
             energy_compensation,
             abbe_number,
             transmission_texture,
+            specular,
+            specular_color,
+            specular_texture,
+            specular_color_texture,
+            sheen_color,
+            sheen_roughness,
+            sheen_color_texture,
+            sheen_roughness_texture,
             // END GENERATED material to C
         }
     }
@@ -512,14 +521,14 @@ mod tests {
     }
 
     /// The layouts older headers have: mlt 0.2's material ends at `ior` (0.3's at
-    /// `abbe_number`), its scene description at `backend`; the one with lights but no surface attributes is 112 bytes,
+    /// `abbe_number`, 0.4's at `transmission_texture`), its scene description at `backend`; the one with lights but no surface attributes is 112 bytes,
     /// the one without the build quality 192; the scene info without the acceleration
     /// structure's facts 64; the settings without the filter 104, without Russian roulette
     /// 128.
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 320]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, today.

@@ -79,6 +79,11 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
             )));
         }
     }
+    // The gltf crate refuses required extensions it does not parse itself; those this
+    // loader reads from the JSON are supported all the same.
+    let mut json = json;
+    json.extensions_required
+        .retain(|name| !READ_FROM_JSON.contains(&name.as_str()));
     let document = ::gltf::Document::from_json(json).map_err(|e| fail(e.to_string()))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob)
@@ -132,6 +137,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<SceneData, IoError> {
     };
     let mut loader = Loader {
         path,
+        document: &document,
         buffers: &buffers,
         images: &images,
         attributes,
@@ -157,8 +163,17 @@ struct Attributes {
     tangents: bool,
 }
 
+/// The material extensions this loader reads from the JSON, which the gltf crate does not
+/// parse.
+const READ_FROM_JSON: &[&str] = &[
+    "KHR_materials_dispersion",
+    "KHR_materials_specular",
+    "KHR_materials_sheen",
+];
+
 struct Loader<'a> {
     path: &'a Path,
+    document: &'a ::gltf::Document,
     buffers: &'a [::gltf::buffer::Data],
     images: &'a [::gltf::image::Data],
     attributes: Attributes,
@@ -562,6 +577,170 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// `KHR_materials_specular` and `KHR_materials_sheen` (read from the JSON: the gltf
+    /// crate parses neither), with their textures and the textures' `KHR_texture_transform`;
+    /// numbers out of the specifications' ranges are errors.
+    fn specular_and_sheen(
+        &mut self,
+        material: &::gltf::Material,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let name = material
+            .index()
+            .map_or("(default)".into(), |i| i.to_string());
+        if let Some(extension) = material.extension_value("KHR_materials_specular") {
+            let what = "KHR_materials_specular";
+            converted.specular =
+                self.json_number(extension, "specularFactor", 1.0, (0.0, 1.0), what, &name)?;
+            converted.specular_color = self.json_colour(
+                extension,
+                "specularColorFactor",
+                [1.0; 3],
+                (0.0, f32::MAX),
+                what,
+                &name,
+            )?;
+            converted.specular_texture =
+                self.json_texture(extension, "specularTexture", false, what, &name)?;
+            converted.specular_color_texture =
+                self.json_texture(extension, "specularColorTexture", true, what, &name)?;
+        }
+        if let Some(extension) = material.extension_value("KHR_materials_sheen") {
+            let what = "KHR_materials_sheen";
+            converted.sheen_color = self.json_colour(
+                extension,
+                "sheenColorFactor",
+                [0.0; 3],
+                (0.0, 1.0),
+                what,
+                &name,
+            )?;
+            converted.sheen_roughness = self.json_number(
+                extension,
+                "sheenRoughnessFactor",
+                0.0,
+                (0.0, 1.0),
+                what,
+                &name,
+            )?;
+            converted.sheen_color_texture =
+                self.json_texture(extension, "sheenColorTexture", true, what, &name)?;
+            converted.sheen_roughness_texture =
+                self.json_texture(extension, "sheenRoughnessTexture", false, what, &name)?;
+        }
+        Ok(())
+    }
+
+    /// The number `key` of an extension's JSON (`default` if absent), within `range`.
+    fn json_number(
+        &self,
+        extension: &::serde_json::Value,
+        key: &str,
+        default: f32,
+        (min, max): (f32, f32),
+        what: &str,
+        material: &str,
+    ) -> Result<f32, IoError> {
+        let Some(value) = extension.get(key) else {
+            return Ok(default);
+        };
+        value
+            .as_f64()
+            .map(|v| v as f32)
+            .filter(|v| v.is_finite() && (min..=max).contains(v))
+            .ok_or_else(|| {
+                self.fail(format!(
+                    "material {material}: {what}'s {key} is {value}; it must be a number in [{min}, {max}]"
+                ))
+            })
+    }
+
+    /// The RGB colour `key` of an extension's JSON (`default` if absent), each channel
+    /// within `range`.
+    fn json_colour(
+        &self,
+        extension: &::serde_json::Value,
+        key: &str,
+        default: [f32; 3],
+        (min, max): (f32, f32),
+        what: &str,
+        material: &str,
+    ) -> Result<[f32; 3], IoError> {
+        let Some(value) = extension.get(key) else {
+            return Ok(default);
+        };
+        let channels: Option<Vec<f32>> = value.as_array().and_then(|a| {
+            a.iter()
+                .map(|c| c.as_f64().map(|c| c as f32))
+                .collect::<Option<Vec<f32>>>()
+        });
+        match channels.as_deref() {
+            Some(&[r, g, b]) if [r, g, b].iter().all(|c| c.is_finite() && (min..=max).contains(c)) => {
+                Ok([r, g, b])
+            }
+            _ => Err(self.fail(format!(
+                "material {material}: {what}'s {key} is {value}; it must be three numbers in [{min}, {max}]"
+            ))),
+        }
+    }
+
+    /// The texture `key` of an extension's JSON (a textureInfo), decoded as sRGB or linear,
+    /// with its `KHR_texture_transform`.
+    fn json_texture(
+        &mut self,
+        extension: &::serde_json::Value,
+        key: &str,
+        srgb: bool,
+        what: &str,
+        material: &str,
+    ) -> Result<Option<TextureRef>, IoError> {
+        let Some(info) = extension.get(key) else {
+            return Ok(None);
+        };
+        let texture = info
+            .get("index")
+            .and_then(|i| i.as_u64())
+            .and_then(|i| self.document.textures().nth(i as usize))
+            .ok_or_else(|| {
+                self.fail(format!(
+                    "material {material}: {what}'s {key} names no texture of the file"
+                ))
+            })?;
+        let mut reference = self.texture_ref(texture, None, srgb)?;
+        if let Some(transform) = info
+            .get("extensions")
+            .and_then(|e| e.get("KHR_texture_transform"))
+        {
+            let pair = |key: &str, default: [f32; 2]| -> Option<[f32; 2]> {
+                let Some(v) = transform.get(key) else {
+                    return Some(default);
+                };
+                let a = v.as_array()?;
+                match a.as_slice() {
+                    [x, y] => Some([x.as_f64()? as f32, y.as_f64()? as f32]),
+                    _ => None,
+                }
+            };
+            let rotation = match transform.get("rotation") {
+                None => Some(0.0),
+                Some(r) => r.as_f64().map(|r| r as f32),
+            };
+            match (pair("offset", [0.0; 2]), rotation, pair("scale", [1.0; 2])) {
+                (Some(offset), Some(rotation), Some(scale)) => {
+                    reference.offset = offset;
+                    reference.rotation = rotation;
+                    reference.scale = scale;
+                }
+                _ => {
+                    return Err(self.fail(format!(
+                        "material {material}: {what}'s {key} has a malformed KHR_texture_transform"
+                    )));
+                }
+            }
+        }
+        Ok(Some(reference))
+    }
+
     /// The index in `data.textures` of glTF texture `info` decoded as sRGB or linear, with
     /// its `KHR_texture_transform`.
     fn texture_ref(
@@ -721,6 +900,7 @@ impl Loader<'_> {
             converted.transmission_texture =
                 Some(self.texture_ref(info.texture(), info.texture_transform(), false)?);
         }
+        self.specular_and_sheen(material, &mut converted)?;
         // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
         if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
             let dispersion = extension
