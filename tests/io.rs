@@ -471,6 +471,30 @@ fn obj_face_indices_out_of_range_are_errors() {
     assert_eq!(io::load_scene(&path).unwrap().triangle_count(), 1);
 }
 
+/// The MTL PBR extension's sheen colour `Ps` (one or three numbers) makes a
+/// metallic-roughness material with that sheen; out of [0, 1] or NaN it is an error.
+#[test]
+fn mtl_sheen_colour_is_read() {
+    let mtl = b"newmtl velvet\nKd 0.1 0.1 0.5\nPs 0.9 0.5 0.2\nnewmtl grey\nPr 0.5\nPs 0.4\n";
+    let obj =
+        b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl velvet\nf 1 2 3\nusemtl grey\nf 1 2 3\n";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    let velvet = material_named(&data, "velvet").1;
+    assert_eq!(velvet.kind, MaterialKind::MetallicRoughness);
+    assert_eq!(velvet.sheen_color, [0.9, 0.5, 0.2]);
+    assert_eq!(material_named(&data, "grey").1.sheen_color, [0.4; 3]);
+    for bad in ["Ps 1.5", "Ps NaN", "Ps -0.1 0 0", "Ps 0.5 0.5"] {
+        let mtl = format!("newmtl velvet\n{bad}\nnewmtl grey\n");
+        let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl.as_bytes())]);
+        let error = io::load_scene(&dir.join("t.obj"))
+            .err()
+            .expect(bad)
+            .to_string();
+        assert!(error.contains("Ps"), "{bad}: {error}");
+    }
+}
+
 #[test]
 fn mtl_mapping_mirror_tf_glass_defaults_and_faces_without_material() {
     let mtl = b"newmtl m\nKs 0.9 0.8 0.7\nillum 5\n\
