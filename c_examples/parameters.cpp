@@ -392,6 +392,22 @@ void check_materials() {
     show("c++", "material.attenuation_color", cpp.attenuation_color);
     show("c", "material.attenuation_distance", c.attenuation_distance);
     show("c++", "material.attenuation_distance", cpp.attenuation_distance);
+    show("c", "material.specular", c.specular);
+    show("c++", "material.specular", cpp.specular);
+    show("c", "material.specular_color", c.specular_color);
+    show("c++", "material.specular_color", cpp.specular_color);
+    show("c", "material.specular_texture", c.specular_texture);
+    show("c++", "material.specular_texture", cpp.specular_texture);
+    show("c", "material.specular_color_texture", c.specular_color_texture);
+    show("c++", "material.specular_color_texture", cpp.specular_color_texture);
+    show("c", "material.sheen_color", c.sheen_color);
+    show("c++", "material.sheen_color", cpp.sheen_color);
+    show("c", "material.sheen_roughness", c.sheen_roughness);
+    show("c++", "material.sheen_roughness", cpp.sheen_roughness);
+    show("c", "material.sheen_color_texture", c.sheen_color_texture);
+    show("c++", "material.sheen_color_texture", cpp.sheen_color_texture);
+    show("c", "material.sheen_roughness_texture", c.sheen_roughness_texture);
+    show("c++", "material.sheen_roughness_texture", cpp.sheen_roughness_texture);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -498,6 +514,40 @@ void check_materials() {
         MltMaterial cs = c;
         cs.attenuation_distance = 0.0f;
         message("c", "material.attenuation_distance", cs);
+    }
+    {
+        mlt::Material s;
+        s.specular = 2.0f;
+        message("c++", "material.specular", s.to_c());
+        MltMaterial cs = c;
+        cs.specular = 2.0f;
+        message("c", "material.specular", cs);
+    }
+    {
+        mlt::Material s;
+        s.specular_color = {-1.0f, 1.0f, 1.0f};
+        message("c++", "material.specular_color", s.to_c());
+        MltMaterial cs = c;
+        const std::array<float, 3> bad{-1.0f, 1.0f, 1.0f};
+        for (std::size_t i = 0; i < bad.size(); ++i) cs.specular_color[i] = bad[i];
+        message("c", "material.specular_color", cs);
+    }
+    {
+        mlt::Material s;
+        s.sheen_color = {2.0f, 0.0f, 0.0f};
+        message("c++", "material.sheen_color", s.to_c());
+        MltMaterial cs = c;
+        const std::array<float, 3> bad{2.0f, 0.0f, 0.0f};
+        for (std::size_t i = 0; i < bad.size(); ++i) cs.sheen_color[i] = bad[i];
+        message("c", "material.sheen_color", cs);
+    }
+    {
+        mlt::Material s;
+        s.sheen_roughness = 2.0f;
+        message("c++", "material.sheen_roughness", s.to_c());
+        MltMaterial cs = c;
+        cs.sheen_roughness = 2.0f;
+        message("c", "material.sheen_roughness", cs);
     }
     // END GENERATED material checks
 }

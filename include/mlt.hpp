@@ -517,6 +517,30 @@ struct Material {
     /// largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
     /// attenuationDistance).
     float attenuation_distance = 3.4028235e38f;
+    /// Metallic-roughness: strength of the dielectric's specular reflection, 0 a pure diffuse base
+    /// (KHR_materials_specular's specularFactor).
+    float specular = 1.0f;
+    /// Metallic-roughness: scales the dielectric's F0 per channel, linear RGB, may exceed 1 (F0
+    /// times it is clamped to 1; KHR_materials_specular's specularColorFactor).
+    std::array<float, 3> specular_color{1.0f, 1.0f, 1.0f};
+    /// Metallic-roughness: alpha multiplies the specular strength (KHR_materials_specular's
+    /// specularTexture); usually linear.
+    TextureRef specular_texture;
+    /// Metallic-roughness: RGB multiplies the specular colour (KHR_materials_specular's
+    /// specularColorTexture); usually 8-bit sRGB.
+    TextureRef specular_color_texture;
+    /// Metallic-roughness: colour of a sheen layer over the material (velvet, cloth), linear RGB;
+    /// black is none (KHR_materials_sheen's sheenColorFactor).
+    std::array<float, 3> sheen_color{0.0f, 0.0f, 0.0f};
+    /// Metallic-roughness: the sheen's roughness (Charlie distribution, alpha = roughness squared,
+    /// at least 0.07 squared; KHR_materials_sheen's sheenRoughnessFactor).
+    float sheen_roughness = 0.0f;
+    /// Metallic-roughness: RGB multiplies the sheen colour (KHR_materials_sheen's
+    /// sheenColorTexture); usually 8-bit sRGB.
+    TextureRef sheen_color_texture;
+    /// Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
+    /// sheenRoughnessTexture); usually linear.
+    TextureRef sheen_roughness_texture;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -584,6 +608,14 @@ struct Material {
         c.thickness = thickness;
         detail::copy_to(c.attenuation_color, attenuation_color);
         c.attenuation_distance = attenuation_distance;
+        c.specular = specular;
+        detail::copy_to(c.specular_color, specular_color);
+        c.specular_texture = specular_texture.to_c();
+        c.specular_color_texture = specular_color_texture.to_c();
+        detail::copy_to(c.sheen_color, sheen_color);
+        c.sheen_roughness = sheen_roughness;
+        c.sheen_color_texture = sheen_color_texture.to_c();
+        c.sheen_roughness_texture = sheen_roughness_texture.to_c();
         // END GENERATED material to C
         return c;
     }
@@ -617,6 +649,14 @@ struct Material {
         m.thickness = c.thickness;
         m.attenuation_color = detail::to_array(c.attenuation_color);
         m.attenuation_distance = c.attenuation_distance;
+        m.specular = c.specular;
+        m.specular_color = detail::to_array(c.specular_color);
+        m.specular_texture = TextureRef::from_c(c.specular_texture);
+        m.specular_color_texture = TextureRef::from_c(c.specular_color_texture);
+        m.sheen_color = detail::to_array(c.sheen_color);
+        m.sheen_roughness = c.sheen_roughness;
+        m.sheen_color_texture = TextureRef::from_c(c.sheen_color_texture);
+        m.sheen_roughness_texture = TextureRef::from_c(c.sheen_roughness_texture);
         // END GENERATED material from C
         return m;
     }

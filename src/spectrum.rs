@@ -122,6 +122,12 @@ impl Spectrum {
     pub fn max(self, other: Spectrum) -> Spectrum {
         Spectrum(self.0.max(other.0))
     }
+
+    /// The smaller of the two in every channel.
+    #[inline]
+    pub fn min(self, other: Spectrum) -> Spectrum {
+        Spectrum(self.0.min(other.0))
+    }
 }
 
 impl From<[f32; 3]> for Spectrum {

@@ -426,6 +426,96 @@ fn mtl_clearcoat_is_read_and_bad_values_refused() {
     );
 }
 
+/// The sky-spheres scene with its clay given `KHR_materials_specular` and
+/// `KHR_materials_sheen` (`clay_extensions`, JSON members), both listed as required, written
+/// beside its buffer.
+fn sky_spheres_with_clay_extensions(name: &str, clay_extensions: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(scenes().join("sky-spheres.gltf")).unwrap();
+    let edited = text
+        .replacen(
+            r#""name": "clay","#,
+            &format!(r#""name": "clay", "extensions": {{ {clay_extensions} }},"#),
+            1,
+        )
+        .replacen(
+            r#""extensionsUsed": ["#,
+            r#""extensionsRequired": ["KHR_materials_specular", "KHR_materials_sheen"], "extensionsUsed": ["KHR_materials_specular", "KHR_materials_sheen","#,
+            1,
+        );
+    let dir = temp_path(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(
+        scenes().join("sky-spheres.bin"),
+        dir.join("sky-spheres.bin"),
+    )
+    .unwrap();
+    let path = dir.join("sky-spheres.gltf");
+    std::fs::write(&path, edited).unwrap();
+    path
+}
+
+/// `KHR_materials_specular` and `KHR_materials_sheen` are read, factors and textures (with
+/// their texture transforms, colours as sRGB), and a file that requires them loads;
+/// values out of the specifications' ranges are clear errors.
+#[test]
+fn gltf_specular_and_sheen_are_read() {
+    let path = sky_spheres_with_clay_extensions(
+        "specular-sheen",
+        r#""KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [2.0, 1.0, 0.5],
+              "specularTexture": { "index": 1 }, "specularColorTexture": { "index": 1 } },
+            "KHR_materials_sheen": { "sheenColorFactor": [0.9, 0.4, 0.1], "sheenRoughnessFactor": 0.3,
+              "sheenColorTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "scale": [30.0, -30.0] } } },
+              "sheenRoughnessTexture": { "index": 1 } }"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!(clay.specular, 0.5);
+    assert_eq!(clay.specular_color, [2.0, 1.0, 0.5]);
+    assert_eq!(clay.sheen_color, [0.9, 0.4, 0.1]);
+    assert_eq!(clay.sheen_roughness, 0.3);
+    let colour = clay.sheen_color_texture.expect("the sheen colour texture");
+    assert_eq!(colour.scale, [30.0, -30.0]);
+    let linear = clay.normal_texture.unwrap().texture;
+    // Colours are sRGB, strengths and roughnesses linear: one image, two textures.
+    assert_eq!(clay.specular_texture.unwrap().texture, linear);
+    assert_eq!(clay.sheen_roughness_texture.unwrap().texture, linear);
+    assert_ne!(colour.texture, linear);
+    assert_eq!(clay.specular_color_texture.unwrap().texture, colour.texture);
+    let (_, glass) = material_named(&data, "glass");
+    assert_eq!((glass.specular, glass.sheen_color), (1.0, [0.0; 3]));
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+
+    for (bad, needle) in [
+        (
+            r#""KHR_materials_specular": { "specularFactor": -0.5 }"#,
+            "specularFactor",
+        ),
+        (
+            r#""KHR_materials_specular": { "specularColorFactor": [1.0, -1.0, 1.0] }"#,
+            "specularColorFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenColorFactor": [1.5, 0.0, 0.0] }"#,
+            "sheenColorFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenRoughnessFactor": "rough" }"#,
+            "sheenRoughnessFactor",
+        ),
+        (
+            r#""KHR_materials_sheen": { "sheenColorTexture": { "index": 99 } }"#,
+            "sheenColorTexture",
+        ),
+    ] {
+        let path = sky_spheres_with_clay_extensions("specular-sheen-bad", bad);
+        let Err(error) = io::load_scene(&path) else {
+            panic!("{bad} loads");
+        };
+        let error = error.to_string();
+        assert!(error.contains(needle), "{bad}: {error}");
+    }
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");
@@ -496,6 +586,30 @@ fn obj_face_indices_out_of_range_are_errors() {
     let path = temp_path("faces.obj");
     std::fs::write(&path, format!("{head}f 1/1/1 -2/-1/-1 3//1\n")).unwrap();
     assert_eq!(io::load_scene(&path).unwrap().triangle_count(), 1);
+}
+
+/// The MTL PBR extension's sheen colour `Ps` (one or three numbers) makes a
+/// metallic-roughness material with that sheen; out of [0, 1] or NaN it is an error.
+#[test]
+fn mtl_sheen_colour_is_read() {
+    let mtl = b"newmtl velvet\nKd 0.1 0.1 0.5\nPs 0.9 0.5 0.2\nnewmtl grey\nPr 0.5\nPs 0.4\n";
+    let obj =
+        b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl velvet\nf 1 2 3\nusemtl grey\nf 1 2 3\n";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    let velvet = material_named(&data, "velvet").1;
+    assert_eq!(velvet.kind, MaterialKind::MetallicRoughness);
+    assert_eq!(velvet.sheen_color, [0.9, 0.5, 0.2]);
+    assert_eq!(material_named(&data, "grey").1.sheen_color, [0.4; 3]);
+    for bad in ["Ps 1.5", "Ps NaN", "Ps -0.1 0 0", "Ps 0.5 0.5"] {
+        let mtl = format!("newmtl velvet\n{bad}\nnewmtl grey\n");
+        let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl.as_bytes())]);
+        let Err(error) = io::load_scene(&dir.join("t.obj")) else {
+            panic!("{bad} loads");
+        };
+        let error = error.to_string();
+        assert!(error.contains("Ps"), "{bad}: {error}");
+    }
 }
 
 #[test]

@@ -165,6 +165,30 @@ class Material:
     #: largest float (FLT_MAX) is infinity, no absorption (KHR_materials_volume's
     #: attenuationDistance).
     attenuation_distance: float = 3.4028235e38
+    #: Metallic-roughness: strength of the dielectric's specular reflection, 0 a pure diffuse base
+    #: (KHR_materials_specular's specularFactor).
+    specular: float = 1.0
+    #: Metallic-roughness: scales the dielectric's F0 per channel, linear RGB, may exceed 1 (F0
+    #: times it is clamped to 1; KHR_materials_specular's specularColorFactor).
+    specular_color: Vec3 = (1.0, 1.0, 1.0)
+    #: Metallic-roughness: alpha multiplies the specular strength (KHR_materials_specular's
+    #: specularTexture); usually linear.
+    specular_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: RGB multiplies the specular colour (KHR_materials_specular's
+    #: specularColorTexture); usually 8-bit sRGB.
+    specular_color_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: colour of a sheen layer over the material (velvet, cloth), linear RGB;
+    #: black is none (KHR_materials_sheen's sheenColorFactor).
+    sheen_color: Vec3 = (0.0, 0.0, 0.0)
+    #: Metallic-roughness: the sheen's roughness (Charlie distribution, alpha = roughness squared,
+    #: at least 0.07 squared; KHR_materials_sheen's sheenRoughnessFactor).
+    sheen_roughness: float = 0.0
+    #: Metallic-roughness: RGB multiplies the sheen colour (KHR_materials_sheen's
+    #: sheenColorTexture); usually 8-bit sRGB.
+    sheen_color_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
+    #: sheenRoughnessTexture); usually linear.
+    sheen_roughness_texture: Optional[TextureRef] = None
     # END GENERATED material
 
     @classmethod

@@ -312,6 +312,10 @@ mod tests {
             transmission,
             energy_compensation: false,
             clearcoat: Clearcoat::NONE,
+            specular: 1.0,
+            specular_color: Spectrum::ONE,
+            specular_color_max: 1.0,
+            sheen: None,
         }
     }
 

@@ -50,6 +50,7 @@ use super::dielectric::{refract, refracted};
 use super::microfacet::TrowbridgeReitz;
 use super::multiple_scattering::{CoatReflectance, EnergyCompensation};
 use super::scattering::{ScatterSample, TransportMode, reflect};
+use super::sheen::{self, Sheen};
 use super::{BsdfLobes, SpecularLobe};
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
@@ -74,6 +75,16 @@ pub(crate) struct MetallicRoughness {
     pub energy_compensation: bool,
     /// The clear coat over all of it (factor 0: none).
     pub clearcoat: Clearcoat,
+    /// `KHR_materials_specular`: the strength of the dielectric's specular reflection, in
+    /// [0, 1] (F0 and F90 are scaled by it).
+    pub specular: f32,
+    /// `KHR_materials_specular`: the colour scaling the dielectric's F0 (not negative; F0
+    /// times it is clamped to 1), each lane at most `specular_color_max`.
+    pub specular_color: Spectrum,
+    /// The specular colour's largest RGB channel: what the base beneath is weighted by.
+    pub specular_color_max: f32,
+    /// `KHR_materials_sheen`: the sheen layer over the whole material, if it has one.
+    pub sheen: Option<Sheen>,
 }
 
 /// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
@@ -144,6 +155,8 @@ struct LobeChoice {
     /// The sum of the lobes' albedo estimates (before normalizing), which the clear coat's
     /// share is weighed against.
     total: f32,
+    /// The sheen layer's lobe (0 without sheen).
+    sheen: f32,
 }
 
 /// Every lobe that can scatter is picked at least this often (before normalizing), so a
@@ -170,19 +183,22 @@ fn schlick_spectrum(f0: Spectrum, cos: f32) -> Spectrum {
     f0 + (Spectrum::ONE - f0) * ((m * m) * (m * m) * m)
 }
 
-/// The reflectance of a dielectric interface for light arriving at cosine `cos_o` (to the
-/// microfacet) on the side of index η_o, with `eta` = η_o / η_t: Schlick's with the cosine
-/// on the side of the lower index, 1 under total internal reflection.
+/// Schlick's Fresnel with a normal reflectance per lane, rounded as [`schlick`] is.
 #[inline]
-fn interface_reflectance(f0: f32, cos_o: f32, eta: f32) -> f32 {
+fn schlick_lanes(f0: Spectrum, cos: f32) -> Spectrum {
+    let m = (1.0 - cos).clamp(0.0, 1.0);
+    f0 + (Spectrum::ONE - f0) * (m * m) * (m * m) * m
+}
+
+/// The cosine on the side of the lower index for light arriving at cosine `cos_o` on the
+/// side of index η_o, with `eta` = η_o / η_t; `None` under total internal reflection.
+#[inline]
+fn rarer_cosine(cos_o: f32, eta: f32) -> Option<f32> {
     if eta <= 1.0 {
-        return schlick(f0, cos_o);
+        return Some(cos_o);
     }
     let sin_t2 = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
-    if sin_t2 >= 1.0 {
-        return 1.0;
-    }
-    schlick(f0, (1.0 - sin_t2).sqrt())
+    (sin_t2 < 1.0).then(|| (1.0 - sin_t2).sqrt())
 }
 
 #[inline]
@@ -225,7 +241,10 @@ impl MetallicRoughness {
         } else {
             BsdfLobes::SPECULAR
         };
-        let base = if self.diffuse_tint().is_black() && self.compensation().is_none() {
+        let base = if self.diffuse_tint().is_black()
+            && self.compensation().is_none()
+            && self.sheen.is_none()
+        {
             scattering
         } else {
             scattering | BsdfLobes::DIFFUSE
@@ -288,6 +307,10 @@ impl MetallicRoughness {
                     let wi = refracted(self.ior, normal, wo)?;
                     Some(self.specular_transmission(&view, wi, choice, mode))
                 }
+                Lobe::Sheen => {
+                    let local = sheen::uniform_hemisphere(u);
+                    self.diffuse_scatter(&view, choice, local, view.basis.to_world(local))
+                }
             };
         };
         let local = match lobe {
@@ -302,6 +325,7 @@ impl MetallicRoughness {
                 let m = distribution.sample_visible_normal(view.wo, u);
                 refract_through(view.wo, m, view.eta()).filter(|wi| wi.z < 0.0)
             }
+            Lobe::Sheen => Some(sheen::uniform_hemisphere(u)).filter(|wi| wi.z > 0.0),
         }?;
         self.rough_scatter(&view, choice, local, view.basis.to_world(local), mode)
     }
@@ -376,7 +400,7 @@ impl MetallicRoughness {
         let mirror = Vec3A::new(-view.wo.x, -view.wo.y, view.wo.z);
         let dirac = self.distribution().is_none()
             && (local.z < 0.0
-                || choice.diffuse == 0.0
+                || choice.diffuse == 0.0 && choice.sheen == 0.0
                 || local.dot(mirror) > 1.0 - MIRROR_TOLERANCE);
         self.scatter_local(&view, choice, local, wi, mode, dirac)
     }
@@ -572,21 +596,54 @@ impl MetallicRoughness {
         r * r
     }
 
-    /// The Fresnel reflectance of the opaque part of the dielectric: the interface seen
-    /// from the outside, whichever side `wo` is on.
+    /// The dielectric's normal reflectance per lane with `KHR_materials_specular`'s colour,
+    /// min(F0 · specular_color, 1) (before the strength `specular`).
+    #[inline]
+    fn specular_f0(&self) -> Spectrum {
+        (Spectrum::splat(self.f0()) * self.specular_color).min(Spectrum::ONE)
+    }
+
+    /// The largest channel of [`Self::specular_f0`] (by the RGB colour).
+    #[inline]
+    fn specular_f0_max(&self) -> f32 {
+        (self.f0() * self.specular_color_max).min(1.0)
+    }
+
+    /// The dielectric interface's reflectance by lane at cosine `cos` to `wo` (η = `eta`):
+    /// `specular` × Schlick's with the specular F0, 1 under total internal reflection.
+    #[inline]
+    fn dielectric_reflectance(&self, cos: f32, eta: f32) -> Spectrum {
+        match rarer_cosine(cos, eta) {
+            Some(rarer) => schlick_lanes(self.specular_f0(), rarer) * self.specular,
+            None => Spectrum::ONE,
+        }
+    }
+
+    /// The largest channel of [`Self::dielectric_reflectance`]: what the layers it covers
+    /// (the diffuse base, the transmission) are weighted by, one minus it.
+    #[inline]
+    fn dielectric_reflectance_max(&self, cos: f32, eta: f32) -> f32 {
+        match rarer_cosine(cos, eta) {
+            Some(rarer) => self.specular * schlick(self.specular_f0_max(), rarer),
+            None => 1.0,
+        }
+    }
+
+    /// The largest channel of the Fresnel reflectance of the opaque part of the dielectric:
+    /// the interface seen from the outside, whichever side `wo` is on.
     #[inline]
     fn opaque_reflectance(&self, cos: f32) -> f32 {
-        interface_reflectance(self.f0(), cos, 1.0 / self.ior)
+        self.dielectric_reflectance_max(cos, 1.0 / self.ior)
     }
 
     /// The reflection's Fresnel factor at a microfacet (or the normal) at cosine `cos` to
     /// `wo`: the metal's, and the dielectric's opaque and transmissive parts'.
     #[inline]
     fn reflectance(&self, cos: f32, eta: f32) -> Spectrum {
-        let dielectric = (1.0 - self.transmission) * self.opaque_reflectance(cos)
-            + self.transmission * interface_reflectance(self.f0(), cos, eta);
-        schlick_spectrum(self.base_color, cos) * self.metallic
-            + Spectrum::splat((1.0 - self.metallic) * dielectric)
+        let dielectric = self.dielectric_reflectance(cos, 1.0 / self.ior)
+            * (1.0 - self.transmission)
+            + self.dielectric_reflectance(cos, eta) * self.transmission;
+        schlick_spectrum(self.base_color, cos) * self.metallic + dielectric * (1.0 - self.metallic)
     }
 
     /// The metal's multiple-scattering compensation, if it has one: asked for, rough and
@@ -624,7 +681,7 @@ impl MetallicRoughness {
     /// Fresnel factors at the macro normal times the tints.
     fn lobe_choice(&self, view: &View) -> LobeChoice {
         let cos_o = view.wo.z;
-        let transmitted = 1.0 - interface_reflectance(self.f0(), cos_o, view.eta());
+        let transmitted = 1.0 - self.dielectric_reflectance_max(cos_o, view.eta());
         let reflection = mean(self.reflectance(cos_o, view.eta()));
         // The base's albedo is (1 − R(cos_o)) of its tint; 1 − F(cos_o) is close to it and
         // cheaper (estimates only need to be positive where the lobe scatters).
@@ -651,36 +708,79 @@ impl MetallicRoughness {
         let multiple = self.compensation().map_or(0.0, |c| {
             mean(self.multiple_scattering_tint(&c)) * (1.0 - c.albedo(cos_o))
         });
-        let total = reflection + diffuse + transmission + multiple;
+        // ---- sheen layer: its lobe's estimate ----
+        let sheen = self
+            .sheen
+            .map_or(0.0, |s| s.estimate(cos_o).max(MIN_LOBE_WEIGHT));
+        let total = reflection + diffuse + transmission + multiple + sheen;
         LobeChoice {
             reflection: reflection / total,
             diffuse: diffuse / total,
             transmission: transmission / total,
             multiple: multiple / total,
             total,
+            sheen: sheen / total,
         }
     }
 
     /// The reflectance of the coat over the diffuse base: the dielectric's reflection seen
-    /// from the outside.
+    /// from the outside, by its largest channel (before the strength `specular`).
     #[inline]
     fn coat(&self) -> CoatReflectance {
-        CoatReflectance::new(self.roughness, self.f0())
+        CoatReflectance::new(self.roughness, self.specular_f0_max())
     }
 
     /// The diffuse base's f at cosines `cos_o`, `cos_i` (same side), scaled by what the
     /// coat does not reflect at either: (1 − R(μo)) (1 − R(μi)) / (1 − R_avg), whose
-    /// cosine-weighted integral over μi is 1 − R(μo) (see the module's documentation).
+    /// cosine-weighted integral over μi is 1 − R(μo) (see the module's documentation), R
+    /// the coat's reflectance times `specular`. A coat that reflects everything (R = 1)
+    /// leaves nothing.
     #[inline]
     fn diffuse_f(&self, cos_o: f32, cos_i: f32) -> Spectrum {
         let coat = self.coat();
-        let through = (1.0 - coat.reflectance(cos_o)) * (1.0 - coat.reflectance(cos_i))
-            / (1.0 - coat.average());
+        let through_average = 1.0 - self.specular * coat.average();
+        if through_average <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let through = (1.0 - self.specular * coat.reflectance(cos_o))
+            * (1.0 - self.specular * coat.reflectance(cos_i))
+            / through_average;
         self.diffuse_tint() * (through * FRAC_1_PI)
     }
 
-    /// f of the lobes with a density, `wi` in the view's frame.
+    /// f of the lobes with a density, `wi` in the view's frame: the layers beneath the
+    /// sheen, scaled by what it leaves them, and the sheen's lobe.
+    #[inline]
     fn eval_local(&self, view: &View, wi: Vec3A, mode: TransportMode) -> Spectrum {
+        let f = self.base_eval_local(view, wi, mode);
+        // ---- sheen layer ----
+        match &self.sheen {
+            None => f,
+            Some(sheen) => f * sheen.scaling(view.wo.z, wi.z) + sheen.f(view.wo, wi),
+        }
+    }
+
+    /// The density of `sample` through the lobes with a density, `wi` in the view's frame.
+    #[inline]
+    fn pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
+        let pdf = self.base_pdf_local(view, choice, wi);
+        // ---- sheen layer: its lobe, uniform over wo's hemisphere ----
+        if choice.sheen > 0.0 && wi.z > 0.0 {
+            pdf + choice.sheen * sheen::UNIFORM_HEMISPHERE_PDF
+        } else {
+            pdf
+        }
+    }
+
+    /// What the sheen layer leaves of a Dirac lobe's weight into `wi`.
+    #[inline]
+    fn sheen_scaling(&self, view: &View, wi: Vec3A) -> f32 {
+        self.sheen
+            .map_or(1.0, |s| s.scaling(view.wo.z, view.local(wi).z))
+    }
+
+    /// f of the lobes beneath the sheen with a density, `wi` in the view's frame.
+    fn base_eval_local(&self, view: &View, wi: Vec3A, mode: TransportMode) -> Spectrum {
         let wo = view.wo;
         if wi.z > 0.0 {
             let mut f = self.diffuse_f(wo.z, wi.z);
@@ -711,21 +811,22 @@ impl MetallicRoughness {
             TransportMode::Importance => view.eta_t * view.eta_t,
         };
         // Schlick's F at the cosine on the side of the lower index, as
-        // `interface_reflectance`, but taken from the pair: recomputing it from Snell's law
+        // `dielectric_reflectance`, but taken from the pair: recomputing it from Snell's law
         // near the critical angle would cancel catastrophically (and break reciprocity).
         let rarer_cos = if view.eta_o <= view.eta_t {
             cos_oh
         } else {
             -cos_ih
         };
-        let transmitted = 1.0 - schlick(self.f0(), rarer_cos);
+        let transmitted = 1.0 - self.specular * schlick(self.specular_f0_max(), rarer_cos);
         let microfacets = distribution.d(h) * distribution.g2(wo, wi) * (cos_oh * cos_ih).abs()
             / (wo.z * wi.z.abs() * denominator * denominator);
         self.transmission_tint() * (transmitted * eta_scale * microfacets)
     }
 
-    /// The density of `sample` through the lobes with a density, `wi` in the view's frame.
-    fn pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
+    /// The density of `sample` through the lobes beneath the sheen with a density, `wi` in
+    /// the view's frame.
+    fn base_pdf_local(&self, view: &View, choice: LobeChoice, wi: Vec3A) -> f32 {
         let wo = view.wo;
         if wi.z > 0.0 {
             let mut pdf = (choice.diffuse + choice.multiple) * cosine_hemisphere_pdf(wi.z);
@@ -779,7 +880,8 @@ impl MetallicRoughness {
         })
     }
 
-    /// Roughness 0's diffuse base scattering into `wi` (`local` in the view's frame).
+    /// Roughness 0's diffuse base (and sheen) scattering into `wi` (`local` in the view's
+    /// frame).
     fn diffuse_scatter(
         &self,
         view: &View,
@@ -787,6 +889,10 @@ impl MetallicRoughness {
         local: Vec3A,
         wi: Vec3A,
     ) -> Option<ScatterSample> {
+        // ---- sheen layer: the lobes with a density are the base's and the sheen's ----
+        if self.sheen.is_some() {
+            return self.rough_scatter(view, choice, local, wi, TransportMode::Radiance);
+        }
         let pdf = choice.diffuse * cosine_hemisphere_pdf(local.z);
         (pdf > 0.0).then(|| ScatterSample {
             wi,
@@ -801,7 +907,8 @@ impl MetallicRoughness {
     fn specular_reflection(&self, view: &View, wi: Vec3A, choice: LobeChoice) -> ScatterSample {
         ScatterSample {
             wi,
-            weight: self.reflectance(view.wo.z, view.eta()) / choice.reflection,
+            weight: self.reflectance(view.wo.z, view.eta())
+                * (self.sheen_scaling(view, wi) / choice.reflection),
             pdf: choice.reflection,
             specular: true,
             radiance_scale: 1.0,
@@ -821,7 +928,8 @@ impl MetallicRoughness {
             TransportMode::Radiance => eta * eta,
             TransportMode::Importance => 1.0,
         };
-        let transmitted = 1.0 - interface_reflectance(self.f0(), view.wo.z, eta);
+        let transmitted = 1.0 - self.dielectric_reflectance_max(view.wo.z, eta);
+        let transmitted = transmitted * self.sheen_scaling(view, wi);
         ScatterSample {
             wi,
             weight: self.transmission_tint() * (transmitted * scale / choice.transmission),
@@ -1062,6 +1170,7 @@ enum Lobe {
     Diffuse,
     Transmission,
     MultipleScattering,
+    Sheen,
 }
 
 impl LobeChoice {
@@ -1075,6 +1184,7 @@ impl LobeChoice {
             (Lobe::Diffuse, self.diffuse),
             (Lobe::Transmission, self.transmission),
             (Lobe::MultipleScattering, self.multiple),
+            (Lobe::Sheen, self.sheen),
         ] {
             cumulative += probability;
             if u < cumulative {
@@ -1083,6 +1193,7 @@ impl LobeChoice {
         }
         // Rounding left u past the sum: the last lobe that has a probability.
         [
+            (Lobe::Sheen, self.sheen),
             (Lobe::MultipleScattering, self.multiple),
             (Lobe::Transmission, self.transmission),
             (Lobe::Diffuse, self.diffuse),
@@ -1129,12 +1240,23 @@ mod tests {
             transmission,
             energy_compensation: false,
             clearcoat: Clearcoat::NONE,
+            specular: 1.0,
+            specular_color: Spectrum::ONE,
+            specular_color_max: 1.0,
+            sheen: None,
         }
+    }
+
+    /// A white sheen layer of `roughness` (white, so that the furnaces test it).
+    fn white_sheen(roughness: f32) -> Option<Sheen> {
+        Sheen::new(Spectrum::ONE, 1.0, roughness)
     }
 
     /// The materials the statistical tests cover: each roughness with metal, dielectric and
     /// their mixture, opaque and transmissive, over three indices (a metal has no index);
-    /// the metal and a mixture also with the energy compensation.
+    /// the metal and a mixture also with the energy compensation; `KHR_materials_specular`'s
+    /// strength and colours (beyond 1, up to F0 clamped to 1); sheen over the diffuse base,
+    /// the metal and transmission.
     fn materials(roughnesses: &[f32]) -> Vec<MetallicRoughness> {
         let mut all = Vec::new();
         for &roughness in roughnesses {
@@ -1155,6 +1277,36 @@ mod tests {
                     ..material(roughness, metallic, transmission, 1.5)
                 });
             }
+        }
+        for &roughness in roughnesses {
+            for transmission in [0.0, 1.0] {
+                all.push(MetallicRoughness {
+                    specular: 0.6,
+                    specular_color: Spectrum::new(50.0, 1.0, 0.2),
+                    specular_color_max: 50.0,
+                    ..material(roughness, 0.0, transmission, 1.5)
+                });
+            }
+            all.push(MetallicRoughness {
+                sheen: Sheen::new(Spectrum::new(0.9, 0.5, 0.2), 0.9, 0.5),
+                ..material(roughness, 0.0, 0.0, 1.5)
+            });
+            all.push(MetallicRoughness {
+                sheen: white_sheen(0.0),
+                ..material(roughness, 1.0, 0.0, 1.5)
+            });
+            all.push(MetallicRoughness {
+                sheen: white_sheen(1.0),
+                specular: 0.8,
+                specular_color: Spectrum::new(2.0, 1.0, 0.5),
+                specular_color_max: 2.0,
+                ..material(roughness, 0.0, 1.0, 1.33)
+            });
+            all.push(MetallicRoughness {
+                sheen: white_sheen(0.2),
+                energy_compensation: true,
+                ..material(roughness, 0.5, 0.5, 1.5)
+            });
         }
         all
     }
@@ -1367,18 +1519,24 @@ mod tests {
     }
 
     /// The albedo ∫ f |cos| dωi (importance mode: the scattered share of the incident
-    /// flux), estimated by sampling.
+    /// flux), estimated by sampling, the directions' `u` stratified on a square grid of
+    /// about `draws` cells (a low sheen roughness's peak at grazing angles makes plain
+    /// sampling noisy).
     fn albedo(m: &MetallicRoughness, wo: Vec3A, draws: usize, rng: &mut Rng) -> Spectrum {
         let n = normal();
+        let k = (draws as f64).sqrt() as usize;
         let mut sum = Spectrum::ZERO;
-        for _ in 0..draws {
-            let u = rng.uniform2();
-            let u_lobe = rng.uniform();
-            if let Some(s) = m.sample(n, wo, u, u_lobe, TransportMode::Importance) {
-                sum += s.weight;
+        for i in 0..k {
+            for j in 0..k {
+                let [a, b] = rng.uniform2();
+                let u = [(i as f32 + a) / k as f32, (j as f32 + b) / k as f32];
+                let u_lobe = rng.uniform();
+                if let Some(s) = m.sample(n, wo, u, u_lobe, TransportMode::Importance) {
+                    sum += s.weight;
+                }
             }
         }
-        sum * (1.0 / draws as f32)
+        sum * (1.0 / (k * k) as f32)
     }
 
     /// No material, white or tinted, scatters more than it receives.
@@ -1395,8 +1553,10 @@ mod tests {
             .collect();
         all.extend(white);
         for m in all {
+            // A sheen's peak at grazing angles needs more draws for the same noise.
+            let draws = if m.sheen.is_some() { 250_000 } else { 40_000 };
             for theta in ANGLES.into_iter().chain([89.5]) {
-                let a = albedo(&m, direction(theta), 40_000, &mut rng);
+                let a = albedo(&m, direction(theta), draws, &mut rng);
                 assert!(a.max_component() <= 1.01, "{m:?} θ {theta}: albedo {a}");
             }
         }
@@ -1747,6 +1907,179 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// With specular strength 0 the dielectric is its diffuse base alone: f = c/π for
+    /// every pair of directions on one side, at every roughness and specular colour.
+    #[test]
+    fn specular_zero_leaves_the_diffuse_base_alone() {
+        let n = normal();
+        for roughness in [0.0f32, 0.3, 1.0] {
+            for color in [Spectrum::ONE, Spectrum::new(50.0, 1.0, 0.0)] {
+                let m = MetallicRoughness {
+                    base_color: Spectrum::splat(0.8),
+                    specular: 0.0,
+                    specular_color: color,
+                    specular_color_max: color.max_component(),
+                    ..material(roughness, 0.0, 0.0, 1.5)
+                };
+                for (a, b) in [(0.0f32, 0.0f32), (10.0, 60.0), (45.0, 89.0), (80.0, 5.0)] {
+                    let f = m.eval(n, direction(a), direction(b), TransportMode::Radiance);
+                    let expected = 0.8 * FRAC_1_PI;
+                    assert!(
+                        (f - Spectrum::splat(expected)).abs().max_component() < 1e-6,
+                        "roughness {roughness} {a}° {b}°: {f} vs {expected}"
+                    );
+                }
+                let mut rng = Rng::new(45, 10);
+                let a = albedo(&m, normal(), 100_000, &mut rng);
+                assert!((a[0] - 0.8).abs() < 2e-3, "roughness {roughness}: {a}");
+            }
+        }
+    }
+
+    /// A specular colour large enough to clamp F0 at 1 (and any between) never reflects
+    /// more than arrives, white base or not, opaque or transmissive, at any angle; with
+    /// F0 clamped at 1 and strength 1 the diffuse base is gone.
+    #[test]
+    fn specular_colour_never_creates_energy() {
+        let mut rng = Rng::new(45, 11);
+        for roughness in [0.0f32, 0.2, 0.6, 1.0] {
+            for scale in [1.0f32, 5.0, 25.0, 100.0] {
+                for transmission in [0.0, 1.0] {
+                    let m = MetallicRoughness {
+                        base_color: Spectrum::ONE,
+                        specular_color: Spectrum::new(scale, scale * 0.5, 1.0),
+                        specular_color_max: scale.max(1.0),
+                        ..material(roughness, 0.0, transmission, 1.5)
+                    };
+                    for theta in [0.0f32, 40.0, 75.0, 89.0, 150.0] {
+                        let a = albedo(&m, direction(theta), 30_000, &mut rng);
+                        assert!(
+                            a.max_component() <= 1.01,
+                            "roughness {roughness} colour ×{scale} transmission {transmission} θ {theta}: {a}"
+                        );
+                    }
+                }
+            }
+            let mirror_like = MetallicRoughness {
+                specular_color: Spectrum::splat(100.0),
+                specular_color_max: 100.0,
+                ..material(roughness, 0.0, 0.0, 1.5)
+            };
+            assert!(mirror_like.diffuse_f(0.5, 0.7).is_black());
+        }
+    }
+
+    /// Sheen over a diffuse base, a metal, transmission and their mixtures, white
+    /// everywhere: never more than arrives, at any angle, at any sheen roughness (the
+    /// lowest is where the specification's lobe alone would reflect up to 2.9 times). The
+    /// true albedos come within 1% of 1 at grazing angles (0.990 at 88° over a rough
+    /// dielectric at the lowest sheen roughness, by 4 million stratified draws).
+    #[test]
+    fn white_furnace_with_sheen_is_at_most_one() {
+        let mut rng = Rng::new(45, 12);
+        for sheen_roughness in [0.0f32, 0.15, 0.4, 1.0] {
+            for roughness in [0.0f32, 0.3, 1.0] {
+                for (metallic, transmission) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (0.3, 0.3)] {
+                    let m = MetallicRoughness {
+                        base_color: Spectrum::ONE,
+                        sheen: white_sheen(sheen_roughness),
+                        energy_compensation: true,
+                        ..material(roughness, metallic, transmission, 1.5)
+                    };
+                    for theta in [0.0f32, 50.0, 80.0, 88.0, 89.7, 135.0, 178.0] {
+                        let a = albedo(&m, direction(theta), 250_000, &mut rng);
+                        assert!(
+                            a.max_component() <= 1.01,
+                            "sheen roughness {sheen_roughness} {m:?} θ {theta}: {a}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// The specification's sheen lobe, from its formulas (Charlie D, its fitted Λ),
+    /// integrated over wi in f64 by the midpoint rule (2000 polar × 1000 azimuth nodes
+    /// over the half plane): the white sheen layer's directional albedo.
+    fn specification_sheen_albedo(roughness: f64, theta_deg: f64) -> f64 {
+        use std::f64::consts::PI;
+        let alpha = roughness * roughness;
+        let fit = |x: f64| {
+            let t = (1.0 - alpha) * (1.0 - alpha);
+            let mix = |a: f64, b: f64| a * (1.0 - t) + b * t;
+            mix(21.5473, 25.3245) / (1.0 + mix(3.82987, 3.32435) * x.powf(mix(0.19823, 0.16801)))
+                + mix(-1.97760, -1.27393) * x
+                + mix(-4.32054, -4.85967)
+        };
+        let lambda = |mu: f64| {
+            if mu < 0.5 {
+                fit(mu).exp()
+            } else {
+                (2.0 * fit(0.5) - fit(1.0 - mu)).exp()
+            }
+        };
+        let (sin_o, mu_o) = theta_deg.to_radians().sin_cos();
+        let (n_theta, n_phi) = (2000, 1000);
+        let mut sum = 0.0;
+        for i in 0..n_theta {
+            let theta = (i as f64 + 0.5) / n_theta as f64 * PI / 2.0;
+            let (sin_i, mu_i) = theta.sin_cos();
+            for j in 0..n_phi {
+                let phi = (j as f64 + 0.5) / n_phi as f64 * PI;
+                let h = [sin_o + sin_i * phi.cos(), sin_i * phi.sin(), mu_o + mu_i];
+                let cos_h = h[2] / (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+                let d = (2.0 + 1.0 / alpha) * (1.0 - cos_h * cos_h).powf(0.5 / alpha) / (2.0 * PI);
+                let f = d / ((1.0 + lambda(mu_o) + lambda(mu_i)) * 4.0 * mu_o * mu_i);
+                sum += f * mu_i * sin_i;
+            }
+        }
+        sum * (PI / 2.0 / n_theta as f64) * (2.0 * PI / n_phi as f64)
+    }
+
+    /// The sheen layer alone (over a black base without specular reflection), sampled by
+    /// `sample` on a stratified grid, reflects the specification's directional albedo
+    /// within 0.5%, at roughnesses where that conserves energy (below 0.25 the lobe is
+    /// normalized; `sheen`'s tests cover it).
+    #[test]
+    fn sheen_albedo_is_the_specifications() {
+        let n = normal();
+        let mut rng = Rng::new(45, 13);
+        for sheen_roughness in [0.3f32, 0.6, 1.0] {
+            let m = MetallicRoughness {
+                base_color: Spectrum::ZERO,
+                specular: 0.0,
+                sheen: white_sheen(sheen_roughness),
+                ..material(0.5, 0.0, 0.0, 1.5)
+            };
+            for theta in [0.0f32, 30.0, 60.0, 80.0] {
+                let wo = direction(theta);
+                let k = 500;
+                let mut sum = 0.0f64;
+                for i in 0..k {
+                    for j in 0..k {
+                        let [a, b] = rng.uniform2();
+                        let u = [(i as f32 + a) / k as f32, (j as f32 + b) / k as f32];
+                        if let Some(s) =
+                            m.sample(n, wo, u, rng.uniform(), TransportMode::Importance)
+                        {
+                            sum += s.weight[0] as f64;
+                        }
+                    }
+                }
+                let ours = sum / (k * k) as f64;
+                let specification =
+                    specification_sheen_albedo(sheen_roughness as f64, theta as f64);
+                println!(
+                    "sheen roughness {sheen_roughness} θ {theta}: {ours:.5} vs {specification:.5}"
+                );
+                assert!(
+                    (ours / specification - 1.0).abs() < 0.005,
+                    "sheen roughness {sheen_roughness} θ {theta}: {ours} vs the specification's {specification}"
+                );
             }
         }
     }

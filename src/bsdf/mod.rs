@@ -15,11 +15,13 @@ mod metallic_roughness;
 mod microfacet;
 mod multiple_scattering;
 mod scattering;
+mod sheen;
 
 pub(crate) use clearcoat::Clearcoat;
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
+pub(crate) use sheen::Sheen;
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;

@@ -55,6 +55,14 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         thickness,
         attenuation_color,
         attenuation_distance,
+        specular,
+        specular_color,
+        specular_texture,
+        specular_color_texture,
+        sheen_color,
+        sheen_roughness,
+        sheen_color_texture,
+        sheen_roughness_texture,
         // END GENERATED material from C
     }
 }

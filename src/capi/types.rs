@@ -264,6 +264,37 @@ pub struct MltMaterial {
     /// attenuationDistance). An attenuation distance must be greater than 0 (the largest float: no
     /// absorption). Default 3.4028235e38.
     pub attenuation_distance: f32,
+    /// Metallic-roughness: strength of the dielectric's specular reflection, 0 a pure diffuse base
+    /// (KHR_materials_specular's specularFactor). It must be in [0, 1]. Default 1.0.
+    pub specular: f32,
+    /// Metallic-roughness: scales the dielectric's F0 per channel, linear RGB, may exceed 1 (F0
+    /// times it is clamped to 1; KHR_materials_specular's specularColorFactor). A specular colour
+    /// must not be negative. Default 1.0, 1.0, 1.0.
+    pub specular_color: [f32; 3],
+    /// Metallic-roughness: alpha multiplies the specular strength (KHR_materials_specular's
+    /// specularTexture); usually linear. An index into `MltSceneDesc.textures` and its transform.
+    /// Default `MLT_NO_TEXTURE` (-1).
+    pub specular_texture: MltTextureRef,
+    /// Metallic-roughness: RGB multiplies the specular colour (KHR_materials_specular's
+    /// specularColorTexture); usually 8-bit sRGB. An index into `MltSceneDesc.textures` and its
+    /// transform. Default `MLT_NO_TEXTURE` (-1).
+    pub specular_color_texture: MltTextureRef,
+    /// Metallic-roughness: colour of a sheen layer over the material (velvet, cloth), linear RGB;
+    /// black is none (KHR_materials_sheen's sheenColorFactor). A reflectance must be in [0, 1];
+    /// above 1 would create energy. Default 0.0, 0.0, 0.0.
+    pub sheen_color: [f32; 3],
+    /// Metallic-roughness: the sheen's roughness (Charlie distribution, alpha = roughness squared,
+    /// at least 0.07 squared; KHR_materials_sheen's sheenRoughnessFactor). It must be in [0, 1].
+    /// Default 0.0.
+    pub sheen_roughness: f32,
+    /// Metallic-roughness: RGB multiplies the sheen colour (KHR_materials_sheen's
+    /// sheenColorTexture); usually 8-bit sRGB. An index into `MltSceneDesc.textures` and its
+    /// transform. Default `MLT_NO_TEXTURE` (-1).
+    pub sheen_color_texture: MltTextureRef,
+    /// Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
+    /// sheenRoughnessTexture); usually linear. An index into `MltSceneDesc.textures` and its
+    /// transform. Default `MLT_NO_TEXTURE` (-1).
+    pub sheen_roughness_texture: MltTextureRef,
     // END GENERATED material
 }
 

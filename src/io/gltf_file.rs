@@ -27,6 +27,8 @@ const MAX_NODE_DEPTH: usize = 1024;
 const EXTENSIONS_READ_HERE: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_dispersion",
+    "KHR_materials_sheen",
+    "KHR_materials_specular",
     "KHR_materials_unlit",
     "KHR_materials_variants",
     "KHR_materials_volume",
@@ -608,6 +610,131 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// `KHR_materials_specular` and `KHR_materials_sheen` (read from the JSON: the gltf
+    /// crate parses neither), with their textures and the textures' `KHR_texture_transform`;
+    /// numbers out of the specifications' ranges are errors.
+    fn specular_and_sheen(
+        &mut self,
+        material: &::gltf::Material,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let name = material
+            .index()
+            .map_or("(default)".into(), |i| i.to_string());
+        if let Some(extension) = material.extension_value("KHR_materials_specular") {
+            let what = "KHR_materials_specular";
+            converted.specular =
+                self.json_number(extension, "specularFactor", 1.0, (0.0, 1.0), what, &name)?;
+            converted.specular_color = self.json_colour(
+                extension,
+                "specularColorFactor",
+                [1.0; 3],
+                (0.0, f32::MAX),
+                what,
+                &name,
+            )?;
+            converted.specular_texture =
+                self.json_texture(extension, "specularTexture", false, what, &name)?;
+            converted.specular_color_texture =
+                self.json_texture(extension, "specularColorTexture", true, what, &name)?;
+        }
+        if let Some(extension) = material.extension_value("KHR_materials_sheen") {
+            let what = "KHR_materials_sheen";
+            converted.sheen_color = self.json_colour(
+                extension,
+                "sheenColorFactor",
+                [0.0; 3],
+                (0.0, 1.0),
+                what,
+                &name,
+            )?;
+            converted.sheen_roughness = self.json_number(
+                extension,
+                "sheenRoughnessFactor",
+                0.0,
+                (0.0, 1.0),
+                what,
+                &name,
+            )?;
+            converted.sheen_color_texture =
+                self.json_texture(extension, "sheenColorTexture", true, what, &name)?;
+            converted.sheen_roughness_texture =
+                self.json_texture(extension, "sheenRoughnessTexture", false, what, &name)?;
+        }
+        Ok(())
+    }
+
+    /// The number `key` of an extension's JSON (`default` if absent), within `range`.
+    fn json_number(
+        &self,
+        extension: &::serde_json::Value,
+        key: &str,
+        default: f32,
+        (min, max): (f32, f32),
+        what: &str,
+        material: &str,
+    ) -> Result<f32, IoError> {
+        let Some(value) = extension.get(key) else {
+            return Ok(default);
+        };
+        value
+            .as_f64()
+            .map(|v| v as f32)
+            .filter(|v| v.is_finite() && (min..=max).contains(v))
+            .ok_or_else(|| {
+                self.fail(format!(
+                    "material {material}: {what}'s {key} is {value}; it must be a number in [{min}, {max}]"
+                ))
+            })
+    }
+
+    /// The RGB colour `key` of an extension's JSON (`default` if absent), each channel
+    /// within `range`.
+    fn json_colour(
+        &self,
+        extension: &::serde_json::Value,
+        key: &str,
+        default: [f32; 3],
+        (min, max): (f32, f32),
+        what: &str,
+        material: &str,
+    ) -> Result<[f32; 3], IoError> {
+        let Some(value) = extension.get(key) else {
+            return Ok(default);
+        };
+        let channels: Option<Vec<f32>> = value.as_array().and_then(|a| {
+            a.iter()
+                .map(|c| c.as_f64().map(|c| c as f32))
+                .collect::<Option<Vec<f32>>>()
+        });
+        match channels.as_deref() {
+            Some(&[r, g, b]) if [r, g, b].iter().all(|c| c.is_finite() && (min..=max).contains(c)) => {
+                Ok([r, g, b])
+            }
+            _ => Err(self.fail(format!(
+                "material {material}: {what}'s {key} is {value}; it must be three numbers in [{min}, {max}]"
+            ))),
+        }
+    }
+
+    /// The texture `key` of an extension's JSON (a textureInfo), decoded as sRGB or linear,
+    /// with its `KHR_texture_transform`.
+    fn json_texture(
+        &mut self,
+        extension: &::serde_json::Value,
+        key: &str,
+        srgb: bool,
+        what: &str,
+        material: &str,
+    ) -> Result<Option<TextureRef>, IoError> {
+        extension
+            .get(key)
+            .map(|info| {
+                self.texture_info(info, &format!("material {material}: {what}'s {key}"), srgb)
+            })
+            .transpose()
+    }
+
     /// The index in `data.textures` of glTF texture `info` decoded as sRGB or linear, with
     /// its `KHR_texture_transform`.
     fn texture_ref(
@@ -797,6 +924,7 @@ impl Loader<'_> {
                 false,
             )?);
         }
+        self.specular_and_sheen(material, &mut converted)?;
         // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
         if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
             let dispersion = extension
@@ -893,15 +1021,16 @@ impl Loader<'_> {
         converted.clearcoat = factor("clearcoatFactor")?;
         converted.clearcoat_roughness = factor("clearcoatRoughnessFactor")?;
         if let Some(info) = extension.get("clearcoatTexture") {
-            converted.clearcoat_texture = Some(self.texture_info(info, &what("clearcoatTexture"))?);
+            converted.clearcoat_texture =
+                Some(self.texture_info(info, &what("clearcoatTexture"), false)?);
         }
         if let Some(info) = extension.get("clearcoatRoughnessTexture") {
             converted.clearcoat_roughness_texture =
-                Some(self.texture_info(info, &what("clearcoatRoughnessTexture"))?);
+                Some(self.texture_info(info, &what("clearcoatRoughnessTexture"), false)?);
         }
         if let Some(info) = extension.get("clearcoatNormalTexture") {
             let name = what("clearcoatNormalTexture");
-            converted.clearcoat_normal_texture = Some(self.texture_info(info, &name)?);
+            converted.clearcoat_normal_texture = Some(self.texture_info(info, &name, false)?);
             converted.clearcoat_normal_scale = match info.get("scale") {
                 None => 1.0,
                 Some(value) => value
@@ -917,11 +1046,12 @@ impl Loader<'_> {
     }
 
     /// A texture named by a textureInfo read from JSON (`{"index": i, "texCoord": 0}`, with
-    /// its `KHR_texture_transform`), as linear data.
+    /// its `KHR_texture_transform`), decoded as sRGB colour or linear data.
     fn texture_info(
         &mut self,
         info: &serde_json::Value,
         what: &str,
+        srgb: bool,
     ) -> Result<TextureRef, IoError> {
         let texture = info
             .get("index")
@@ -944,7 +1074,7 @@ impl Loader<'_> {
             .or_else(|| info.get("texCoord"))
             .map_or(Some(0), |v| v.as_u64().and_then(|v| u32::try_from(v).ok()))
             .ok_or_else(|| self.fail(format!("{what}'s texCoord must be a set index")))?;
-        let mut reference = self.texture_ref(texture, texcoord, None, false)?;
+        let mut reference = self.texture_ref(texture, texcoord, None, srgb)?;
         if let Some(transform) = transform {
             let numbers = |field: &str, default: &[f32]| -> Result<Vec<f32>, IoError> {
                 let Some(value) = transform.get(field) else {

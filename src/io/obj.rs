@@ -152,9 +152,19 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
     // The PBR extension's clear coat: `Pc` its thickness (here its factor), `Pcr` its
     // roughness.
     let (clearcoat, clearcoat_roughness) = (number("Pc")?, number("Pcr")?);
+    // The PBR extension's sheen colour, `Ps r g b` or `Ps v` (grey), in [0, 1].
+    let sheen = match m.unknown_param.get("Ps") {
+        Some(text) => Some(
+            parse_tf(text)
+                .filter(|c| c.iter().all(|&c| (0.0..=1.0).contains(&c)))
+                .ok_or_else(|| format!("Ps '{text}' is not one or three numbers in [0, 1]"))?,
+        ),
+        None => None,
+    };
     let pbr = roughness.is_some()
         || metallic.is_some()
         || clearcoat.is_some()
+        || sheen.is_some()
         || m.unknown_param.contains_key("map_Pr")
         || m.unknown_param.contains_key("map_Pm");
     let glossy = matches!(illum, None | Some(2))
@@ -197,6 +207,7 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
             abbe_number,
             clearcoat: clearcoat.unwrap_or(0.0),
             clearcoat_roughness: clearcoat_roughness.unwrap_or(0.0),
+            sheen_color: sheen.unwrap_or([0.0; 3]),
             ..material
         },
         _ => material,
@@ -369,7 +380,8 @@ impl TextureFiles<'_> {
 
 /// The textures of an MTL material: `map_Kd` (base colour, sRGB), `norm` / `map_Bump` /
 /// `bump` (a tangent-space normal map; a grey image is a height map, which is skipped),
-/// `map_Ke` (emission, sRGB), and `map_Pr` / `map_Pm` (roughness and metalness, combined
+/// `map_Ke` (emission, sRGB), `map_Ps` (sheen colour, sRGB), and `map_Pr` / `map_Pm`
+/// (roughness and metalness, combined
 /// into one texture as glTF's green and blue channels; they must have the same size).
 fn add_textures(
     m: &tobj::Material,
@@ -396,6 +408,16 @@ fn add_textures(
         if textures[reference.texture as usize].channels >= 3 {
             material.normal_texture = Some(reference);
             material.normal_scale = statement.bump_scale;
+        }
+    }
+    if let Some(text) = m.unknown_param.get("map_Ps")
+        && material.kind == MaterialKind::MetallicRoughness
+    {
+        let statement = parse_texture_statement(text)?;
+        material.sheen_color_texture = Some(files.reference(&statement, true, textures)?);
+        if material.sheen_color == [0.0; 3] {
+            // map_Ps alone means a sheen as the texture says.
+            material.sheen_color = [1.0; 3];
         }
     }
     let roughness = m.unknown_param.get("map_Pr");

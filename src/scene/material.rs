@@ -1,6 +1,6 @@
 //! Surface materials: what a triangle does with light.
 
-use crate::bsdf::{BsdfModel, Clearcoat, MetallicRoughness};
+use crate::bsdf::{BsdfModel, Clearcoat, MetallicRoughness, Sheen};
 use crate::error::{Error, Result};
 use crate::params::{ChoiceParameter, Range, declare_parameters, in_unit_interval};
 use crate::spectral::Channels;
@@ -58,7 +58,10 @@ declare_parameters! {
     /// multiplies `transmission`; `clearcoat_texture`'s red and
     /// `clearcoat_roughness_texture`'s green multiply the clear coat's factor and roughness,
     /// and `clearcoat_normal_texture` is the coat's own normal map (scaled by
-    /// `clearcoat_normal_scale`). Per-vertex colours multiply `color` and `alpha` too.
+    /// `clearcoat_normal_scale`); `specular_texture`'s alpha and `specular_color_texture`'s
+    /// RGB multiply `specular` and `specular_color`, `sheen_color_texture`'s RGB and
+    /// `sheen_roughness_texture`'s alpha `sheen_color` and `sheen_roughness`. Per-vertex
+    /// colours multiply `color` and `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
     #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,6 +209,50 @@ declare_parameters! {
             range: Range::above(0.0, f32::MAX as f64),
             rule: |_| "an attenuation distance must be greater than 0 (the largest float: no absorption)".into(),
         },
+        /// Metallic-roughness: the strength of the dielectric's specular reflection
+        /// (`KHR_materials_specular`'s `specularFactor`), in [0, 1]; 0 leaves the diffuse
+        /// base alone, and the base gains what the reflection gives up.
+        specular: f32 = 1.0 => {
+            doc: "Metallic-roughness: strength of the dielectric's specular reflection, 0 a pure diffuse base (KHR_materials_specular's specularFactor).",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        /// Metallic-roughness: scales the dielectric's normal reflectance F0 per channel
+        /// (`KHR_materials_specular`'s `specularColorFactor`), linear RGB, not negative; may
+        /// exceed 1 (F0 times it is clamped to 1).
+        specular_color: [f32; 3] = [1.0; 3] => {
+            doc: "Metallic-roughness: scales the dielectric's F0 per channel, linear RGB, may exceed 1 (F0 times it is clamped to 1; KHR_materials_specular's specularColorFactor).",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "a specular colour must not be negative".into(),
+        },
+        specular_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: alpha multiplies the specular strength (KHR_materials_specular's specularTexture); usually linear.",
+        },
+        specular_color_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: RGB multiplies the specular colour (KHR_materials_specular's specularColorTexture); usually 8-bit sRGB.",
+        },
+        /// Metallic-roughness: the colour of a sheen layer over the material
+        /// (`KHR_materials_sheen`'s `sheenColorFactor`), linear RGB in [0, 1]; black, the
+        /// default, is no sheen.
+        sheen_color: [f32; 3] = [0.0; 3] => {
+            doc: "Metallic-roughness: colour of a sheen layer over the material (velvet, cloth), linear RGB; black is none (KHR_materials_sheen's sheenColorFactor).",
+            range: Range::closed(0.0, 1.0),
+            rule: |_| "a reflectance must be in [0, 1]; above 1 would create energy".into(),
+        },
+        /// Metallic-roughness: the sheen's perceptual roughness (`KHR_materials_sheen`'s
+        /// `sheenRoughnessFactor`) in [0, 1]; the Charlie distribution's α is its square, at
+        /// least 0.07².
+        sheen_roughness: f32 = 0.0 => {
+            doc: "Metallic-roughness: the sheen's roughness (Charlie distribution, alpha = roughness squared, at least 0.07 squared; KHR_materials_sheen's sheenRoughnessFactor).",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        sheen_color_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: RGB multiplies the sheen colour (KHR_materials_sheen's sheenColorTexture); usually 8-bit sRGB.",
+        },
+        sheen_roughness_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's sheenRoughnessTexture); usually linear.",
+        },
     }
 }
 
@@ -338,13 +385,28 @@ impl Material {
             self.roughness,
             self.transmission,
             self.ior_in(channels),
+            &self.untextured_layers(),
+            channels,
         )
+    }
+
+    /// The specular and sheen parameters without their textures.
+    #[inline]
+    pub(crate) fn untextured_layers(&self) -> SpecularAndSheen {
+        SpecularAndSheen {
+            specular: self.specular,
+            specular_color: self.specular_color,
+            sheen_color: self.sheen_color,
+            sheen_roughness: self.sheen_roughness,
+        }
     }
 
     /// The scattering model with the colour replaced by `color` and, for the
     /// metallic-roughness model, its metalness, roughness and transmission by `metallic`,
-    /// `roughness` and `transmission` (textured).
+    /// `roughness` and `transmission`, its specular and sheen parameters by `layers`
+    /// (textured; their colours turned into `channels`).
     #[inline]
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn textured_bsdf_model(
         &self,
         color: Spectrum,
@@ -352,6 +414,8 @@ impl Material {
         roughness: f32,
         transmission: f32,
         ior: f32,
+        layers: &SpecularAndSheen,
+        channels: &Channels,
     ) -> BsdfModel {
         match self.kind {
             MaterialKind::Diffuse => BsdfModel::Diffuse(color),
@@ -369,8 +433,56 @@ impl Material {
                     roughness: self.clearcoat_roughness,
                     normal: None,
                 },
+                specular: layers.specular,
+                specular_color: layers.specular_color(channels),
+                specular_color_max: max3(layers.specular_color),
+                sheen: layers.sheen(channels),
             }),
         }
+    }
+}
+
+/// The `KHR_materials_specular` and `KHR_materials_sheen` parameters at a surface point.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SpecularAndSheen {
+    pub specular: f32,
+    pub specular_color: [f32; 3],
+    pub sheen_color: [f32; 3],
+    pub sheen_roughness: f32,
+}
+
+#[inline]
+fn max3(c: [f32; 3]) -> f32 {
+    c[0].max(c[1]).max(c[2])
+}
+
+impl SpecularAndSheen {
+    /// The specular colour in `channels` (white, the default, exactly: no spectral fit).
+    #[inline]
+    fn specular_color(&self, channels: &Channels) -> Spectrum {
+        if self.specular_color == [1.0; 3] {
+            Spectrum::ONE
+        } else {
+            // A spectral fit may rise above the RGB's largest channel, which weights the base.
+            channels
+                .reflectance(self.specular_color)
+                .min(Spectrum::splat(max3(self.specular_color)))
+        }
+    }
+
+    /// The sheen layer, `None` for a black sheen colour (the default) without a look at
+    /// the rest.
+    #[inline]
+    fn sheen(&self, channels: &Channels) -> Option<Sheen> {
+        let color_max = max3(self.sheen_color);
+        if color_max <= 0.0 {
+            return None;
+        }
+        Sheen::new(
+            channels.reflectance(self.sheen_color),
+            color_max,
+            self.sheen_roughness,
+        )
     }
 }
 

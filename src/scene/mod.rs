@@ -578,8 +578,16 @@ impl Scene {
             );
             // The least transmission leaves the most diffuse base beside the specular lobes.
             let transmission = m.transmission * texture_min(m.transmission_texture, 0);
-            let smoothest =
-                m.textured_bsdf_model(Spectrum::from(m.color), metallic, 0.0, transmission, m.ior);
+            let layers = m.untextured_layers();
+            let smoothest = m.textured_bsdf_model(
+                Spectrum::from(m.color),
+                metallic,
+                0.0,
+                transmission,
+                m.ior,
+                &layers,
+                &crate::spectral::Channels::Rgb,
+            );
             let smooth_coat =
                 m.clearcoat_roughness * texture_min(m.clearcoat_roughness_texture, 1) == 0.0;
             smooth_coat

@@ -5,7 +5,7 @@
 //! Attributes are stored per triangle corner in the backend's internal triangle order, so a
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
-use super::material::{Material, TextureRef};
+use super::material::{Material, SpecularAndSheen, TextureRef};
 use crate::bsdf::{Bsdf, BsdfModel, Clearcoat};
 use crate::error::{Error, Result};
 use crate::spectral::{Channels, FittedColour};
@@ -374,6 +374,31 @@ impl SurfacePoint<'_> {
         }
     }
 
+    /// The specular and sheen parameters here, times their textures.
+    #[inline]
+    fn specular_and_sheen(&self) -> SpecularAndSheen {
+        let m = self.material;
+        let mut layers = m.untextured_layers();
+        let rgb = |t: Vec4| [t.x, t.y, t.z];
+        let times = |c: [f32; 3], t: [f32; 3]| [c[0] * t[0], c[1] * t[1], c[2] * t[2]];
+        if let Some(texture) = &m.specular_texture {
+            layers.specular *= self.lookup(texture).w;
+        }
+        if let Some(texture) = &m.specular_color_texture {
+            layers.specular_color = times(layers.specular_color, rgb(self.lookup(texture)));
+        }
+        // Without sheen the sheen's textures change nothing: no lookups.
+        if layers.sheen_color != [0.0; 3] {
+            if let Some(texture) = &m.sheen_color_texture {
+                layers.sheen_color = times(layers.sheen_color, rgb(self.lookup(texture)));
+            }
+            if let Some(texture) = &m.sheen_roughness_texture {
+                layers.sheen_roughness *= self.lookup(texture).w;
+            }
+        }
+        layers
+    }
+
     /// The BSDF here, on a triangle with front geometric normal `geometric_normal`.
     #[inline]
     pub fn bsdf(&self, geometric_normal: Vec3A, channels: &Channels) -> Bsdf {
@@ -386,6 +411,8 @@ impl SurfacePoint<'_> {
                 m.roughness,
                 m.transmission,
                 m.ior_in(channels),
+                &m.untextured_layers(),
+                channels,
             );
             return Bsdf::new(model, geometric_normal, geometric_normal)
                 .with_dispersion(dispersive);
@@ -403,8 +430,16 @@ impl SurfacePoint<'_> {
         if let Some(texture) = &m.transmission_texture {
             transmission *= self.lookup(texture).x;
         }
-        let mut model =
-            m.textured_bsdf_model(color, metallic, roughness, transmission, m.ior_in(channels));
+        let layers = self.specular_and_sheen();
+        let mut model = m.textured_bsdf_model(
+            color,
+            metallic,
+            roughness,
+            transmission,
+            m.ior_in(channels),
+            &layers,
+            channels,
+        );
         let shading_normal = self.shading_normal(geometric_normal);
         if let BsdfModel::MetallicRoughness(model) = &mut model
             && model.clearcoat.is_present()
