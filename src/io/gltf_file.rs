@@ -1003,23 +1003,23 @@ impl Loader<'_> {
             .index()
             .map_or("(default)".into(), |i| i.to_string());
         let what = |field: &str| format!("material {label}: KHR_materials_clearcoat's {field}");
-        let factor = |field: &str| -> Result<f32, IoError> {
-            match extension.get(field) {
-                None => Ok(0.0),
-                Some(value) => value
-                    .as_f64()
-                    .filter(|v| (0.0..=1.0).contains(v))
-                    .map(|v| v as f32)
-                    .ok_or_else(|| {
-                        self.fail(format!(
-                            "{} is {value}; it must be a number in [0, 1]",
-                            what(field)
-                        ))
-                    }),
-            }
-        };
-        converted.clearcoat = factor("clearcoatFactor")?;
-        converted.clearcoat_roughness = factor("clearcoatRoughnessFactor")?;
+        let extension_name = "KHR_materials_clearcoat";
+        converted.clearcoat = self.json_number(
+            extension,
+            "clearcoatFactor",
+            0.0,
+            (0.0, 1.0),
+            extension_name,
+            &label,
+        )?;
+        converted.clearcoat_roughness = self.json_number(
+            extension,
+            "clearcoatRoughnessFactor",
+            0.0,
+            (0.0, 1.0),
+            extension_name,
+            &label,
+        )?;
         if let Some(info) = extension.get("clearcoatTexture") {
             converted.clearcoat_texture =
                 Some(self.texture_info(info, &what("clearcoatTexture"), false)?);
