@@ -79,10 +79,13 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   ([`crate::MaterialKind::MetallicRoughness`]): base colour and alpha, metallic and
 ///   roughness factors and textures, `normalTexture` with its scale, emission =
 ///   `emissiveFactor` × `KHR_materials_emissive_strength` × `emissiveTexture`,
-///   `KHR_materials_transmission` (factor; its texture is ignored), `KHR_materials_ior`,
-///   `KHR_texture_transform`, `KHR_materials_clearcoat` (factors, textures and the coat's
-///   own normal map; files may require it), `KHR_materials_unlit` (the base colour
-///   emitted, nothing scattered), alpha modes (`BLEND` as stochastic coverage,
+///   `KHR_materials_transmission` (factor and texture), `KHR_materials_ior`,
+///   `KHR_materials_dispersion`, `KHR_texture_transform`, `KHR_materials_clearcoat`
+///   (factors, textures and the coat's own normal map), `KHR_materials_specular` and
+///   `KHR_materials_sheen` (factors and textures), `KHR_materials_volume` (thickness as
+///   the flag, attenuation colour and distance), `KHR_materials_unlit` (the base colour
+///   emitted, nothing scattered), `KHR_materials_variants` (see [`load_scene_variant`]);
+///   files may require any of these. Alpha modes (`BLEND` as stochastic coverage,
 ///   [`crate::AlphaMode::Blend`]). Images (PNG, JPEG; embedded, data URIs or files) become
 ///   textures: base colour and emission decoded as sRGB, the others linear, with the
 ///   sampler's wrap modes and nearest or bilinear filtering. Attributes: `NORMAL`,
