@@ -15,7 +15,7 @@ mod common {
     pub mod surfaces;
 }
 
-use common::references::{cached_estimate, render_image};
+use common::references::{cached_estimate, estimate_over_seeds, render_image};
 use common::scenes::canonical_camera;
 use common::stats::{Estimate, assert_estimates_agree};
 use common::surfaces::surfaces_mesh;
@@ -31,21 +31,18 @@ const MAX_DEPTH: u32 = 4;
 
 /// `renders` independent renders of the surfaces scene with `settings`.
 fn estimate(settings: RenderSettings, renders: u64) -> Estimate {
-    let scene = surfaces_mesh().scene(Backend::Bvh);
-    let camera = canonical_camera("cornell-box");
-    let images: Vec<Vec<f32>> = (0..renders)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: SIZE,
-                height: SIZE,
-                max_depth: MAX_DEPTH,
-                seed: 900 + seed,
-                ..settings
-            };
-            render_image(&scene, &camera, &settings)
-        })
-        .collect();
-    Estimate::from_correlated_renders(SIZE as usize, SIZE as usize, &images)
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        max_depth: MAX_DEPTH,
+        ..settings
+    };
+    estimate_over_seeds(
+        &surfaces_mesh().scene(Backend::Bvh),
+        &canonical_camera("cornell-box"),
+        &settings,
+        900..900 + renders,
+    )
 }
 
 /// BDPT's estimate, once per test binary: the reference of the Metropolis algorithms,
@@ -156,22 +153,17 @@ fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
     let scene = coated_surfaces_scene();
     let camera = canonical_camera("cornell-box");
     let estimate = |algorithm, samples_per_pixel, renders: u64| {
-        let images: Vec<Vec<f32>> = (0..renders)
-            .map(|seed| {
-                let settings = RenderSettings {
-                    algorithm,
-                    samples_per_pixel,
-                    width: SIZE,
-                    height: SIZE,
-                    max_depth: MAX_DEPTH,
-                    seed: 700 + seed,
-                    ..Default::default()
-                };
-                render_image(&scene, &camera, &settings)
-            })
-            .collect();
-        Estimate::from_correlated_renders(SIZE as usize, SIZE as usize, &images)
+        let settings = RenderSettings {
+            algorithm,
+            samples_per_pixel,
+            width: SIZE,
+            height: SIZE,
+            max_depth: MAX_DEPTH,
+            ..Default::default()
+        };
+        estimate_over_seeds(&scene, &camera, &settings, 700..700 + renders)
     };
+
     assert_estimates_agree(
         "coated surfaces BDPT against the path tracer",
         &estimate(Algorithm::Bdpt, 64, 16),
@@ -222,21 +214,18 @@ fn coated_box() -> mlt::Scene {
 
 /// `renders` independent renders of the coated box with `settings`.
 fn coated_estimate(settings: RenderSettings, renders: u64) -> Estimate {
-    let scene = coated_box();
-    let camera = canonical_camera("cornell-box");
-    let images: Vec<Vec<f32>> = (0..renders)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: SIZE,
-                height: SIZE,
-                max_depth: MAX_DEPTH,
-                seed: 700 + seed,
-                ..settings
-            };
-            render_image(&scene, &camera, &settings)
-        })
-        .collect();
-    Estimate::from_correlated_renders(SIZE as usize, SIZE as usize, &images)
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        max_depth: MAX_DEPTH,
+        ..settings
+    };
+    estimate_over_seeds(
+        &coated_box(),
+        &canonical_camera("cornell-box"),
+        &settings,
+        700..700 + renders,
+    )
 }
 
 /// Path-space MLT (its perturbations turning directions, and stepping them in their

@@ -19,7 +19,7 @@ mod common {
     pub mod surfaces;
 }
 
-use common::references::{cached_estimate, render_image};
+use common::references::{cached_estimate, estimate_over_seeds, render_image};
 use common::scenes::canonical_camera;
 use common::stats::{Estimate, assert_estimates_agree, assert_within_and_sharp};
 use common::surfaces::surfaces_mesh;
@@ -229,21 +229,18 @@ fn volume_scene() -> Scene {
 
 /// `renders` independent renders of the volume scene with `settings`.
 fn estimate(settings: RenderSettings, renders: u64) -> Estimate {
-    let scene = volume_scene();
-    let camera = canonical_camera("cornell-box");
-    let images: Vec<Vec<f32>> = (0..renders)
-        .map(|seed| {
-            let settings = RenderSettings {
-                width: SIZE,
-                height: SIZE,
-                max_depth: MAX_DEPTH,
-                seed: 700 + seed,
-                ..settings
-            };
-            render_image(&scene, &camera, &settings)
-        })
-        .collect();
-    Estimate::from_correlated_renders(SIZE as usize, SIZE as usize, &images)
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        max_depth: MAX_DEPTH,
+        ..settings
+    };
+    estimate_over_seeds(
+        &volume_scene(),
+        &canonical_camera("cornell-box"),
+        &settings,
+        700..700 + renders,
+    )
 }
 
 fn bdpt_reference() -> &'static Estimate {

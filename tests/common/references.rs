@@ -50,6 +50,21 @@ pub fn render_image(scene: &Scene, camera: &Camera, settings: &mlt::RenderSettin
     image
 }
 
+/// `settings` rendered once per seed in `seeds` (each replacing `settings.seed`), as one
+/// estimate over the renders.
+pub fn estimate_over_seeds(
+    scene: &Scene,
+    camera: &Camera,
+    settings: &mlt::RenderSettings,
+    seeds: std::ops::Range<u64>,
+) -> Estimate {
+    let renders: Vec<Vec<f32>> = seeds
+        .map(|seed| render_image(scene, camera, &mlt::RenderSettings { seed, ..*settings }))
+        .collect();
+    let (width, height) = (settings.width as usize, settings.height as usize);
+    Estimate::from_correlated_renders(width, height, &renders)
+}
+
 /// An estimate computed once per test binary under `key`: the tests comparing against the
 /// same reference share it (one asking while another computes it waits for that one).
 pub fn cached_estimate(key: &str, compute: impl FnOnce() -> Estimate) -> &'static Estimate {
