@@ -5,6 +5,9 @@
 //!   (1.0) every path crosses the slab straight, and each pixel is the lamp's radiance times
 //!   exp(−σ d) = colour^(d / distance) to float precision (the path tracer and BDPT); at
 //!   index 1.5 the two Fresnel transmissions (1 − F0)² multiply it.
+//! - A rough index-matched slab passes light straight on, each face letting through the
+//!   closed form 20/21 of it at roughness 1, in every algorithm but the light tracer (which
+//!   cannot see a lamp through Dirac lobes).
 //! - A grey attenuation absorbs the same in spectral renders as in RGB ones.
 //! - On the surfaces scene with its rough glass sphere made absorbing, every algorithm
 //!   agrees with BDPT, and BDPT with the path tracer (and each check would fail a 2% error).
@@ -171,6 +174,75 @@ fn beer_lambert_through_a_glass_slab_with_fresnel() {
         );
     }
 }
+
+/// A rough (roughness 1) index-matched slab that absorbs: microfacets of index 1 pass light
+/// straight on, each face letting through 1 − F̄ of it, F̄ Schlick's F (F0 = 0) averaged
+/// over the normals visible face-on. At α = 1 GGX's D is 1/π, so F̄ = 2 ∫ (1 − μ)⁵ μ dμ =
+/// 1/21 in closed form (the views are within 0.71° of the normal: F̄ and the masking move
+/// by less than 10⁻⁴ there), and the slab lets through (20/21)² colour². Each sample is
+/// that over the two lobe choices' probability, or 0 where a face's rough reflection is
+/// picked instead (it leaves the scene).
+#[test]
+fn a_rough_index_matched_slab_passes_light_straight_on() {
+    let slab = Material {
+        transmission: 1.0,
+        ior: 1.0,
+        thickness: 1.0,
+        attenuation_color: COLOUR,
+        attenuation_distance: DEPTH / 2.0,
+        ..Material::metallic_roughness([1.0; 3], 0.0, 1.0)
+    };
+    let through = (20.0f64 / 21.0).powi(2);
+    for algorithm in [Algorithm::Path, Algorithm::Bdpt] {
+        let image = render_image(
+            &slab_scene(slab),
+            &slab_camera(),
+            &slab_settings(algorithm, 64),
+        );
+        let (mean, standard_error) = common::stats::mean_and_standard_error(&image);
+        for c in 0..3 {
+            assert_within_and_sharp(
+                &format!("{algorithm:?} channel {c}"),
+                mean[c],
+                through * (COLOUR[c] as f64).powi(2),
+                standard_error[c],
+                4.0,
+            );
+        }
+    }
+    // A Metropolis render's pixels share chains: the error is the spread of whole-image
+    // means over independent seeds.
+    for algorithm in [
+        Algorithm::Pssmlt,
+        Algorithm::PssmltBdpt,
+        Algorithm::Mmlt,
+        Algorithm::PathSpaceMlt,
+        Algorithm::Erpt,
+    ] {
+        let means: Vec<f64> = (0..SEEDS)
+            .map(|seed| {
+                let settings = RenderSettings {
+                    seed,
+                    ..slab_settings(algorithm, 16)
+                };
+                let image = render_image(&slab_scene(slab), &slab_camera(), &settings);
+                common::stats::mean_and_standard_error(&image).0[2]
+            })
+            .collect();
+        let mean = means.iter().sum::<f64>() / SEEDS as f64;
+        let spread = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (SEEDS - 1) as f64;
+        assert_within_and_sharp(
+            &format!("{algorithm:?} blue"),
+            mean,
+            through * (COLOUR[2] as f64).powi(2),
+            (spread / SEEDS as f64).sqrt(),
+            4.0,
+        );
+    }
+}
+
+/// Independent renders of each Metropolis algorithm in the rough index-matched slab's test.
+const SEEDS: u64 = 16;
 
 /// A grey attenuation is grey at every wavelength: the spectral render of the index-matched
 /// slab is the clear slab's times grey², as the RGB render is.

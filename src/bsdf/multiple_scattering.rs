@@ -23,6 +23,11 @@
 //! albedo the coat would have with its multiple scattering restored (1 for F = 1), and the
 //! metallic-roughness model scales its diffuse base by what it leaves
 //! ([`CoatReflectance`]).
+//!
+//! A third table holds the mean of (1 − wo·h)⁵ over the normals visible from wo (all of
+//! them, whether their reflection leaves the surface or not): Schlick's Fresnel averaged
+//! the way an index-matched rough interface's microfacets pass light straight on
+//! ([`visible_schlick_mean`]).
 
 use super::microfacet::{MIN_ALPHA, TrowbridgeReitz};
 use super::scattering::reflect;
@@ -47,6 +52,8 @@ struct AlbedoTable {
     schlick_share: Vec<f32>,
     /// Its cosine-weighted mean per roughness node, as `average`.
     schlick_share_average: Vec<f32>,
+    /// The mean of (1 − wo·h)⁵ over the visible normals, as `albedo`.
+    visible_schlick: Vec<f32>,
 }
 
 #[inline]
@@ -73,12 +80,21 @@ pub(crate) fn single_scattering_albedo(
 
 /// The white albedo E (as [`single_scattering_albedo`]) and E_s, the same integral weighted
 /// by Schlick's (1 − wo·h)⁵, in one quadrature.
+#[cfg(test)]
 pub(crate) fn single_scattering_albedos(
     alpha: f32,
     mu: f32,
     polar_nodes: usize,
     azimuth_nodes: usize,
 ) -> [f64; 2] {
+    let [e, e_s, _] = albedo_quadrature(alpha, mu, polar_nodes, azimuth_nodes);
+    [e, e_s]
+}
+
+/// E and E_s (as [`single_scattering_albedos`]) and the mean of (1 − wo·h)⁵ over the
+/// normals visible from wo, the density D(h) max(0, wo·h) normalised by the same
+/// quadrature's own sum.
+fn albedo_quadrature(alpha: f32, mu: f32, polar_nodes: usize, azimuth_nodes: usize) -> [f64; 3] {
     use std::f64::consts::PI;
     let distribution = TrowbridgeReitz::new(alpha);
     let alpha = alpha.max(MIN_ALPHA);
@@ -86,6 +102,7 @@ pub(crate) fn single_scattering_albedos(
     let wo = Vec3A::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let alpha = alpha as f64;
     let (mut sum, mut schlick) = (0.0f64, 0.0f64);
+    let (mut visible, mut visible_schlick) = (0.0f64, 0.0f64);
     // The azimuths' sines and cosines, once rather than per polar node.
     let azimuths: Vec<(f64, f64)> = (0..azimuth_nodes)
         .map(|j| (PI * (j as f64 + 0.5) / azimuth_nodes as f64).sin_cos())
@@ -100,8 +117,14 @@ pub(crate) fn single_scattering_albedos(
         for &(sin_phi, cos_phi) in &azimuths {
             let h = Vec3A::new((sin * cos_phi) as f32, (sin * sin_phi) as f32, cos as f32);
             let cos_oh = wo.dot(h);
+            if cos_oh <= 0.0 {
+                continue;
+            }
+            let seen = distribution.d(h) as f64 * cos_oh as f64 * sin * d_theta;
+            visible += seen;
+            visible_schlick += seen * (1.0 - cos_oh as f64).powi(5);
             let wi = reflect(wo, h);
-            if cos_oh <= 0.0 || wi.z <= 0.0 {
+            if wi.z <= 0.0 {
                 continue;
             }
             let f = distribution.d(h) as f64 * distribution.g2(wo, wi) as f64 * cos_oh as f64;
@@ -111,7 +134,12 @@ pub(crate) fn single_scattering_albedos(
     }
     // Both sides of the plane: 2 × π / azimuth_nodes per azimuth node.
     let scale = 2.0 * PI / (azimuth_nodes * polar_nodes) as f64 / mu as f64;
-    [sum * scale, schlick * scale]
+    let visible_mean = if visible > 0.0 {
+        visible_schlick / visible
+    } else {
+        0.0
+    };
+    [sum * scale, schlick * scale, visible_mean]
 }
 
 /// 2 ∫ E(μ) μ dμ of the E that is linear in μ between the cosine nodes, segment by segment
@@ -136,21 +164,21 @@ fn table() -> &'static AlbedoTable {
         let mut schlick_share = Vec::with_capacity(COSINES * ROUGHNESSES);
         let mut average = Vec::with_capacity(ROUGHNESSES);
         let mut schlick_share_average = Vec::with_capacity(ROUGHNESSES);
+        let mut visible_schlick = Vec::with_capacity(COSINES * ROUGHNESSES);
         for j in 0..ROUGHNESSES {
             let roughness = j as f32 / (ROUGHNESSES - 1) as f32;
             let alpha = roughness * roughness;
-            let (row, share_row): (Vec<f32>, Vec<f32>) = (0..COSINES)
+            let mut share_row = Vec::with_capacity(COSINES);
+            let row: Vec<f32> = (0..COSINES)
                 .map(|i| {
-                    let [e, e_s] = single_scattering_albedos(
-                        alpha,
-                        cosine_node(i),
-                        POLAR_NODES,
-                        AZIMUTH_NODES,
-                    );
+                    let [e, e_s, visible_mean] =
+                        albedo_quadrature(alpha, cosine_node(i), POLAR_NODES, AZIMUTH_NODES);
                     let share = if e > 0.0 { (e_s / e).min(1.0) } else { 1.0 };
-                    (e.min(1.0) as f32, share as f32)
+                    share_row.push(share as f32);
+                    visible_schlick.push(visible_mean.min(1.0) as f32);
+                    e.min(1.0) as f32
                 })
-                .unzip();
+                .collect();
             average.push(cosine_weighted_mean(&row));
             schlick_share_average.push(cosine_weighted_mean(&share_row));
             albedo.extend(row);
@@ -161,8 +189,17 @@ fn table() -> &'static AlbedoTable {
             average,
             schlick_share,
             schlick_share_average,
+            visible_schlick,
         }
     })
+}
+
+/// The mean of Schlick's (1 − wo·h)⁵ over the microfacet normals visible from a direction
+/// at cosine `mu` to the normal, GGX of perceptual roughness `roughness` (> 0).
+#[inline]
+pub(crate) fn visible_schlick_mean(roughness: f32, mu: f32) -> f32 {
+    let (j, w) = roughness_cell(roughness);
+    lookup(&table().visible_schlick, j, w, mu)
 }
 
 /// The roughness node below `roughness` and the weight of the one above.
