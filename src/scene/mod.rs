@@ -744,6 +744,14 @@ impl Scene {
         barycentrics: [f32; 2],
         channels: &Channels,
     ) -> Spectrum {
+        // Where alpha removes the surface no ray meets it, and nothing is emitted there
+        // either: light samples pick points on the triangle without asking.
+        if self.materials[self.shading[triangle as usize].material as usize].alpha_mode
+            != AlphaMode::Opaque
+            && !self.is_solid(triangle, barycentrics[0], barycentrics[1])
+        {
+            return Spectrum::ZERO;
+        }
         self.surface_point(triangle, barycentrics)
             .emission(channels)
     }
@@ -773,13 +781,6 @@ impl Scene {
     ) -> Option<lights::EmissionSample> {
         self.lights
             .sample_emission(self, u_select, u_point, u_direction, channels)
-    }
-
-    /// Whether internal triangle `triangle`'s material has an emission texture.
-    #[inline]
-    fn emission_is_textured(&self, triangle: u32) -> bool {
-        let material = self.shading[triangle as usize].material;
-        self.materials[material as usize].emission_texture.is_some()
     }
 
     /// Density of light vertex `emitter` as the start of a light subpath
@@ -843,8 +844,9 @@ impl lights::EmissiveSurfaces for Scene {
     }
 
     #[inline]
-    fn is_emission_textured(&self, triangle: u32) -> bool {
-        self.emission_is_textured(triangle)
+    fn emission_varies(&self, triangle: u32) -> bool {
+        let material = &self.materials[self.shading[triangle as usize].material as usize];
+        material.emission_texture.is_some() || material.alpha_mode != AlphaMode::Opaque
     }
 
     #[inline]

@@ -211,8 +211,10 @@ pub(crate) trait EmissiveSurfaces {
         barycentrics: [f32; 2],
         channels: &Channels,
     ) -> Spectrum;
-    /// Whether the triangle's material has an emission texture.
-    fn is_emission_textured(&self, triangle: u32) -> bool;
+    /// Whether the triangle's emission varies over it (an emission texture, or alpha that
+    /// removes parts of it): light samples then ask `surface_emission` at their point
+    /// rather than take the light's own RGB emission.
+    fn emission_varies(&self, triangle: u32) -> bool;
     /// The density with which light sampling picks a point on the triangle, per unit area
     /// (0: not a light).
     fn triangle_light_pdf(&self, triangle: u32) -> f32;
@@ -444,14 +446,13 @@ impl SceneLights {
         };
         match vertex.light.0 {
             EmitterKind::Area(triangle) => {
-                // In RGB the light's own emission, unless textured; spectra from the
-                // material's fit.
-                let emission =
-                    if surfaces.is_emission_textured(triangle) || *channels != Channels::Rgb {
-                        surfaces.surface_emission(triangle, vertex.barycentrics, channels)
-                    } else {
-                        vertex.emission
-                    };
+                // In RGB the light's own emission, unless it varies over the triangle;
+                // spectra from the material's fit.
+                let emission = if surfaces.emission_varies(triangle) || *channels != Channels::Rgb {
+                    surfaces.surface_emission(triangle, vertex.barycentrics, channels)
+                } else {
+                    vertex.emission
+                };
                 let to_light = vertex.point - p;
                 let distance2 = to_light.length_squared();
                 if distance2 <= 0.0 {
@@ -502,7 +503,7 @@ impl SceneLights {
     ) -> Option<EmissionSample> {
         let mut sample = self.sample_emission_rgb(u_select, u_point, u_direction)?;
         if let EmitterKind::Area(triangle) = sample.emitter.0
-            && (surfaces.is_emission_textured(triangle) || *channels != Channels::Rgb)
+            && (surfaces.emission_varies(triangle) || *channels != Channels::Rgb)
         {
             sample.emission = surfaces.surface_emission(triangle, sample.barycentrics, channels);
             let cos = sample.direction.dot(sample.normal);
