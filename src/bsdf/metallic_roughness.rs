@@ -85,6 +85,20 @@ pub(crate) struct MetallicRoughness {
     pub specular_color_max: f32,
     /// `KHR_materials_sheen`: the sheen layer over the whole material, if it has one.
     pub sheen: Option<Sheen>,
+    /// `KHR_materials_anisotropy`: the microfacets stretched along a direction, if they are.
+    pub anisotropy: Option<Anisotropy>,
+}
+
+/// `KHR_materials_anisotropy` at a surface point: GGX's roughness along `direction` is
+/// α_t = mix(α, 1, strength²), across it α_b = α (α = roughness²). It applies to every
+/// lobe of the base's microfacets (the metal's and the dielectric's reflection, and the
+/// transmission through them), not to the clear coat nor the sheen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Anisotropy {
+    /// In (0, 1].
+    pub strength: f32,
+    /// Unit, perpendicular to the shading normal (world space): the local frame's x axis.
+    pub direction: Vec3A,
 }
 
 /// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
@@ -108,8 +122,10 @@ struct View {
 }
 
 impl View {
+    /// The view of `wo`, in a frame whose x axis is `direction` if the surface is
+    /// anisotropic (any frame about the normal otherwise).
     #[inline]
-    fn of(ior: f32, normal: Vec3A, wo: Vec3A) -> Option<View> {
+    fn of(ior: f32, normal: Vec3A, wo: Vec3A, direction: Option<Vec3A>) -> Option<View> {
         let cos_o = wo.dot(normal);
         if cos_o == 0.0 {
             return None;
@@ -119,7 +135,14 @@ impl View {
         } else {
             (-normal, ior, 1.0)
         };
-        let basis = OrthonormalBasis::from_normal(side_normal);
+        let basis = match direction {
+            None => OrthonormalBasis::from_normal(side_normal),
+            Some(tangent) => OrthonormalBasis {
+                tangent,
+                bitangent: side_normal.cross(tangent),
+                normal: side_normal,
+            },
+        };
         Some(View {
             wo: Vec3A::new(wo.dot(basis.tangent), wo.dot(basis.bitangent), cos_o.abs()),
             basis,
@@ -236,7 +259,7 @@ impl MetallicRoughness {
     /// The classes of its lobes: glossy reflection (and transmission) when rough, specular
     /// when smooth, and a diffuse lobe when the dielectric's base is partly opaque.
     pub fn lobes(&self) -> BsdfLobes {
-        let scattering = if self.roughness > 0.0 {
+        let scattering = if !self.is_smooth() {
             BsdfLobes::GLOSSY
         } else {
             BsdfLobes::SPECULAR
@@ -269,7 +292,7 @@ impl MetallicRoughness {
         u_lobe: f32,
         mode: TransportMode,
     ) -> Option<ScatterSample> {
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let choice = self.lobe_choice(&view);
         // Clear coat.
         if self.clearcoat.is_present() {
@@ -333,7 +356,7 @@ impl MetallicRoughness {
     /// BSDF value f(wo, wi), without the cosine, of the lobes that have a density (all but
     /// roughness 0's Dirac reflection and refraction).
     pub fn eval(&self, normal: Vec3A, wo: Vec3A, wi: Vec3A, mode: TransportMode) -> Spectrum {
-        let Some(view) = View::of(self.ior, normal, wo) else {
+        let Some(view) = self.view(normal, wo) else {
             return Spectrum::ZERO;
         };
         // Clear coat.
@@ -349,7 +372,7 @@ impl MetallicRoughness {
     /// Solid-angle density with which `sample` generates `wi` from `wo` through the lobes
     /// that have a density, their selection probabilities included.
     pub fn pdf(&self, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> f32 {
-        let Some(view) = View::of(self.ior, normal, wo) else {
+        let Some(view) = self.view(normal, wo) else {
             return 0.0;
         };
         let choice = self.lobe_choice(&view);
@@ -374,7 +397,7 @@ impl MetallicRoughness {
         wi: Vec3A,
         mode: TransportMode,
     ) -> Option<ScatterSample> {
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let choice = self.lobe_choice(&view);
         // Clear coat.
         if self.clearcoat.is_present() {
@@ -416,7 +439,7 @@ impl MetallicRoughness {
         mode: TransportMode,
         dirac: bool,
     ) -> Option<ScatterSample> {
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let choice = self.lobe_choice(&view);
         let local = view.local(wi);
         if local.z == 0.0 {
@@ -466,7 +489,7 @@ impl MetallicRoughness {
         {
             return Some(reflect(wo, self.clearcoat.normal.unwrap_or(normal)));
         }
-        if self.roughness > 0.0 {
+        if !self.is_smooth() {
             return None;
         }
         match lobe {
@@ -483,7 +506,7 @@ impl MetallicRoughness {
     /// roughness 0, or where no microfacet scatters wo into wi.
     pub fn microfacet(&self, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> Option<Microfacet> {
         self.distribution()?;
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let local = view.local(wi);
         let (h, refracts) = if local.z > 0.0 {
             let h = (view.wo + local).normalize();
@@ -503,7 +526,7 @@ impl MetallicRoughness {
     /// [`Self::microfacet`]), or `None` if m is not on wo's side, the refraction is totally
     /// reflected, or the direction is not one the lobe scatters into.
     pub fn scatter_through(&self, normal: Vec3A, wo: Vec3A, m: Microfacet) -> Option<Vec3A> {
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let h = view.local(m.normal);
         if h.z <= 0.0 {
             return None;
@@ -523,7 +546,7 @@ impl MetallicRoughness {
     /// `wo` ([`TrowbridgeReitz::visible_normal_coordinates`]).
     pub fn microfacet_coordinates(&self, normal: Vec3A, wo: Vec3A, m: Vec3A) -> Option<[f32; 2]> {
         let distribution = self.distribution()?;
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         distribution.visible_normal_coordinates(view.wo, view.local(m))
     }
 
@@ -536,7 +559,7 @@ impl MetallicRoughness {
         refracts: bool,
     ) -> Option<Microfacet> {
         let distribution = self.distribution()?;
-        let view = View::of(self.ior, normal, wo)?;
+        let view = self.view(normal, wo)?;
         let h = distribution.sample_visible_normal(view.wo, u);
         Some(Microfacet {
             normal: view.basis.to_world(h),
@@ -556,9 +579,7 @@ impl MetallicRoughness {
         wi: Vec3A,
         in_sample_space: bool,
     ) -> f32 {
-        let (Some(distribution), Some(view)) =
-            (self.distribution(), View::of(self.ior, normal, wo))
-        else {
+        let (Some(distribution), Some(view)) = (self.distribution(), self.view(normal, wo)) else {
             return 0.0;
         };
         let local = view.local(wi);
@@ -584,10 +605,50 @@ impl MetallicRoughness {
         }
     }
 
-    /// GGX of this roughness, or `None` for the Dirac lobes of roughness 0.
+    /// The surface as seen from `wo` (see [`View`]).
+    #[inline]
+    fn view(&self, normal: Vec3A, wo: Vec3A) -> Option<View> {
+        View::of(self.ior, normal, wo, self.anisotropy.map(|a| a.direction))
+    }
+
+    /// Whether its lobes are the Dirac ones of roughness 0 (an anisotropic surface is
+    /// rough along its direction even there).
+    #[inline]
+    fn is_smooth(&self) -> bool {
+        self.roughness == 0.0 && self.anisotropy.is_none()
+    }
+
+    /// GGX of this roughness (stretched along the anisotropy's direction), or `None` for
+    /// the Dirac lobes of roughness 0.
     #[inline]
     fn distribution(&self) -> Option<TrowbridgeReitz> {
-        (self.roughness > 0.0).then(|| TrowbridgeReitz::new(self.roughness * self.roughness))
+        let alpha = self.roughness * self.roughness;
+        match self.anisotropy {
+            None => (self.roughness > 0.0).then(|| TrowbridgeReitz::new(alpha)),
+            Some(a) => {
+                let stretch = a.strength * a.strength;
+                Some(TrowbridgeReitz::anisotropic(
+                    alpha + (1.0 - alpha) * stretch,
+                    alpha,
+                ))
+            }
+        }
+    }
+
+    /// The perceptual roughness the albedo tables (`multiple_scattering`, tabulated for
+    /// isotropic GGX) are read at: the roughness, or for an anisotropic surface the
+    /// isotropic one of the same α_t α_b (the geometric mean of the two α, as Cycles
+    /// does), whose distribution has the same peak density and so about the same share of
+    /// light lost to masking.
+    #[inline]
+    fn table_roughness(&self) -> f32 {
+        match (self.anisotropy, self.distribution()) {
+            (Some(_), Some(d)) => {
+                let (alpha_x, alpha_y) = d.alphas();
+                (alpha_x * alpha_y).sqrt().sqrt()
+            }
+            _ => self.roughness,
+        }
     }
 
     #[inline]
@@ -650,10 +711,10 @@ impl MetallicRoughness {
     /// with a metallic part that loses energy.
     #[inline]
     fn compensation(&self) -> Option<EnergyCompensation> {
-        if !self.energy_compensation || self.metallic == 0.0 || self.roughness == 0.0 {
+        if !self.energy_compensation || self.metallic == 0.0 || self.is_smooth() {
             return None;
         }
-        EnergyCompensation::new(self.roughness)
+        EnergyCompensation::new(self.table_roughness())
     }
 
     /// The compensation lobe's tint: the metal's share times F_ms of Schlick's Fresnel
@@ -696,7 +757,7 @@ impl MetallicRoughness {
         };
         // A smooth interface refracts nothing under total internal reflection; a rough one
         // still refracts through tilted microfacets.
-        let refracts = if self.roughness > 0.0 {
+        let refracts = if !self.is_smooth() {
             !self.transmission_tint().is_black()
         } else {
             transmission > 0.0
@@ -727,7 +788,7 @@ impl MetallicRoughness {
     /// from the outside, by its largest channel (before the strength `specular`).
     #[inline]
     fn coat(&self) -> CoatReflectance {
-        CoatReflectance::new(self.roughness, self.specular_f0_max())
+        CoatReflectance::new(self.table_roughness(), self.specular_f0_max())
     }
 
     /// The diffuse base's f at cosines `cos_o`, `cos_i` (same side), scaled by what the
@@ -960,7 +1021,7 @@ impl MetallicRoughness {
     /// Whether the smooth coat's mirror and a smooth base's are the same Dirac lobe.
     #[inline]
     fn mirrors_coincide(&self) -> bool {
-        self.roughness == 0.0 && self.clearcoat.is_smooth() && self.clearcoat.normal.is_none()
+        self.is_smooth() && self.clearcoat.is_smooth() && self.clearcoat.normal.is_none()
     }
 
     /// f of the lobes with a density: the base's under the coat, and the coat's.
@@ -1244,6 +1305,7 @@ mod tests {
             specular_color: Spectrum::ONE,
             specular_color_max: 1.0,
             sheen: None,
+            anisotropy: None,
         }
     }
 

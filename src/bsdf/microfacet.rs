@@ -1,7 +1,13 @@
-//! The isotropic Trowbridge–Reitz (GGX) microfacet distribution in a local frame whose z
-//! axis is the macro-surface normal: the normal distribution D, Smith's masking (Λ, G1 and
-//! the height-correlated G2 of Heitz 2014), and sampling of the normals visible from a
+//! The Trowbridge–Reitz (GGX) microfacet distribution in a local frame whose z axis is the
+//! macro-surface normal, isotropic or anisotropic (roughness α_x along the frame's x axis,
+//! the tangent, and α_y along y): the normal distribution D, Smith's masking (Λ, G1 and the
+//! height-correlated G2 of Heitz 2014), and sampling of the normals visible from a
 //! direction (Heitz 2018, in the spherical-cap form of Dupuy and Benyoub 2023).
+//!
+//! The anisotropic distribution is the isotropic one of α = 1 stretched by (α_x, α_y) in
+//! slope space, which is what every function below applies. Where α_x = α_y the isotropic
+//! expressions are kept as they were written, so that isotropic surfaces round exactly as
+//! before.
 
 use glam::Vec3A;
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -11,10 +17,12 @@ use std::f32::consts::{FRAC_1_PI, PI};
 /// wider than the rounding of f32 directions (≈ 1e-7 rad).
 pub(crate) const MIN_ALPHA: f32 = 1e-4;
 
-/// A GGX distribution of roughness α (the slopes' scale; α = perceptual roughness²).
+/// A GGX distribution of roughness α_x along the local x axis and α_y along y (the slopes'
+/// scales; α = perceptual roughness²); isotropic where they are equal.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct TrowbridgeReitz {
-    alpha: f32,
+    alpha_x: f32,
+    alpha_y: f32,
 }
 
 #[cfg_attr(not(test), allow(dead_code))]
@@ -22,9 +30,33 @@ impl TrowbridgeReitz {
     /// The distribution of roughness `alpha`, raised to [`MIN_ALPHA`].
     #[inline]
     pub fn new(alpha: f32) -> Self {
+        let alpha = alpha.max(MIN_ALPHA);
         TrowbridgeReitz {
-            alpha: alpha.max(MIN_ALPHA),
+            alpha_x: alpha,
+            alpha_y: alpha,
         }
+    }
+
+    /// The distribution of roughness `alpha_x` along the local x axis and `alpha_y` along
+    /// y, each raised to [`MIN_ALPHA`].
+    #[inline]
+    pub fn anisotropic(alpha_x: f32, alpha_y: f32) -> Self {
+        TrowbridgeReitz {
+            alpha_x: alpha_x.max(MIN_ALPHA),
+            alpha_y: alpha_y.max(MIN_ALPHA),
+        }
+    }
+
+    /// (α_x, α_y).
+    #[inline]
+    pub fn alphas(self) -> (f32, f32) {
+        (self.alpha_x, self.alpha_y)
+    }
+
+    /// Whether α_x = α_y.
+    #[inline]
+    fn is_isotropic(self) -> bool {
+        self.alpha_x == self.alpha_y
     }
 
     /// Density of microfacet normals `m` (unit) per projected solid angle of the macro
@@ -34,10 +66,17 @@ impl TrowbridgeReitz {
         if m.z <= 0.0 {
             return 0.0;
         }
-        // 1 / (π α² cos⁴θ (1 + tan²θ / α²)²) written with sin²θ = x² + y², which keeps its
-        // precision near the normal where 1 − z² would not.
-        let a2 = self.alpha * self.alpha;
-        let t = m.z * m.z + (m.x * m.x + m.y * m.y) / a2;
+        // 1 / (π α_x α_y (z² + x² / α_x² + y² / α_y²)²), isotropic: 1 / (π α² cos⁴θ
+        // (1 + tan²θ / α²)²) written with sin²θ = x² + y², which keeps its precision near
+        // the normal where 1 − z² would not.
+        let a2 = self.alpha_x * self.alpha_y;
+        let slopes = if self.is_isotropic() {
+            (m.x * m.x + m.y * m.y) / a2
+        } else {
+            let (x, y) = (m.x / self.alpha_x, m.y / self.alpha_y);
+            x * x + y * y
+        };
+        let t = m.z * m.z + slopes;
         FRAC_1_PI / (a2 * t * t)
     }
 
@@ -48,7 +87,13 @@ impl TrowbridgeReitz {
         if z2 == 0.0 {
             return f32::INFINITY;
         }
-        let a2_tan2 = self.alpha * self.alpha * (w.x * w.x + w.y * w.y) / z2;
+        // α² tan²θ, with α the roughness in w's azimuth: (α_x² x² + α_y² y²) / z².
+        let a2_tan2 = if self.is_isotropic() {
+            self.alpha_x * self.alpha_x * (w.x * w.x + w.y * w.y) / z2
+        } else {
+            let (x, y) = (self.alpha_x * w.x, self.alpha_y * w.y);
+            (x * x + y * y) / z2
+        };
         0.5 * ((1.0 + a2_tan2).sqrt() - 1.0)
     }
 
@@ -77,13 +122,13 @@ impl TrowbridgeReitz {
         };
         // In the stretched space where α = 1 the visible normals are the points of a
         // spherical cap around wo, offset by wo; stretching back gives GGX's.
-        let stretched = Vec3A::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
+        let stretched = Vec3A::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).normalize();
         let phi = 2.0 * PI * u[0];
         let z = (1.0 - u[1]) * (1.0 + stretched.z) - stretched.z;
         let sin_theta = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
         let (sin_phi, cos_phi) = phi.sin_cos();
         let h = Vec3A::new(sin_theta * cos_phi, sin_theta * sin_phi, z) + stretched;
-        let m = Vec3A::new(self.alpha * h.x, self.alpha * h.y, h.z.max(0.0)).normalize();
+        let m = Vec3A::new(self.alpha_x * h.x, self.alpha_y * h.y, h.z.max(0.0)).normalize();
         if flip { Vec3A::new(m.x, m.y, -m.z) } else { m }
     }
 
@@ -103,10 +148,10 @@ impl TrowbridgeReitz {
             }
         };
         let (wo, m) = (flip(wo), flip(m));
-        let stretched = Vec3A::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
+        let stretched = Vec3A::new(self.alpha_x * wo.x, self.alpha_y * wo.y, wo.z).normalize();
         // In the stretched space h = c + stretched lies along m unstretched, with c on the
         // unit sphere: h = t d with |t d − stretched| = 1, so t = 2 d·stretched.
-        let d = Vec3A::new(m.x / self.alpha, m.y / self.alpha, m.z).normalize();
+        let d = Vec3A::new(m.x / self.alpha_x, m.y / self.alpha_y, m.z).normalize();
         let t = 2.0 * d.dot(stretched);
         if t <= 0.0 {
             return None;
