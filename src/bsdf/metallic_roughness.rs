@@ -41,6 +41,10 @@
 //!   reflectance seen from the back includes total internal reflection; the opaque part is
 //!   seen from the outside on either side. For `ior` ≥ 1 both are glTF's F from the front.
 //!
+//! `KHR_materials_anisotropy` stretches the GGX of every lobe above along a direction in
+//! the tangent plane ([`Anisotropy`]): the local frame's x axis is then that direction, and
+//! the albedo tables are read at an isotropic equivalent (`table_roughness`).
+//!
 //! A clear coat (`KHR_materials_clearcoat`, the `clearcoat` module) lies over all of it,
 //! with its own roughness and normal; it is composed into the sampling, evaluation, density
 //! and lobe choice at the points marked "Clear coat", and skipped where its factor is 0.
