@@ -58,7 +58,7 @@ use super::sheen::{self, Sheen};
 use super::{BsdfLobes, SpecularLobe};
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use std::f32::consts::FRAC_1_PI;
 
 /// glTF's metallic-roughness material (see the module's documentation).
@@ -102,7 +102,8 @@ pub(crate) struct Anisotropy {
     /// In (0, 1].
     pub strength: f32,
     /// Unit, perpendicular to the shading normal (world space): the local frame's x axis.
-    pub direction: Vec3A,
+    /// (A `Vec3`, unaligned: the model is copied by value, and stays smaller so.)
+    pub direction: Vec3,
 }
 
 /// A microfacet of a rough surface, through which a glossy lobe scatters a direction.
@@ -612,7 +613,12 @@ impl MetallicRoughness {
     /// The surface as seen from `wo` (see [`View`]).
     #[inline]
     fn view(&self, normal: Vec3A, wo: Vec3A) -> Option<View> {
-        View::of(self.ior, normal, wo, self.anisotropy.map(|a| a.direction))
+        View::of(
+            self.ior,
+            normal,
+            wo,
+            self.anisotropy.map(|a| Vec3A::from(a.direction)),
+        )
     }
 
     /// Whether its lobes are the Dirac ones of roughness 0 (an anisotropic surface is
@@ -1323,7 +1329,7 @@ mod tests {
         MetallicRoughness {
             anisotropy: Some(Anisotropy {
                 strength,
-                direction: basis.tangent * c + basis.bitangent * s,
+                direction: (basis.tangent * c + basis.bitangent * s).into(),
             }),
             ..m
         }
@@ -2222,11 +2228,11 @@ mod tests {
             [(0.3, 1.0, 0.0), (0.0, 0.0, 0.0), (0.5, 0.0, 1.0)]
         {
             let m = anisotropic(material(roughness, metallic, transmission, 1.5), 0.9, 0.3);
-            let direction_of = |m: &MetallicRoughness| m.anisotropy.unwrap().direction;
+            let direction_of = |m: &MetallicRoughness| Vec3A::from(m.anisotropy.unwrap().direction);
             let turned = MetallicRoughness {
                 anisotropy: Some(Anisotropy {
                     strength: 0.9,
-                    direction: n.cross(direction_of(&m)),
+                    direction: n.cross(direction_of(&m)).into(),
                 }),
                 ..m
             };

@@ -445,7 +445,7 @@ impl SurfacePoint<'_> {
             .unwrap_or(tangent);
         Some(Anisotropy {
             strength: strength.min(1.0),
-            direction,
+            direction: direction.into(),
         })
     }
 
