@@ -408,6 +408,12 @@ void check_materials() {
     show("c++", "material.sheen_color_texture", cpp.sheen_color_texture);
     show("c", "material.sheen_roughness_texture", c.sheen_roughness_texture);
     show("c++", "material.sheen_roughness_texture", cpp.sheen_roughness_texture);
+    show("c", "material.anisotropy", c.anisotropy);
+    show("c++", "material.anisotropy", cpp.anisotropy);
+    show("c", "material.anisotropy_rotation", c.anisotropy_rotation);
+    show("c++", "material.anisotropy_rotation", cpp.anisotropy_rotation);
+    show("c", "material.anisotropy_texture", c.anisotropy_texture);
+    show("c++", "material.anisotropy_texture", cpp.anisotropy_texture);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -548,6 +554,14 @@ void check_materials() {
         MltMaterial cs = c;
         cs.sheen_roughness = 2.0f;
         message("c", "material.sheen_roughness", cs);
+    }
+    {
+        mlt::Material s;
+        s.anisotropy = 2.0f;
+        message("c++", "material.anisotropy", s.to_c());
+        MltMaterial cs = c;
+        cs.anisotropy = 2.0f;
+        message("c", "material.anisotropy", cs);
     }
     // END GENERATED material checks
 }

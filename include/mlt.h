@@ -654,6 +654,25 @@ typedef struct MltMaterial {
    * transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef sheen_roughness_texture;
+  /**
+   * Metallic-roughness: anisotropy of the microfacets (brushed metal), alpha along its direction
+   * = mix(alpha, 1, strength squared); 0 is isotropic (KHR_materials_anisotropy's
+   * anisotropyStrength). It must be in [0, 1]. Default 0.0.
+   */
+  float anisotropy;
+  /**
+   * Metallic-roughness: the anisotropy's direction in radians, counter-clockwise from the mesh's
+   * tangent towards its bitangent (KHR_materials_anisotropy's anisotropyRotation). Any finite
+   * number. Default 0.0.
+   */
+  float anisotropy_rotation;
+  /**
+   * Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped
+   * from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
+   * (KHR_materials_anisotropy's anisotropyTexture); linear. An index into
+   * `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+   */
+  struct MltTextureRef anisotropy_texture;
 } MltMaterial;
 
 /**

@@ -541,6 +541,17 @@ struct Material {
     /// Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
     /// sheenRoughnessTexture); usually linear.
     TextureRef sheen_roughness_texture;
+    /// Metallic-roughness: anisotropy of the microfacets (brushed metal), alpha along its direction
+    /// = mix(alpha, 1, strength squared); 0 is isotropic (KHR_materials_anisotropy's
+    /// anisotropyStrength).
+    float anisotropy = 0.0f;
+    /// Metallic-roughness: the anisotropy's direction in radians, counter-clockwise from the mesh's
+    /// tangent towards its bitangent (KHR_materials_anisotropy's anisotropyRotation).
+    float anisotropy_rotation = 0.0f;
+    /// Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped
+    /// from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
+    /// (KHR_materials_anisotropy's anisotropyTexture); linear.
+    TextureRef anisotropy_texture;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -616,6 +627,9 @@ struct Material {
         c.sheen_roughness = sheen_roughness;
         c.sheen_color_texture = sheen_color_texture.to_c();
         c.sheen_roughness_texture = sheen_roughness_texture.to_c();
+        c.anisotropy = anisotropy;
+        c.anisotropy_rotation = anisotropy_rotation;
+        c.anisotropy_texture = anisotropy_texture.to_c();
         // END GENERATED material to C
         return c;
     }
@@ -657,6 +671,9 @@ struct Material {
         m.sheen_roughness = c.sheen_roughness;
         m.sheen_color_texture = TextureRef::from_c(c.sheen_color_texture);
         m.sheen_roughness_texture = TextureRef::from_c(c.sheen_roughness_texture);
+        m.anisotropy = c.anisotropy;
+        m.anisotropy_rotation = c.anisotropy_rotation;
+        m.anisotropy_texture = TextureRef::from_c(c.anisotropy_texture);
         // END GENERATED material from C
         return m;
     }

@@ -516,6 +516,80 @@ fn gltf_specular_and_sheen_are_read() {
     }
 }
 
+/// `KHR_materials_anisotropy` is read: strength, rotation and texture (linear, with its
+/// transform); a strength outside [0, 1], a rotation that is not a number and a missing
+/// texture are clear errors.
+#[test]
+fn gltf_anisotropy_is_read() {
+    let path = sky_spheres_with_clay_extensions(
+        "anisotropy",
+        r#""KHR_materials_anisotropy": { "anisotropyStrength": 0.6, "anisotropyRotation": 1.25,
+              "anisotropyTexture": { "index": 1, "extensions": { "KHR_texture_transform": { "scale": [2.0, 3.0] } } } }"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!((clay.anisotropy, clay.anisotropy_rotation), (0.6, 1.25));
+    let texture = clay.anisotropy_texture.expect("the anisotropy texture");
+    assert_eq!(texture.scale, [2.0, 3.0]);
+    assert_eq!(
+        texture.texture,
+        clay.normal_texture.unwrap().texture,
+        "linear"
+    );
+    let (_, glass) = material_named(&data, "glass");
+    assert_eq!((glass.anisotropy, glass.anisotropy_texture), (0.0, None));
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+
+    for (bad, needle) in [
+        (
+            r#""KHR_materials_anisotropy": { "anisotropyStrength": 1.5 }"#,
+            "anisotropyStrength",
+        ),
+        (
+            r#""KHR_materials_anisotropy": { "anisotropyStrength": -0.1 }"#,
+            "anisotropyStrength",
+        ),
+        (
+            r#""KHR_materials_anisotropy": { "anisotropyRotation": "north" }"#,
+            "anisotropyRotation",
+        ),
+        (
+            r#""KHR_materials_anisotropy": { "anisotropyTexture": { "index": 99 } }"#,
+            "anisotropyTexture",
+        ),
+    ] {
+        let path = sky_spheres_with_clay_extensions("anisotropy-bad", bad);
+        let Err(error) = io::load_scene(&path) else {
+            panic!("{bad} loads");
+        };
+        let error = error.to_string();
+        assert!(error.contains(needle), "{bad}: {error}");
+    }
+}
+
+/// MTL's PBR anisotropy: `aniso` its strength, `anisor` its rotation in turns; a strength
+/// above 1 is refused when the scene is made, naming the field.
+#[test]
+fn mtl_anisotropy_is_read_and_bad_values_refused() {
+    let obj =
+        b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl brushed\nf 1 2 3\nusemtl bad\nf 1 2 3\n";
+    let mtl = b"newmtl brushed\nKd 0.9 0.9 0.9\nPm 1\nPr 0.3\naniso 0.8\nanisor 0.25\nnewmtl bad\naniso 2\n";
+    let dir = temp_dir_with(&[("t.obj", obj), ("t.mtl", mtl)]);
+    let data = io::load_scene(&dir.join("t.obj")).unwrap();
+    let (_, brushed) = material_named(&data, "brushed");
+    assert_eq!(brushed.kind, MaterialKind::MetallicRoughness);
+    assert_eq!(brushed.anisotropy, 0.8);
+    assert_eq!(brushed.anisotropy_rotation, std::f32::consts::FRAC_PI_2);
+    let Err(error) = Scene::new(&data.desc(mlt::Backend::Bvh)) else {
+        panic!("an anisotropy of 2 was accepted");
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("anisotropy") && error.contains("[0, 1]"),
+        "{error}"
+    );
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");

@@ -189,6 +189,17 @@ class Material:
     #: Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's
     #: sheenRoughnessTexture); usually linear.
     sheen_roughness_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: anisotropy of the microfacets (brushed metal), alpha along its direction
+    #: = mix(alpha, 1, strength squared); 0 is isotropic (KHR_materials_anisotropy's
+    #: anisotropyStrength).
+    anisotropy: float = 0.0
+    #: Metallic-roughness: the anisotropy's direction in radians, counter-clockwise from the mesh's
+    #: tangent towards its bitangent (KHR_materials_anisotropy's anisotropyRotation).
+    anisotropy_rotation: float = 0.0
+    #: Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped
+    #: from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
+    #: (KHR_materials_anisotropy's anisotropyTexture); linear.
+    anisotropy_texture: Optional[TextureRef] = None
     # END GENERATED material
 
     @classmethod

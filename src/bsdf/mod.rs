@@ -18,7 +18,7 @@ mod scattering;
 mod sheen;
 
 pub(crate) use clearcoat::Clearcoat;
-pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
+pub(crate) use metallic_roughness::{Anisotropy, MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 pub(crate) use sheen::Sheen;

@@ -63,6 +63,9 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         sheen_roughness,
         sheen_color_texture,
         sheen_roughness_texture,
+        anisotropy,
+        anisotropy_rotation,
+        anisotropy_texture,
         // END GENERATED material from C
     }
 }

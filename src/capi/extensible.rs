@@ -198,11 +198,13 @@ impl Extensible for MltMaterial {
     const TYPE_NAME: &'static str = "MltMaterial";
     const INITIALIZER: &'static str = "mlt_material_default";
     /// Before the metallic-roughness model and textures (mlt 0.2's header): 36 bytes; before
-    /// the transmission texture (0.3's): 168; before the clear coat, the volume, specular and sheen (0.4's): 192.
+    /// the transmission texture (0.3's): 168; before the clear coat, the volume, specular and sheen (0.4's): 192;
+    /// before the anisotropy: 424.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltMaterial, metallic),
         offset_of!(MltMaterial, transmission_texture),
         offset_of!(MltMaterial, clearcoat),
+        offset_of!(MltMaterial, anisotropy),
     ];
     fn defaults() -> Self {
         (&Material::default()).into()
@@ -257,6 +259,9 @@ impl From<&Material> for MltMaterial {
             sheen_roughness,
             sheen_color_texture,
             sheen_roughness_texture,
+            anisotropy,
+            anisotropy_rotation,
+            anisotropy_texture,
             // END GENERATED material to C
         }
     }
@@ -537,7 +542,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 456]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, today.

@@ -295,6 +295,19 @@ pub struct MltMaterial {
     /// sheenRoughnessTexture); usually linear. An index into `MltSceneDesc.textures` and its
     /// transform. Default `MLT_NO_TEXTURE` (-1).
     pub sheen_roughness_texture: MltTextureRef,
+    /// Metallic-roughness: anisotropy of the microfacets (brushed metal), alpha along its direction
+    /// = mix(alpha, 1, strength squared); 0 is isotropic (KHR_materials_anisotropy's
+    /// anisotropyStrength). It must be in [0, 1]. Default 0.0.
+    pub anisotropy: f32,
+    /// Metallic-roughness: the anisotropy's direction in radians, counter-clockwise from the mesh's
+    /// tangent towards its bitangent (KHR_materials_anisotropy's anisotropyRotation). Any finite
+    /// number. Default 0.0.
+    pub anisotropy_rotation: f32,
+    /// Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped
+    /// from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
+    /// (KHR_materials_anisotropy's anisotropyTexture); linear. An index into
+    /// `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+    pub anisotropy_texture: MltTextureRef,
     // END GENERATED material
 }
 

@@ -25,6 +25,7 @@ const MAX_NODE_DEPTH: usize = 1024;
 /// itself: a file that requires them is accepted (the crate refuses required extensions
 /// it does not know).
 const EXTENSIONS_READ_HERE: &[&str] = &[
+    "KHR_materials_anisotropy",
     "KHR_materials_clearcoat",
     "KHR_materials_dispersion",
     "KHR_materials_sheen",
@@ -664,6 +665,45 @@ impl Loader<'_> {
         Ok(())
     }
 
+    /// `KHR_materials_anisotropy` (read from the JSON: the gltf crate does not parse it):
+    /// strength, rotation and texture (linear); a strength outside [0, 1] or a rotation
+    /// that is not a finite number is an error.
+    fn anisotropy(
+        &mut self,
+        material: &::gltf::Material,
+        converted: &mut Material,
+    ) -> Result<(), IoError> {
+        let Some(extension) = material.extension_value("KHR_materials_anisotropy") else {
+            return Ok(());
+        };
+        let name = material
+            .index()
+            .map_or("(default)".into(), |i| i.to_string());
+        let what = "KHR_materials_anisotropy";
+        converted.anisotropy = self.json_number(
+            extension,
+            "anisotropyStrength",
+            0.0,
+            (0.0, 1.0),
+            what,
+            &name,
+        )?;
+        if let Some(value) = extension.get("anisotropyRotation") {
+            converted.anisotropy_rotation = value
+                .as_f64()
+                .map(|v| v as f32)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    self.fail(format!(
+                        "material {name}: {what}'s anisotropyRotation is {value}; it must be a finite number (radians)"
+                    ))
+                })?;
+        }
+        converted.anisotropy_texture =
+            self.json_texture(extension, "anisotropyTexture", false, what, &name)?;
+        Ok(())
+    }
+
     /// The number `key` of an extension's JSON (`default` if absent), within `range`.
     fn json_number(
         &self,
@@ -925,6 +965,7 @@ impl Loader<'_> {
             )?);
         }
         self.specular_and_sheen(material, &mut converted)?;
+        self.anisotropy(material, &mut converted)?;
         // KHR_materials_dispersion (not parsed by the gltf crate): `dispersion` is 20 / V_d.
         if let Some(extension) = material.extension_value("KHR_materials_dispersion") {
             let dispersion = extension

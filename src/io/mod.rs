@@ -29,6 +29,9 @@
 //! - the PBR extension's `Pc` (clear coat thickness, taken as its factor in [0, 1]) and
 //!   `Pcr` (its roughness, 0 if absent) on a metallic-roughness material: its clear coat;
 //!   `Pc` alone makes the material metallic-roughness;
+//! - the PBR extension's `aniso` (anisotropy strength in [0, 1]) and `anisor` (its
+//!   rotation, as a fraction of a full turn, Blender's convention) on a metallic-roughness
+//!   material: its anisotropy; `aniso` alone makes the material metallic-roughness;
 //! - `Vd` (mlt's own keyword; MTL has none for it) on a dielectric or metallic-roughness
 //!   material: its Abbe number, the dispersion `Material::abbe_number` describes.
 //!
@@ -82,7 +85,8 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   `KHR_materials_transmission` (factor and texture), `KHR_materials_ior`,
 ///   `KHR_materials_dispersion`, `KHR_texture_transform`, `KHR_materials_clearcoat`
 ///   (factors, textures and the coat's own normal map), `KHR_materials_specular` and
-///   `KHR_materials_sheen` (factors and textures), `KHR_materials_volume` (thickness as
+///   `KHR_materials_sheen` (factors and textures), `KHR_materials_anisotropy` (strength,
+///   rotation and texture), `KHR_materials_volume` (thickness as
 ///   the flag, attenuation colour and distance), `KHR_materials_unlit` (the base colour
 ///   emitted, nothing scattered), `KHR_materials_variants` (see [`load_scene_variant`]);
 ///   files may require any of these. Alpha modes (`BLEND` as stochastic coverage,

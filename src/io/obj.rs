@@ -161,9 +161,13 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         ),
         None => None,
     };
+    // The PBR extension's anisotropy, `aniso` its strength in [0, 1] and `anisor` its
+    // rotation as a fraction of a full turn (Blender's convention, which writes them).
+    let (anisotropy, anisotropy_turns) = (number("aniso")?, number("anisor")?);
     let pbr = roughness.is_some()
         || metallic.is_some()
         || clearcoat.is_some()
+        || anisotropy.is_some()
         || sheen.is_some()
         || m.unknown_param.contains_key("map_Pr")
         || m.unknown_param.contains_key("map_Pm");
@@ -208,6 +212,8 @@ fn convert_material(m: &tobj::Material) -> Result<Material, String> {
             clearcoat: clearcoat.unwrap_or(0.0),
             clearcoat_roughness: clearcoat_roughness.unwrap_or(0.0),
             sheen_color: sheen.unwrap_or([0.0; 3]),
+            anisotropy: anisotropy.unwrap_or(0.0),
+            anisotropy_rotation: anisotropy_turns.unwrap_or(0.0) * std::f32::consts::TAU,
             ..material
         },
         _ => material,

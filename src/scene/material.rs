@@ -60,8 +60,10 @@ declare_parameters! {
     /// and `clearcoat_normal_texture` is the coat's own normal map (scaled by
     /// `clearcoat_normal_scale`); `specular_texture`'s alpha and `specular_color_texture`'s
     /// RGB multiply `specular` and `specular_color`, `sheen_color_texture`'s RGB and
-    /// `sheen_roughness_texture`'s alpha `sheen_color` and `sheen_roughness`. Per-vertex
-    /// colours multiply `color` and `alpha` too.
+    /// `sheen_roughness_texture`'s alpha `sheen_color` and `sheen_roughness`;
+    /// `anisotropy_texture`'s red and green give the anisotropy's direction in the tangent
+    /// plane and its blue multiplies `anisotropy`. Per-vertex colours multiply `color` and
+    /// `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
     #[derive(Clone, Copy, Debug, PartialEq)]
@@ -253,6 +255,22 @@ declare_parameters! {
         sheen_roughness_texture: Option<TextureRef> = None => {
             doc: "Metallic-roughness: alpha multiplies the sheen roughness (KHR_materials_sheen's sheenRoughnessTexture); usually linear.",
         },
+        /// Metallic-roughness: the anisotropy of the microfacets (`KHR_materials_anisotropy`'s
+        /// `anisotropyStrength`), in [0, 1]: GGX's α along the anisotropy's direction is
+        /// mix(α, 1, strength²), across it α; 0, the default, is isotropic.
+        anisotropy: f32 = 0.0 => {
+            doc: "Metallic-roughness: anisotropy of the microfacets (brushed metal), alpha along its direction = mix(alpha, 1, strength squared); 0 is isotropic (KHR_materials_anisotropy's anisotropyStrength).",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        /// Metallic-roughness: the anisotropy's direction, in radians counter-clockwise from
+        /// the mesh's tangent towards its bitangent (`anisotropyRotation`); finite.
+        anisotropy_rotation: f32 = 0.0 => {
+            doc: "Metallic-roughness: the anisotropy's direction in radians, counter-clockwise from the mesh's tangent towards its bitangent (KHR_materials_anisotropy's anisotropyRotation).",
+        },
+        anisotropy_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength (KHR_materials_anisotropy's anisotropyTexture); linear.",
+        },
     }
 }
 
@@ -437,6 +455,8 @@ impl Material {
                 specular_color: layers.specular_color(channels),
                 specular_color_max: max3(layers.specular_color),
                 sheen: layers.sheen(channels),
+                // Its direction needs the surface's tangent frame: the surface sets it.
+                anisotropy: None,
             }),
         }
     }

@@ -936,14 +936,20 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
 }
 
 /// Per-corner tangents of the host's triangles (3 per triangle), where a material has a
-/// normal map: the host's per-vertex tangents, or MikkTSpace's from the normals (vertex
-/// normals averaged from the faces when the host gave none) and texture coordinates.
-/// Empty when no material has a normal map.
+/// normal map or anisotropy: the host's per-vertex tangents, or MikkTSpace's from the
+/// normals (vertex normals averaged from the faces when the host gave none) and texture
+/// coordinates. Empty when no material needs them, or there are neither tangents nor
+/// texture coordinates (a normal map needs texture coordinates; anisotropy can do with
+/// the host's tangents alone).
 fn corner_tangents(desc: &SceneDesc) -> Vec<[f32; 4]> {
-    if !desc.materials.iter().any(|m| m.normal_texture.is_some()) || desc.texcoords.is_empty() {
+    let normal_mapped = desc.materials.iter().any(|m| m.normal_texture.is_some());
+    let anisotropic = desc.materials.iter().any(|m| m.anisotropy > 0.0);
+    let host_tangents_usable =
+        !desc.tangents.is_empty() && (anisotropic || !desc.texcoords.is_empty());
+    if !(normal_mapped || anisotropic) || desc.texcoords.is_empty() && !host_tangents_usable {
         return Vec::new();
     }
-    if !desc.tangents.is_empty() {
+    if host_tangents_usable {
         return desc
             .indices
             .iter()

@@ -6,8 +6,9 @@
 //! hit reads one contiguous record per attribute. A scene without an attribute stores none.
 
 use super::material::{Material, SpecularAndSheen, TextureRef};
-use crate::bsdf::{Bsdf, BsdfModel, Clearcoat};
+use crate::bsdf::{Anisotropy, Bsdf, BsdfModel, Clearcoat};
 use crate::error::{Error, Result};
+use crate::sampling::OrthonormalBasis;
 use crate::spectral::{Channels, FittedColour};
 use crate::spectrum::Spectrum;
 use crate::texture::Texture;
@@ -157,7 +158,10 @@ impl SurfaceAttributes {
     /// Whether a point's BSDF is its material's untextured one on the geometric normal.
     #[inline]
     fn is_flat(&self, material: &Material) -> bool {
-        self.normals.is_empty() && self.colors.is_empty() && !material.has_textures()
+        self.normals.is_empty()
+            && self.colors.is_empty()
+            && !material.has_textures()
+            && material.anisotropy == 0.0
     }
 
     /// The interpolated texture coordinates of set `set` (0 or 1; (0, 0) without any).
@@ -399,6 +403,52 @@ impl SurfacePoint<'_> {
         layers
     }
 
+    /// `KHR_materials_anisotropy` here: its strength (times the texture's blue), and its
+    /// direction (the texture's red and green, or the tangent, turned by the rotation) in
+    /// the frame of the mesh's tangent and bitangent made perpendicular to `normal`. A
+    /// mesh without tangents gets an arbitrary frame about the normal. `None` where the
+    /// strength is 0.
+    #[inline]
+    fn anisotropy(&self, normal: Vec3A) -> Option<Anisotropy> {
+        let m = self.material;
+        let mut strength = m.anisotropy;
+        if strength <= 0.0 {
+            return None;
+        }
+        let (mut x, mut y) = (1.0, 0.0);
+        if let Some(texture) = &m.anisotropy_texture {
+            let texel = self.lookup(texture);
+            (x, y) = (texel.x * 2.0 - 1.0, texel.y * 2.0 - 1.0);
+            strength *= texel.z;
+            if strength <= 0.0 {
+                return None;
+            }
+        }
+        let (sin, cos) = m.anisotropy_rotation.sin_cos();
+        let (x, y) = (cos * x - sin * y, sin * x + cos * y);
+        let tangent = self
+            .attributes
+            .tangent(self.triangle, self.barycentrics)
+            .and_then(|t| {
+                // Gram-Schmidt: the interpolated tangent is only nearly perpendicular.
+                let xyz = Vec3A::new(t.x, t.y, t.z);
+                let tangent = (xyz - normal * normal.dot(xyz)).try_normalize()?;
+                Some((tangent, normal.cross(tangent) * t.w.signum()))
+            });
+        let (tangent, bitangent) = tangent.unwrap_or_else(|| {
+            let basis = OrthonormalBasis::from_normal(normal);
+            (basis.tangent, basis.bitangent)
+        });
+        // A texel at the middle of red and green names no direction: the tangent's.
+        let direction = (tangent * x + bitangent * y)
+            .try_normalize()
+            .unwrap_or(tangent);
+        Some(Anisotropy {
+            strength: strength.min(1.0),
+            direction: direction.into(),
+        })
+    }
+
     /// The BSDF here, on a triangle with front geometric normal `geometric_normal`.
     #[inline]
     pub fn bsdf(&self, geometric_normal: Vec3A, channels: &Channels) -> Bsdf {
@@ -441,10 +491,11 @@ impl SurfacePoint<'_> {
             channels,
         );
         let shading_normal = self.shading_normal(geometric_normal);
-        if let BsdfModel::MetallicRoughness(model) = &mut model
-            && model.clearcoat.is_present()
-        {
-            model.clearcoat = self.clearcoat(shading_normal, geometric_normal);
+        if let BsdfModel::MetallicRoughness(model) = &mut model {
+            if model.clearcoat.is_present() {
+                model.clearcoat = self.clearcoat(shading_normal, geometric_normal);
+            }
+            model.anisotropy = self.anisotropy(shading_normal);
         }
         Bsdf::new(model, shading_normal, geometric_normal).with_dispersion(dispersive)
     }
