@@ -408,6 +408,18 @@ void check_materials() {
     show("c++", "material.sheen_color_texture", cpp.sheen_color_texture);
     show("c", "material.sheen_roughness_texture", c.sheen_roughness_texture);
     show("c++", "material.sheen_roughness_texture", cpp.sheen_roughness_texture);
+    show("c", "material.iridescence", c.iridescence);
+    show("c++", "material.iridescence", cpp.iridescence);
+    show("c", "material.iridescence_texture", c.iridescence_texture);
+    show("c++", "material.iridescence_texture", cpp.iridescence_texture);
+    show("c", "material.iridescence_ior", c.iridescence_ior);
+    show("c++", "material.iridescence_ior", cpp.iridescence_ior);
+    show("c", "material.iridescence_thickness_minimum", c.iridescence_thickness_minimum);
+    show("c++", "material.iridescence_thickness_minimum", cpp.iridescence_thickness_minimum);
+    show("c", "material.iridescence_thickness_maximum", c.iridescence_thickness_maximum);
+    show("c++", "material.iridescence_thickness_maximum", cpp.iridescence_thickness_maximum);
+    show("c", "material.iridescence_thickness_texture", c.iridescence_thickness_texture);
+    show("c++", "material.iridescence_thickness_texture", cpp.iridescence_thickness_texture);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -548,6 +560,38 @@ void check_materials() {
         MltMaterial cs = c;
         cs.sheen_roughness = 2.0f;
         message("c", "material.sheen_roughness", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence = 2.0f;
+        message("c++", "material.iridescence", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence = 2.0f;
+        message("c", "material.iridescence", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_ior = 0.0f;
+        message("c++", "material.iridescence_ior", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_ior = 0.0f;
+        message("c", "material.iridescence_ior", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_thickness_minimum = -1.0f;
+        message("c++", "material.iridescence_thickness_minimum", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_thickness_minimum = -1.0f;
+        message("c", "material.iridescence_thickness_minimum", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_thickness_maximum = -1.0f;
+        message("c++", "material.iridescence_thickness_maximum", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_thickness_maximum = -1.0f;
+        message("c", "material.iridescence_thickness_maximum", cs);
     }
     // END GENERATED material checks
 }

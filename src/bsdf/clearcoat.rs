@@ -316,6 +316,7 @@ mod tests {
             specular_color: Spectrum::ONE,
             specular_color_max: 1.0,
             sheen: None,
+            film: None,
         }
     }
 

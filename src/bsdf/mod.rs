@@ -16,12 +16,14 @@ mod microfacet;
 mod multiple_scattering;
 mod scattering;
 mod sheen;
+mod thin_film;
 
 pub(crate) use clearcoat::Clearcoat;
 pub(crate) use metallic_roughness::{MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 pub(crate) use sheen::Sheen;
+pub(crate) use thin_film::ThinFilm;
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;

@@ -63,6 +63,12 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         sheen_roughness,
         sheen_color_texture,
         sheen_roughness_texture,
+        iridescence,
+        iridescence_texture,
+        iridescence_ior,
+        iridescence_thickness_minimum,
+        iridescence_thickness_maximum,
+        iridescence_thickness_texture,
         // END GENERATED material from C
     }
 }

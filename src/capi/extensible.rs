@@ -203,6 +203,7 @@ impl Extensible for MltMaterial {
         offset_of!(MltMaterial, metallic),
         offset_of!(MltMaterial, transmission_texture),
         offset_of!(MltMaterial, clearcoat),
+        offset_of!(MltMaterial, iridescence),
     ];
     fn defaults() -> Self {
         (&Material::default()).into()
@@ -257,6 +258,12 @@ impl From<&Material> for MltMaterial {
             sheen_roughness,
             sheen_color_texture,
             sheen_roughness_texture,
+            iridescence,
+            iridescence_texture,
+            iridescence_ior,
+            iridescence_thickness_minimum,
+            iridescence_thickness_maximum,
+            iridescence_thickness_texture,
             // END GENERATED material to C
         }
     }
@@ -537,7 +544,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 488]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, today.
