@@ -9,7 +9,7 @@
 //! coloured scene. Tolerances are 4–6 standard errors of the image mean, each checked sharp
 //! enough that a 2% brightness error fails.
 //!
-//! Runs in about 23 s on 2 cores (`cargo test --test spectral`).
+//! Runs in about 31 s on 2 cores (`cargo test --test spectral`).
 
 mod common {
     pub mod references;
