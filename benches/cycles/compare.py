@@ -419,10 +419,24 @@ SHEEN_ROUGHNESSES = (0.3, 0.5, 1.0)
 FURNACE_COSINES = (0.95, 0.8, 0.6, 0.4, 0.25)
 
 
-def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
+def sheen_sphere_gltf(path, roughness):
     """A unit sphere of sheen alone: black base, `KHR_materials_specular`'s factor 0 (no
     specular lobe at any angle: an index of refraction of 1 would leave Schlick's grazing
     term), white sheen of the given roughness."""
+    sphere_gltf(path, {
+        "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
+                                 "roughnessFactor": 1},
+        "extensions": {
+            "KHR_materials_specular": {"specularFactor": 0.0},
+            "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
+                                    "sheenRoughnessFactor": roughness},
+        },
+    })
+
+
+def sphere_gltf(path, material, rings=96, segments=192):
+    """A unit sphere at the origin of glTF material `material` (its extensions listed as
+    used)."""
     positions, indices = [], []
     for i in range(rings + 1):
         theta = math.pi * i / rings
@@ -440,21 +454,13 @@ def sheen_sphere_gltf(path, roughness, rings=96, segments=192):
     count = len(positions) // 3
     document = {
         "asset": {"version": "2.0"},
-        "extensionsUsed": ["KHR_materials_sheen", "KHR_materials_specular"],
+        "extensionsUsed": sorted(material.get("extensions", {})),
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2,
                                     "material": 0}]}],
-        "materials": [{
-            "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
-                                     "roughnessFactor": 1},
-            "extensions": {
-                "KHR_materials_specular": {"specularFactor": 0.0},
-                "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
-                                        "sheenRoughnessFactor": roughness},
-            },
-        }],
+        "materials": [material],
         "accessors": [
             {"bufferView": 0, "componentType": 5126, "count": count, "type": "VEC3",
              "min": [-1, -1, -1], "max": [1, 1, 1]},
