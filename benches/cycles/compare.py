@@ -783,6 +783,15 @@ def write_page(args, sky_rows, results, furnace_rows, seconds):
             furnace_table(furnace_rows),
             "",
         ]
+    lines += [
+        "## A thin film alone in a white furnace",
+        "",
+        "Blender's importer does not read `KHR_materials_iridescence`; Cycles' Principled BSDF",
+        "has a thin film of its own (Thin Film Thickness and IOR). `benches/cycles/thin_film.py`",
+        "compares the two on a smooth sphere under a white sky and writes",
+        "[its table](cycles-thin-film.md).",
+        "",
+    ]
     with open(os.path.join(ROOT, "docs", "cycles.md"), "w") as f:
         f.write("\n".join(lines))
 

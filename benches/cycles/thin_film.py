@@ -101,8 +101,33 @@ def main():
     target = os.environ.get("CARGO_TARGET_DIR", os.path.join(compare.ROOT, "target"))
     directory = os.path.join(target, "mlt-bench", "thin-film")
     os.makedirs(directory, exist_ok=True)
+    rows = run(args, directory)
     print("A thin film alone in a white furnace, linear sRGB reflectance at cos θo:")
-    print(table(run(args, directory)))
+    print(table(rows))
+    lines = [
+        "# A thin film alone: mlt against Blender Cycles",
+        "",
+        "<!-- Written by benches/cycles/thin_film.py: edit the script, not this page. -->",
+        "",
+        "A smooth unit sphere (roughness 0) under a white sky of radiance 1: a pixel's colour",
+        "is the surface's reflectance at its cos θo (averaged over the covered pixels whose",
+        "centre's cos θo is within ±0.02), linear sRGB. Blender's importer does not read",
+        "`KHR_materials_iridescence`, so the script sets the Principled BSDF's Thin Film",
+        "Thickness and Thin Film IOR by hand after the import. Bases: a black dielectric of",
+        "index 1.5 (the specular reflection alone) and a metal of base colour",
+        "(0.95, 0.64, 0.54). mlt renders the file with the extension in RGB and with",
+        f"`--spectral` ({args.size}², {args.spp} samples per pixel, as Cycles). mlt follows the",
+        "specification (Schlick's Fresnel at both interfaces, a metal's index derived from its",
+        "F0); Cycles evaluates its own film model (see",
+        "[lights and surfaces](lights-and-surfaces.md#thin-film-iridescence)).",
+        "",
+        "    nice -n 10 target/cycles-venv/bin/python benches/cycles/thin_film.py",
+        "",
+        table(rows),
+        "",
+    ]
+    with open(os.path.join(compare.ROOT, "docs", "cycles-thin-film.md"), "w") as f:
+        f.write("\n".join(lines))
 
 
 if __name__ == "__main__":
