@@ -478,6 +478,39 @@ mod tests {
         assert!(coated.has_non_specular() && coated.contains(BsdfLobes::SPECULAR));
     }
 
+    /// A film of strength 0 or thickness 0 is no film (as `KHR_materials_iridescence`
+    /// defines): the model is the plain material's, in RGB and spectral renders, and a
+    /// film of both has one.
+    #[test]
+    fn a_film_without_strength_or_thickness_is_none() {
+        let plain = Material::metallic_roughness([0.6, 0.3, 0.2], 0.5, 0.4);
+        let spectral = Channels::new(true, || 0.3);
+        for channels in [Channels::Rgb, spectral] {
+            let model = |m: Material| match m.bsdf_model(&channels) {
+                BsdfModel::MetallicRoughness(m) => m,
+                _ => unreachable!(),
+            };
+            for m in [
+                Material {
+                    iridescence: 0.0,
+                    ..plain
+                },
+                Material {
+                    iridescence: 1.0,
+                    iridescence_thickness_maximum: 0.0,
+                    ..plain
+                },
+            ] {
+                assert_eq!(model(m), model(plain));
+            }
+            let filmed = model(Material {
+                iridescence: 0.5,
+                ..plain
+            });
+            assert_eq!(filmed.film.map(|f| f.thickness), Some(400.0));
+        }
+    }
+
     /// Energy conservation and reciprocity-style check: the albedo estimated by sampling
     /// equals the material's color for diffuse, and the pdf matches eval/cos for diffuse.
     #[test]
