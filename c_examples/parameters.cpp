@@ -414,6 +414,18 @@ void check_materials() {
     show("c++", "material.anisotropy_rotation", cpp.anisotropy_rotation);
     show("c", "material.anisotropy_texture", c.anisotropy_texture);
     show("c++", "material.anisotropy_texture", cpp.anisotropy_texture);
+    show("c", "material.iridescence", c.iridescence);
+    show("c++", "material.iridescence", cpp.iridescence);
+    show("c", "material.iridescence_texture", c.iridescence_texture);
+    show("c++", "material.iridescence_texture", cpp.iridescence_texture);
+    show("c", "material.iridescence_ior", c.iridescence_ior);
+    show("c++", "material.iridescence_ior", cpp.iridescence_ior);
+    show("c", "material.iridescence_thickness_minimum", c.iridescence_thickness_minimum);
+    show("c++", "material.iridescence_thickness_minimum", cpp.iridescence_thickness_minimum);
+    show("c", "material.iridescence_thickness_maximum", c.iridescence_thickness_maximum);
+    show("c++", "material.iridescence_thickness_maximum", cpp.iridescence_thickness_maximum);
+    show("c", "material.iridescence_thickness_texture", c.iridescence_thickness_texture);
+    show("c++", "material.iridescence_thickness_texture", cpp.iridescence_thickness_texture);
     {
         mlt::Material s;
         s.color = {2.0f, 0.8f, 0.8f};
@@ -562,6 +574,38 @@ void check_materials() {
         MltMaterial cs = c;
         cs.anisotropy = 2.0f;
         message("c", "material.anisotropy", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence = 2.0f;
+        message("c++", "material.iridescence", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence = 2.0f;
+        message("c", "material.iridescence", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_ior = 0.0f;
+        message("c++", "material.iridescence_ior", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_ior = 0.0f;
+        message("c", "material.iridescence_ior", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_thickness_minimum = -1.0f;
+        message("c++", "material.iridescence_thickness_minimum", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_thickness_minimum = -1.0f;
+        message("c", "material.iridescence_thickness_minimum", cs);
+    }
+    {
+        mlt::Material s;
+        s.iridescence_thickness_maximum = -1.0f;
+        message("c++", "material.iridescence_thickness_maximum", s.to_c());
+        MltMaterial cs = c;
+        cs.iridescence_thickness_maximum = -1.0f;
+        message("c", "material.iridescence_thickness_maximum", cs);
     }
     // END GENERATED material checks
 }

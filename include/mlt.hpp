@@ -552,6 +552,26 @@ struct Material {
     /// from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
     /// (KHR_materials_anisotropy's anisotropyTexture); linear.
     TextureRef anisotropy_texture;
+    /// Metallic-roughness: strength of a thin film over the material, its interference colours
+    /// (soap bubbles, oil); 0 is none (KHR_materials_iridescence's iridescenceFactor). Exact per
+    /// wavelength in spectral renders, integrated over each RGB channel otherwise.
+    float iridescence = 0.0f;
+    /// Metallic-roughness: red multiplies the thin film's strength (KHR_materials_iridescence's
+    /// iridescenceTexture); usually linear.
+    TextureRef iridescence_texture;
+    /// Metallic-roughness: the thin film's index of refraction (KHR_materials_iridescence's
+    /// iridescenceIor).
+    float iridescence_ior = 1.3f;
+    /// Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    /// green is 0 (KHR_materials_iridescence's iridescenceThicknessMinimum).
+    float iridescence_thickness_minimum = 100.0f;
+    /// Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    /// green is 1, and everywhere without it; 0 is no film (KHR_materials_iridescence's
+    /// iridescenceThicknessMaximum).
+    float iridescence_thickness_maximum = 400.0f;
+    /// Metallic-roughness: green interpolates the thin film's thickness from the minimum (0) to the
+    /// maximum (1) (KHR_materials_iridescence's iridescenceThicknessTexture); usually linear.
+    TextureRef iridescence_thickness_texture;
     // END GENERATED material members
 
     static Material diffuse(const Rgb &albedo) {
@@ -630,6 +650,12 @@ struct Material {
         c.anisotropy = anisotropy;
         c.anisotropy_rotation = anisotropy_rotation;
         c.anisotropy_texture = anisotropy_texture.to_c();
+        c.iridescence = iridescence;
+        c.iridescence_texture = iridescence_texture.to_c();
+        c.iridescence_ior = iridescence_ior;
+        c.iridescence_thickness_minimum = iridescence_thickness_minimum;
+        c.iridescence_thickness_maximum = iridescence_thickness_maximum;
+        c.iridescence_thickness_texture = iridescence_thickness_texture.to_c();
         // END GENERATED material to C
         return c;
     }
@@ -674,6 +700,12 @@ struct Material {
         m.anisotropy = c.anisotropy;
         m.anisotropy_rotation = c.anisotropy_rotation;
         m.anisotropy_texture = TextureRef::from_c(c.anisotropy_texture);
+        m.iridescence = c.iridescence;
+        m.iridescence_texture = TextureRef::from_c(c.iridescence_texture);
+        m.iridescence_ior = c.iridescence_ior;
+        m.iridescence_thickness_minimum = c.iridescence_thickness_minimum;
+        m.iridescence_thickness_maximum = c.iridescence_thickness_maximum;
+        m.iridescence_thickness_texture = TextureRef::from_c(c.iridescence_thickness_texture);
         // END GENERATED material from C
         return m;
     }

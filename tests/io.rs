@@ -590,6 +590,135 @@ fn mtl_anisotropy_is_read_and_bad_values_refused() {
     );
 }
 
+/// `sky_spheres_with_clay_extensions` with `KHR_materials_iridescence` required too.
+fn sky_spheres_with_iridescent_clay(name: &str, clay_extensions: &str) -> std::path::PathBuf {
+    let path = sky_spheres_with_clay_extensions(name, clay_extensions);
+    let text = std::fs::read_to_string(&path).unwrap().replacen(
+        r#""extensionsRequired": ["#,
+        r#""extensionsRequired": ["KHR_materials_iridescence", "#,
+        1,
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `KHR_materials_iridescence` is read, factors and textures, with the specification's
+/// defaults where a member is absent, and a file that requires it loads; values out of its
+/// ranges are clear errors, in the loader and in the material's own checks.
+#[test]
+fn gltf_iridescence_is_read() {
+    let path = sky_spheres_with_iridescent_clay(
+        "iridescence",
+        r#""KHR_materials_iridescence": { "iridescenceFactor": 0.8, "iridescenceIor": 1.6,
+              "iridescenceThicknessMinimum": 150.0, "iridescenceThicknessMaximum": 600.0,
+              "iridescenceTexture": { "index": 1 }, "iridescenceThicknessTexture": { "index": 1 } }"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!(clay.iridescence, 0.8);
+    assert_eq!(clay.iridescence_ior, 1.6);
+    assert_eq!(
+        (
+            clay.iridescence_thickness_minimum,
+            clay.iridescence_thickness_maximum
+        ),
+        (150.0, 600.0)
+    );
+    // Linear, as the normal map: one image, one texture.
+    let linear = clay.normal_texture.unwrap().texture;
+    assert_eq!(clay.iridescence_texture.unwrap().texture, linear);
+    assert_eq!(clay.iridescence_thickness_texture.unwrap().texture, linear);
+    let (_, glass) = material_named(&data, "glass");
+    assert_eq!(glass.iridescence, 0.0);
+    Scene::new(&data.desc(mlt::Backend::Bvh)).unwrap();
+
+    let path = sky_spheres_with_iridescent_clay(
+        "iridescence-defaults",
+        r#""KHR_materials_iridescence": { "iridescenceFactor": 1.0 }"#,
+    );
+    let data = io::load_scene(&path).unwrap();
+    let (_, clay) = material_named(&data, "clay");
+    assert_eq!(
+        (
+            clay.iridescence,
+            clay.iridescence_ior,
+            clay.iridescence_thickness_minimum,
+            clay.iridescence_thickness_maximum
+        ),
+        (1.0, 1.3, 100.0, 400.0)
+    );
+    assert_eq!(clay.iridescence_texture, None);
+
+    for (bad, needle) in [
+        (
+            r#""KHR_materials_iridescence": { "iridescenceFactor": 1.5 }"#,
+            "iridescenceFactor",
+        ),
+        (
+            r#""KHR_materials_iridescence": { "iridescenceIor": 0.5 }"#,
+            "iridescenceIor",
+        ),
+        (
+            r#""KHR_materials_iridescence": { "iridescenceThicknessMaximum": -1.0 }"#,
+            "iridescenceThicknessMaximum",
+        ),
+        (
+            r#""KHR_materials_iridescence": { "iridescenceThicknessMinimum": "thin" }"#,
+            "iridescenceThicknessMinimum",
+        ),
+        (
+            r#""KHR_materials_iridescence": { "iridescenceThicknessTexture": { "index": 99 } }"#,
+            "iridescenceThicknessTexture",
+        ),
+    ] {
+        let path = sky_spheres_with_iridescent_clay("iridescence-bad", bad);
+        let Err(error) = io::load_scene(&path) else {
+            panic!("{bad} loads");
+        };
+        let error = error.to_string();
+        assert!(error.contains(needle), "{bad}: {error}");
+    }
+
+    let film = Material {
+        iridescence: 1.0,
+        ..Material::metallic_roughness([0.5; 3], 0.0, 0.5)
+    };
+    for (bad, field) in [
+        (
+            Material {
+                iridescence_ior: 0.0,
+                ..film
+            },
+            "iridescence_ior",
+        ),
+        (
+            Material {
+                iridescence_thickness_maximum: f32::NAN,
+                ..film
+            },
+            "iridescence_thickness_maximum",
+        ),
+        (
+            Material {
+                iridescence_thickness_minimum: -5.0,
+                ..film
+            },
+            "iridescence_thickness_minimum",
+        ),
+        (
+            Material {
+                iridescence: f32::NAN,
+                ..film
+            },
+            "iridescence",
+        ),
+    ] {
+        let error = bad.validate(0, 0).unwrap_err().to_string();
+        assert!(error.contains(field), "{error}");
+    }
+    film.validate(0, 0).unwrap();
+}
+
 #[test]
 fn cornell_glass_has_a_dielectric_with_ior_1_5() {
     let path = scenes().join("cornell-glass.obj");

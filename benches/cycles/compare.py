@@ -445,7 +445,7 @@ def sheen_sphere_gltf(path, roughness):
     """A unit sphere of sheen alone: black base, `KHR_materials_specular`'s factor 0 (no
     specular lobe at any angle: an index of refraction of 1 would leave Schlick's grazing
     term), white sheen of the given roughness."""
-    material = {
+    sphere_gltf(path, {
         "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
                                  "roughnessFactor": 1},
         "extensions": {
@@ -453,12 +453,12 @@ def sheen_sphere_gltf(path, roughness):
             "KHR_materials_sheen": {"sheenColorFactor": [1, 1, 1],
                                     "sheenRoughnessFactor": roughness},
         },
-    }
-    sphere_gltf(path, material)
+    })
 
 
 def sphere_gltf(path, material, rings=96, segments=192):
-    """A unit sphere at the origin (smooth normals) of one glTF material."""
+    """A unit sphere at the origin of glTF material `material` (its extensions listed as
+    used)."""
     positions, indices = [], []
     for i in range(rings + 1):
         theta = math.pi * i / rings
@@ -879,6 +879,15 @@ def write_page(args, sky_rows, results, furnace_rows, tint_rows, seconds):
             tint_table(tint_rows),
             "",
         ]
+    lines += [
+        "## A thin film alone in a white furnace",
+        "",
+        "Blender's importer does not read `KHR_materials_iridescence`; Cycles' Principled BSDF",
+        "has a thin film of its own (Thin Film Thickness and IOR). `benches/cycles/thin_film.py`",
+        "compares the two on a smooth sphere under a white sky and writes",
+        "[its table](cycles-thin-film.md).",
+        "",
+    ]
     with open(os.path.join(ROOT, "docs", "cycles.md"), "w") as f:
         f.write("\n".join(lines))
 

@@ -200,6 +200,26 @@ class Material:
     #: from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength
     #: (KHR_materials_anisotropy's anisotropyTexture); linear.
     anisotropy_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: strength of a thin film over the material, its interference colours (soap
+    #: bubbles, oil); 0 is none (KHR_materials_iridescence's iridescenceFactor). Exact per
+    #: wavelength in spectral renders, integrated over each RGB channel otherwise.
+    iridescence: float = 0.0
+    #: Metallic-roughness: red multiplies the thin film's strength (KHR_materials_iridescence's
+    #: iridescenceTexture); usually linear.
+    iridescence_texture: Optional[TextureRef] = None
+    #: Metallic-roughness: the thin film's index of refraction (KHR_materials_iridescence's
+    #: iridescenceIor).
+    iridescence_ior: float = 1.3
+    #: Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    #: green is 0 (KHR_materials_iridescence's iridescenceThicknessMinimum).
+    iridescence_thickness_minimum: float = 100.0
+    #: Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    #: green is 1, and everywhere without it; 0 is no film (KHR_materials_iridescence's
+    #: iridescenceThicknessMaximum).
+    iridescence_thickness_maximum: float = 400.0
+    #: Metallic-roughness: green interpolates the thin film's thickness from the minimum (0) to the
+    #: maximum (1) (KHR_materials_iridescence's iridescenceThicknessTexture); usually linear.
+    iridescence_thickness_texture: Optional[TextureRef] = None
     # END GENERATED material
 
     @classmethod

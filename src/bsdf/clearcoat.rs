@@ -317,6 +317,7 @@ mod tests {
             specular_color_max: 1.0,
             sheen: None,
             anisotropy: None,
+            film: None,
         }
     }
 

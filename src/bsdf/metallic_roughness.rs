@@ -62,6 +62,7 @@ use super::microfacet::TrowbridgeReitz;
 use super::multiple_scattering::{CoatReflectance, EnergyCompensation, visible_schlick_mean};
 use super::scattering::{ScatterSample, TransportMode, reflect};
 use super::sheen::{self, Sheen};
+use super::thin_film::ThinFilm;
 use super::{BsdfLobes, SpecularLobe};
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
@@ -98,6 +99,8 @@ pub(crate) struct MetallicRoughness {
     pub sheen: Option<Sheen>,
     /// `KHR_materials_anisotropy`: the microfacets stretched along a direction, if they are.
     pub anisotropy: Option<Anisotropy>,
+    /// `KHR_materials_iridescence`: a thin film over the base, if it has one.
+    pub film: Option<ThinFilm>,
 }
 
 /// `KHR_materials_anisotropy` at a surface point: GGX's roughness along `direction` is
@@ -726,8 +729,25 @@ impl MetallicRoughness {
     #[inline]
     fn dielectric_reflectance(&self, cos: f32, eta: f32) -> Spectrum {
         match rarer_cosine(cos, eta) {
-            Some(rarer) => schlick_lanes(self.specular_f0(), rarer) * self.specular,
+            Some(rarer) => self.rarer_dielectric_reflectance(rarer),
             None => Spectrum::ONE,
+        }
+    }
+
+    /// The dielectric interface's reflectance by lane at cosine `rarer` on the side of the
+    /// lower index. Thin film: its reflectance, over a base of normal reflectance
+    /// `specular` × the specular F0, mixed in by its factor (as `KHR_materials_iridescence`
+    /// writes it with `KHR_materials_specular`). The film is seen from the outside on either
+    /// side: a film without losses reflects the same from both.
+    #[inline]
+    fn rarer_dielectric_reflectance(&self, rarer: f32) -> Spectrum {
+        let plain = schlick_lanes(self.specular_f0(), rarer) * self.specular;
+        match &self.film {
+            None => plain,
+            Some(film) => {
+                let filmed = film.reflectance(self.specular_f0() * self.specular, rarer);
+                plain + (filmed - plain) * film.factor
+            }
         }
     }
 
@@ -736,8 +756,18 @@ impl MetallicRoughness {
     #[inline]
     fn dielectric_reflectance_max(&self, cos: f32, eta: f32) -> f32 {
         match rarer_cosine(cos, eta) {
-            Some(rarer) => self.specular * schlick(self.specular_f0_max(), rarer),
+            Some(rarer) => self.rarer_dielectric_reflectance_max(rarer),
             None => 1.0,
+        }
+    }
+
+    /// The largest channel of [`Self::rarer_dielectric_reflectance`] (a thin film's by
+    /// its lanes).
+    #[inline]
+    fn rarer_dielectric_reflectance_max(&self, rarer: f32) -> f32 {
+        match &self.film {
+            None => self.specular * schlick(self.specular_f0_max(), rarer),
+            Some(_) => self.rarer_dielectric_reflectance(rarer).max_component(),
         }
     }
 
@@ -755,7 +785,18 @@ impl MetallicRoughness {
         let dielectric = self.dielectric_reflectance(cos, 1.0 / self.ior)
             * (1.0 - self.transmission)
             + self.dielectric_reflectance(cos, eta) * self.transmission;
-        schlick_spectrum(self.base_color, cos) * self.metallic + dielectric * (1.0 - self.metallic)
+        self.metal_reflectance(cos) * self.metallic + dielectric * (1.0 - self.metallic)
+    }
+
+    /// The metal's Fresnel factor: Schlick's with F0 = base colour. Thin film: its
+    /// reflectance over a base of that normal reflectance, mixed in by its factor.
+    #[inline]
+    fn metal_reflectance(&self, cos: f32) -> Spectrum {
+        let plain = schlick_spectrum(self.base_color, cos);
+        match &self.film {
+            None => plain,
+            Some(film) => plain + (film.reflectance(self.base_color, cos) - plain) * film.factor,
+        }
     }
 
     /// The metal's multiple-scattering compensation, if it has one: asked for, rough and
@@ -850,14 +891,77 @@ impl MetallicRoughness {
     #[inline]
     fn diffuse_f(&self, cos_o: f32, cos_i: f32) -> Spectrum {
         let coat = self.coat();
-        let through_average = 1.0 - self.specular * coat.average();
+        let (at_o, at_i, average) = match &self.film {
+            None => (
+                self.specular * coat.reflectance(cos_o),
+                self.specular * coat.reflectance(cos_i),
+                self.specular * coat.average(),
+            ),
+            Some(film) => self.filmed_coat_reflectances(film, &coat, cos_o, cos_i),
+        };
+        let through_average = 1.0 - average;
         if through_average <= 0.0 {
             return Spectrum::ZERO;
         }
-        let through = (1.0 - self.specular * coat.reflectance(cos_o))
-            * (1.0 - self.specular * coat.reflectance(cos_i))
-            / through_average;
+        let through = (1.0 - at_o) * (1.0 - at_i) / through_average;
         self.diffuse_tint() * (through * FRAC_1_PI)
+    }
+
+    /// Thin film: what the coat over the diffuse base reflects at `cos_o` and `cos_i`, and
+    /// its cosine-weighted mean, for the albedo scaling of `diffuse_f`: the plain coat's
+    /// mixed by the film's factor with a bound of the film's. The bound is the film's
+    /// reflectance with its two interfaces' waves in phase (its largest at any wavelength
+    /// and thickness), of the interfaces' tabulated coat reflectances (Schlick's for a
+    /// smooth coat) with the outer F0 and the largest inner one among the lanes, the inner
+    /// one taken at the outside cosine (Schlick's there is at least at the cosine inside a
+    /// film denser than vacuum). A smooth coat then reflects no more than the base loses,
+    /// lane by lane, so a white furnace stays at most 1; for rough coats it is tested. The
+    /// mean is a Gauss–Legendre quadrature.
+    #[inline(never)]
+    fn filmed_coat_reflectances(
+        &self,
+        film: &ThinFilm,
+        coat: &CoatReflectance,
+        cos_o: f32,
+        cos_i: f32,
+    ) -> (f32, f32, f32) {
+        let (outer_f0, inner_f0) = film.interface_f0s(self.specular_f0() * self.specular);
+        let outer = CoatReflectance::new(self.roughness, outer_f0);
+        let inner = CoatReflectance::new(self.roughness, inner_f0);
+        // A film rarer than vacuum has its inner cosine below the outside one.
+        let inner_cosine = |mu: f32| {
+            if film.ior >= 1.0 {
+                Some(mu)
+            } else {
+                let sin2 = (1.0 - mu * mu) / (film.ior * film.ior);
+                (sin2 < 1.0).then(|| (1.0 - sin2).sqrt())
+            }
+        };
+        let bound = |mu: f32| match inner_cosine(mu) {
+            Some(inside) => ThinFilm::envelope_of(outer.reflectance(mu), inner.reflectance(inside)),
+            None => 1.0,
+        };
+        // 2 ∫ R(μ) μ dμ = ∫ R(√u) du, 8 Gauss–Legendre nodes in u over [0, 1].
+        const NODES: [(f32, f32); 4] = [
+            (0.183_434_64, 0.362_683_78),
+            (0.525_532_4, 0.313_706_65),
+            (0.796_666_5, 0.222_381_03),
+            (0.960_289_85, 0.101_228_54),
+        ];
+        let bound_average: f32 = NODES
+            .iter()
+            .map(|&(x, w)| {
+                let (lo, hi) = ((1.0 - x) / 2.0, (1.0 + x) / 2.0);
+                w / 2.0 * (bound(lo.sqrt()) + bound(hi.sqrt()))
+            })
+            .sum();
+        let plain = |r: f32| self.specular * r;
+        let mix = |plain: f32, filmed: f32| plain + (filmed - plain) * film.factor;
+        (
+            mix(plain(coat.reflectance(cos_o)), bound(cos_o)),
+            mix(plain(coat.reflectance(cos_i)), bound(cos_i)),
+            mix(plain(coat.average()), bound_average),
+        )
     }
 
     /// f of the lobes with a density, `wi` in the view's frame: the layers beneath the
@@ -930,7 +1034,7 @@ impl MetallicRoughness {
         } else {
             -cos_ih
         };
-        let transmitted = 1.0 - self.specular * schlick(self.specular_f0_max(), rarer_cos);
+        let transmitted = 1.0 - self.rarer_dielectric_reflectance_max(rarer_cos);
         let microfacets = distribution.d(h) * distribution.g2(wo, wi) * (cos_oh * cos_ih).abs()
             / (wo.z * wi.z.abs() * denominator * denominator);
         self.transmission_tint() * (transmitted * eta_scale * microfacets)
@@ -1384,6 +1488,7 @@ mod tests {
             specular_color_max: 1.0,
             sheen: None,
             anisotropy: None,
+            film: None,
         }
     }
 
@@ -1474,8 +1579,39 @@ mod tests {
                 energy_compensation: true,
                 ..material(roughness, 0.5, 0.5, 1.5)
             });
+            // Thin films, RGB and spectral, over the opaque and transmissive dielectric,
+            // the metal and a specular colour.
+            all.push(MetallicRoughness {
+                film: Some(film(1.0, 1.3, 400.0, false)),
+                ..material(roughness, 0.0, 0.0, 1.5)
+            });
+            all.push(MetallicRoughness {
+                film: Some(film(0.7, 2.0, 250.0, true)),
+                ..material(roughness, 0.0, 1.0, 1.5)
+            });
+            all.push(MetallicRoughness {
+                film: Some(film(1.0, 1.8, 300.0, true)),
+                ..material(roughness, 1.0, 0.0, 1.5)
+            });
+            all.push(MetallicRoughness {
+                film: Some(film(1.0, 2.5, 150.0, false)),
+                specular: 0.8,
+                specular_color: Spectrum::new(2.0, 1.0, 0.5),
+                specular_color_max: 2.0,
+                ..material(roughness, 0.3, 0.5, 1.33)
+            });
         }
         all
+    }
+
+    /// A thin film; `spectral`: at four wavelengths across the visible range.
+    fn film(factor: f32, ior: f32, thickness: f32, spectral: bool) -> ThinFilm {
+        ThinFilm {
+            factor,
+            ior,
+            thickness,
+            wavelengths: spectral.then_some([430.0, 505.0, 580.0, 655.0]),
+        }
     }
 
     /// Incident angles: normal, oblique, grazing, and the same from below.
@@ -2233,6 +2369,59 @@ mod tests {
     /// lowest is where the specification's lobe alone would reflect up to 2.9 times). The
     /// true albedos come within 1% of 1 at grazing angles (0.990 at 88° over a rough
     /// dielectric at the lowest sheen roughness, by 4 million stratified draws).
+    /// A white dielectric under a thin film (the base is white, the worst case for the
+    /// albedo scaling) reflects at most what it receives, at every angle, for films rarer
+    /// and denser than the base, thin and thick, smooth and rough, RGB and spectral; and a
+    /// film on a smooth surface reflects its own reflectance exactly. Albedos by the
+    /// stratified estimator at 40 000 draws (its standard deviation about 0.2% here; the
+    /// largest measured 1.0001).
+    #[test]
+    fn white_furnace_with_a_film_is_at_most_one() {
+        let mut rng = Rng::new(45, 2);
+        let mut largest = 0.0f32;
+        for roughness in [0.0, 0.3, 1.0] {
+            for (ior, thickness) in [(1.3, 400.0), (2.0, 250.0), (2.5, 120.0), (1.1, 900.0)] {
+                for spectral in [false, true] {
+                    let m = MetallicRoughness {
+                        base_color: Spectrum::ONE,
+                        film: Some(film(1.0, ior, thickness, spectral)),
+                        ..material(roughness, 0.0, 0.0, 1.5)
+                    };
+                    for theta in [0.0, 45.0, 75.0, 89.5] {
+                        let a = albedo(&m, direction(theta), 40_000, &mut rng);
+                        largest = largest.max(a.max_component());
+                        assert!(a.max_component() <= 1.006, "{m:?} θ {theta}: albedo {a}");
+                    }
+                }
+            }
+        }
+        eprintln!("largest film albedo {largest}");
+    }
+
+    /// At roughness 0 with a black base the material is the film alone: the mirror's weight
+    /// is the film's reflectance at the view's cosine, mixed with Schlick's by the factor.
+    #[test]
+    fn smooth_film_reflects_the_films_reflectance() {
+        let f = film(0.6, 1.8, 330.0, true);
+        let m = MetallicRoughness {
+            base_color: Spectrum::ZERO,
+            film: Some(f),
+            ..material(0.0, 0.0, 0.0, 1.5)
+        };
+        for theta in [0.0f32, 40.0, 80.0] {
+            let wo = direction(theta);
+            let cos = theta.to_radians().cos();
+            let s = m
+                .scatter(normal(), wo, reflect(wo, normal()), TransportMode::Radiance)
+                .unwrap();
+            let plain = schlick(0.04, cos);
+            let filmed = f.reflectance(Spectrum::splat(0.04), cos);
+            let expected = Spectrum::splat(plain) + (filmed - Spectrum::splat(plain)) * 0.6;
+            let got = s.weight * s.pdf;
+            assert!(close(got, expected, 1e-3), "θ {theta}: {got} vs {expected}");
+        }
+    }
+
     #[test]
     fn white_furnace_with_sheen_is_at_most_one() {
         let mut rng = Rng::new(45, 12);

@@ -16,12 +16,14 @@ mod microfacet;
 mod multiple_scattering;
 mod scattering;
 mod sheen;
+mod thin_film;
 
 pub(crate) use clearcoat::Clearcoat;
 pub(crate) use metallic_roughness::{Anisotropy, MetallicRoughness, Microfacet};
 pub(crate) use scattering::{BsdfLobes, SpecularLobe};
 pub use scattering::{ScatterSample, TransportMode, reflect};
 pub(crate) use sheen::Sheen;
+pub(crate) use thin_film::ThinFilm;
 
 use crate::sampling::{OrthonormalBasis, cosine_hemisphere, cosine_hemisphere_pdf};
 use crate::spectrum::Spectrum;
@@ -474,6 +476,39 @@ mod tests {
         assert!(BsdfLobes::GLOSSY.has_non_specular());
         let coated = BsdfLobes::GLOSSY | BsdfLobes::SPECULAR;
         assert!(coated.has_non_specular() && coated.contains(BsdfLobes::SPECULAR));
+    }
+
+    /// A film of strength 0 or thickness 0 is no film (as `KHR_materials_iridescence`
+    /// defines): the model is the plain material's, in RGB and spectral renders, and a
+    /// film of both has one.
+    #[test]
+    fn a_film_without_strength_or_thickness_is_none() {
+        let plain = Material::metallic_roughness([0.6, 0.3, 0.2], 0.5, 0.4);
+        let spectral = Channels::new(true, || 0.3);
+        for channels in [Channels::Rgb, spectral] {
+            let model = |m: Material| match m.bsdf_model(&channels) {
+                BsdfModel::MetallicRoughness(m) => m,
+                _ => unreachable!(),
+            };
+            for m in [
+                Material {
+                    iridescence: 0.0,
+                    ..plain
+                },
+                Material {
+                    iridescence: 1.0,
+                    iridescence_thickness_maximum: 0.0,
+                    ..plain
+                },
+            ] {
+                assert_eq!(model(m), model(plain));
+            }
+            let filmed = model(Material {
+                iridescence: 0.5,
+                ..plain
+            });
+            assert_eq!(filmed.film.map(|f| f.thickness), Some(400.0));
+        }
     }
 
     /// Energy conservation and reciprocity-style check: the albedo estimated by sampling

@@ -66,6 +66,12 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         anisotropy,
         anisotropy_rotation,
         anisotropy_texture,
+        iridescence,
+        iridescence_texture,
+        iridescence_ior,
+        iridescence_thickness_minimum,
+        iridescence_thickness_maximum,
+        iridescence_thickness_texture,
         // END GENERATED material from C
     }
 }

@@ -262,6 +262,12 @@ impl From<&Material> for MltMaterial {
             anisotropy,
             anisotropy_rotation,
             anisotropy_texture,
+            iridescence,
+            iridescence_texture,
+            iridescence_ior,
+            iridescence_thickness_minimum,
+            iridescence_thickness_maximum,
+            iridescence_thickness_texture,
             // END GENERATED material to C
         }
     }
@@ -542,7 +548,7 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 456]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 520]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, today.

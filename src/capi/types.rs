@@ -308,6 +308,30 @@ pub struct MltMaterial {
     /// (KHR_materials_anisotropy's anisotropyTexture); linear. An index into
     /// `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
     pub anisotropy_texture: MltTextureRef,
+    /// Metallic-roughness: strength of a thin film over the material, its interference colours
+    /// (soap bubbles, oil); 0 is none (KHR_materials_iridescence's iridescenceFactor). Exact per
+    /// wavelength in spectral renders, integrated over each RGB channel otherwise. It must be in
+    /// [0, 1]. Default 0.0.
+    pub iridescence: f32,
+    /// Metallic-roughness: red multiplies the thin film's strength (KHR_materials_iridescence's
+    /// iridescenceTexture); usually linear. An index into `MltSceneDesc.textures` and its
+    /// transform. Default `MLT_NO_TEXTURE` (-1).
+    pub iridescence_texture: MltTextureRef,
+    /// Metallic-roughness: the thin film's index of refraction (KHR_materials_iridescence's
+    /// iridescenceIor). An index of refraction must be greater than 0. Default 1.3.
+    pub iridescence_ior: f32,
+    /// Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    /// green is 0 (KHR_materials_iridescence's iridescenceThicknessMinimum). A thickness must not
+    /// be negative. Default 100.0.
+    pub iridescence_thickness_minimum: f32,
+    /// Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's
+    /// green is 1, and everywhere without it; 0 is no film (KHR_materials_iridescence's
+    /// iridescenceThicknessMaximum). A thickness must not be negative. Default 400.0.
+    pub iridescence_thickness_maximum: f32,
+    /// Metallic-roughness: green interpolates the thin film's thickness from the minimum (0) to the
+    /// maximum (1) (KHR_materials_iridescence's iridescenceThicknessTexture); usually linear. An
+    /// index into `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
+    pub iridescence_thickness_texture: MltTextureRef,
     // END GENERATED material
 }
 

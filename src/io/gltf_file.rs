@@ -28,6 +28,7 @@ const EXTENSIONS_READ_HERE: &[&str] = &[
     "KHR_materials_anisotropy",
     "KHR_materials_clearcoat",
     "KHR_materials_dispersion",
+    "KHR_materials_iridescence",
     "KHR_materials_sheen",
     "KHR_materials_specular",
     "KHR_materials_unlit",
@@ -611,8 +612,8 @@ impl Loader<'_> {
         Ok(())
     }
 
-    /// `KHR_materials_specular` and `KHR_materials_sheen` (read from the JSON: the gltf
-    /// crate parses neither), with their textures and the textures' `KHR_texture_transform`;
+    /// `KHR_materials_specular`, `KHR_materials_sheen` and `KHR_materials_iridescence`
+    /// (read from the JSON: the gltf crate parses none of them), with their textures and the textures' `KHR_texture_transform`;
     /// numbers out of the specifications' ranges are errors.
     fn specular_and_sheen(
         &mut self,
@@ -661,6 +662,39 @@ impl Loader<'_> {
                 self.json_texture(extension, "sheenColorTexture", true, what, &name)?;
             converted.sheen_roughness_texture =
                 self.json_texture(extension, "sheenRoughnessTexture", false, what, &name)?;
+        }
+        if let Some(extension) = material.extension_value("KHR_materials_iridescence") {
+            let what = "KHR_materials_iridescence";
+            converted.iridescence =
+                self.json_number(extension, "iridescenceFactor", 0.0, (0.0, 1.0), what, &name)?;
+            converted.iridescence_ior = self.json_number(
+                extension,
+                "iridescenceIor",
+                1.3,
+                (1.0, f32::MAX),
+                what,
+                &name,
+            )?;
+            converted.iridescence_thickness_minimum = self.json_number(
+                extension,
+                "iridescenceThicknessMinimum",
+                100.0,
+                (0.0, f32::MAX),
+                what,
+                &name,
+            )?;
+            converted.iridescence_thickness_maximum = self.json_number(
+                extension,
+                "iridescenceThicknessMaximum",
+                400.0,
+                (0.0, f32::MAX),
+                what,
+                &name,
+            )?;
+            converted.iridescence_texture =
+                self.json_texture(extension, "iridescenceTexture", false, what, &name)?;
+            converted.iridescence_thickness_texture =
+                self.json_texture(extension, "iridescenceThicknessTexture", false, what, &name)?;
         }
         Ok(())
     }

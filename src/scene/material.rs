@@ -1,6 +1,6 @@
 //! Surface materials: what a triangle does with light.
 
-use crate::bsdf::{BsdfModel, Clearcoat, MetallicRoughness, Sheen};
+use crate::bsdf::{BsdfModel, Clearcoat, MetallicRoughness, Sheen, ThinFilm};
 use crate::error::{Error, Result};
 use crate::params::{ChoiceParameter, Range, declare_parameters, in_unit_interval};
 use crate::spectral::Channels;
@@ -62,8 +62,10 @@ declare_parameters! {
     /// RGB multiply `specular` and `specular_color`, `sheen_color_texture`'s RGB and
     /// `sheen_roughness_texture`'s alpha `sheen_color` and `sheen_roughness`;
     /// `anisotropy_texture`'s red and green give the anisotropy's direction in the tangent
-    /// plane and its blue multiplies `anisotropy`. Per-vertex colours multiply `color` and
-    /// `alpha` too.
+    /// plane and its blue multiplies `anisotropy`; `iridescence_texture`'s red multiplies
+    /// `iridescence`, and `iridescence_thickness_texture`'s green interpolates the film's
+    /// thickness from `iridescence_thickness_minimum` to `iridescence_thickness_maximum`.
+    /// Per-vertex colours multiply `color` and `alpha` too.
     ///
     /// The default is a light grey (0.8) diffuse surface, the C API's and Python's.
     #[derive(Clone, Copy, Debug, PartialEq)]
@@ -271,6 +273,42 @@ declare_parameters! {
         anisotropy_texture: Option<TextureRef> = None => {
             doc: "Metallic-roughness: red and green are the anisotropy's direction in the tangent plane mapped from [-1, 1] to [0, 1] (then rotated by anisotropy_rotation), blue multiplies its strength (KHR_materials_anisotropy's anisotropyTexture); linear.",
         },
+        /// Metallic-roughness: the strength of a thin film over the material
+        /// (`KHR_materials_iridescence`'s `iridescenceFactor`), in [0, 1]; 0, the default, is
+        /// none. The specular reflection's Fresnel term becomes the film's by this share.
+        iridescence: f32 = 0.0 => {
+            doc: "Metallic-roughness: strength of a thin film over the material, its interference colours (soap bubbles, oil); 0 is none (KHR_materials_iridescence's iridescenceFactor). Exact per wavelength in spectral renders, integrated over each RGB channel otherwise.",
+            range: Range::UNIT,
+            rule: in_unit_interval,
+        },
+        iridescence_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: red multiplies the thin film's strength (KHR_materials_iridescence's iridescenceTexture); usually linear.",
+        },
+        /// Metallic-roughness: the thin film's index of refraction, > 0 (glTF's default
+        /// 1.3).
+        iridescence_ior: f32 = 1.3 => {
+            doc: "Metallic-roughness: the thin film's index of refraction (KHR_materials_iridescence's iridescenceIor).",
+            range: Range::above(0.0, f32::MAX as f64),
+            rule: |_| "an index of refraction must be greater than 0".into(),
+        },
+        /// Metallic-roughness: the thin film's thickness in nanometres where
+        /// `iridescence_thickness_texture`'s green is 0; not negative.
+        iridescence_thickness_minimum: f32 = 100.0 => {
+            doc: "Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's green is 0 (KHR_materials_iridescence's iridescenceThicknessMinimum).",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "a thickness must not be negative".into(),
+        },
+        /// Metallic-roughness: the thin film's thickness in nanometres where
+        /// `iridescence_thickness_texture`'s green is 1, and everywhere without the texture;
+        /// not negative. A film of thickness 0 is none.
+        iridescence_thickness_maximum: f32 = 400.0 => {
+            doc: "Metallic-roughness: the thin film's thickness in nanometres where the thickness texture's green is 1, and everywhere without it; 0 is no film (KHR_materials_iridescence's iridescenceThicknessMaximum).",
+            range: Range::closed(0.0, f32::MAX as f64),
+            rule: |_| "a thickness must not be negative".into(),
+        },
+        iridescence_thickness_texture: Option<TextureRef> = None => {
+            doc: "Metallic-roughness: green interpolates the thin film's thickness from the minimum (0) to the maximum (1) (KHR_materials_iridescence's iridescenceThicknessTexture); usually linear.",
+        },
     }
 }
 
@@ -408,7 +446,7 @@ impl Material {
         )
     }
 
-    /// The specular and sheen parameters without their textures.
+    /// The specular, sheen and thin film parameters without their textures.
     #[inline]
     pub(crate) fn untextured_layers(&self) -> SpecularAndSheen {
         SpecularAndSheen {
@@ -416,6 +454,8 @@ impl Material {
             specular_color: self.specular_color,
             sheen_color: self.sheen_color,
             sheen_roughness: self.sheen_roughness,
+            iridescence: self.iridescence,
+            iridescence_thickness: self.iridescence_thickness_maximum,
         }
     }
 
@@ -457,18 +497,24 @@ impl Material {
                 sheen: layers.sheen(channels),
                 // Its direction needs the surface's tangent frame: the surface sets it.
                 anisotropy: None,
+                film: layers.film(self.iridescence_ior, channels),
             }),
         }
     }
 }
 
-/// The `KHR_materials_specular` and `KHR_materials_sheen` parameters at a surface point.
+/// The `KHR_materials_specular`, `KHR_materials_sheen` and `KHR_materials_iridescence`
+/// parameters at a surface point.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SpecularAndSheen {
     pub specular: f32,
     pub specular_color: [f32; 3],
     pub sheen_color: [f32; 3],
     pub sheen_roughness: f32,
+    /// The thin film's strength.
+    pub iridescence: f32,
+    /// The thin film's thickness in nanometres.
+    pub iridescence_thickness: f32,
 }
 
 #[inline]
@@ -488,6 +534,18 @@ impl SpecularAndSheen {
                 .reflectance(self.specular_color)
                 .min(Spectrum::splat(max3(self.specular_color)))
         }
+    }
+
+    /// The thin film of index `ior`, `None` where its strength or its thickness is 0 (as
+    /// `KHR_materials_iridescence` defines: no film, the plain Fresnel term exactly).
+    #[inline]
+    fn film(&self, ior: f32, channels: &Channels) -> Option<ThinFilm> {
+        (self.iridescence > 0.0 && self.iridescence_thickness > 0.0).then(|| ThinFilm {
+            factor: self.iridescence,
+            ior,
+            thickness: self.iridescence_thickness,
+            wavelengths: channels.wavelengths(),
+        })
     }
 
     /// The sheen layer, `None` for a black sheen colour (the default) without a look at

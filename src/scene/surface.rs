@@ -378,7 +378,7 @@ impl SurfacePoint<'_> {
         }
     }
 
-    /// The specular and sheen parameters here, times their textures.
+    /// The specular, sheen and thin film parameters here, with their textures.
     #[inline]
     fn specular_and_sheen(&self) -> SpecularAndSheen {
         let m = self.material;
@@ -398,6 +398,19 @@ impl SurfacePoint<'_> {
             }
             if let Some(texture) = &m.sheen_roughness_texture {
                 layers.sheen_roughness *= self.lookup(texture).w;
+            }
+        }
+        // Without a film its textures change nothing either.
+        if layers.iridescence > 0.0 {
+            if let Some(texture) = &m.iridescence_texture {
+                layers.iridescence *= self.lookup(texture).x;
+            }
+            if let Some(texture) = &m.iridescence_thickness_texture {
+                let (low, high) = (
+                    m.iridescence_thickness_minimum,
+                    m.iridescence_thickness_maximum,
+                );
+                layers.iridescence_thickness = low + (high - low) * self.lookup(texture).y;
             }
         }
         layers

@@ -78,6 +78,15 @@ impl Channels {
         }
     }
 
+    /// The wavelengths of the four lanes in nm; `None` in RGB mode.
+    #[inline]
+    pub fn wavelengths(&self) -> Option<[f32; 4]> {
+        match self {
+            Channels::Rgb => None,
+            Channels::Wavelengths(w) => Some(w.lambda),
+        }
+    }
+
     /// The hero wavelength (lane 0) in nm; `None` in RGB mode.
     #[inline]
     pub fn hero(&self) -> Option<f32> {
