@@ -147,7 +147,6 @@ fn coated_surfaces_scene() -> Scene {
 /// Light tracing sees the coat's non-reciprocal layering and its own normal from the
 /// other end (the adjoint): BDPT agrees with the path tracer on the coated scene, where a
 /// coat evaluated without the adjoint, or without its normal's correction, would differ.
-/// Path-space MLT refuses the smooth coat with a clear error.
 #[test]
 fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
     let scene = coated_surfaces_scene();
@@ -172,24 +171,16 @@ fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
         5.0,
         6.0,
     );
-    let settings = RenderSettings {
-        algorithm: Algorithm::PathSpaceMlt,
-        width: 8,
-        height: 8,
-        ..Default::default()
-    };
-    let mut image = vec![0.0; 8 * 8 * 3];
-    let error = mlt::render(&scene, &camera, &settings, &mut image, None)
-        .unwrap_err()
-        .to_string();
-    assert!(error.contains("clear coat is smooth"), "{error}");
 }
 
 /// The Cornell box with smooth coats over its blocks (metallic-roughness at roughness 0,
 /// non-metal): the short block's over a red diffuse base, the tall block's over a base
 /// half diffuse and half transmissive (Dirac reflection and refraction beside the diffuse
-/// lobe), and the floor's over its white base. Path-space MLT and ERPT record at each such
-/// vertex which lobe the path scatters through (path_space/mod.rs, "Lobes").
+/// lobe), and the floor's over its white base. Its side walls have smooth clear coats (a
+/// Dirac lobe beside the base's): the left one over a red non-metal of roughness 1 (its
+/// diffuse base and a rough reflection), the right one over a green metal of roughness
+/// 0.3. Path-space MLT and ERPT record at each such vertex which lobe the path scatters
+/// through (path_space/mod.rs, "Lobes").
 fn coated_box() -> mlt::Scene {
     let mut mesh = common::scenes::canonical_mesh("cornell-box");
     let coated = mesh.materials.len() as u32;
@@ -201,9 +192,26 @@ fn coated_box() -> mlt::Scene {
     });
     mesh.materials
         .push(Material::metallic_roughness([0.8; 3], 0.0, 0.0));
+    let clear_coat = |m: Material| Material {
+        clearcoat: 1.0,
+        clearcoat_roughness: 0.0,
+        ..m
+    };
+    mesh.materials.push(clear_coat(Material::metallic_roughness(
+        [0.63, 0.065, 0.05],
+        0.0,
+        1.0,
+    )));
+    mesh.materials.push(clear_coat(Material::metallic_roughness(
+        [0.3, 0.8, 0.35],
+        1.0,
+        0.3,
+    )));
     for (triangle, material) in mesh.material_ids.iter_mut().enumerate() {
         match triangle {
             0..2 => *material = coated + 2,
+            6..8 => *material = coated + 4,
+            8..10 => *material = coated + 3,
             10..20 => *material = coated,
             20..30 => *material = coated + 1,
             _ => {}
@@ -230,7 +238,7 @@ fn coated_estimate(settings: RenderSettings, renders: u64) -> Estimate {
 
 /// Path-space MLT (its perturbations turning directions, and stepping them in their
 /// samplings' coordinates) and ERPT agree with BDPT on smooth coats over diffuse and
-/// transmissive bases.
+/// transmissive bases, and on smooth clear coats over a rough non-metal and a metal.
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
     let bdpt = coated_estimate(
