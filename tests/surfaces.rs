@@ -118,10 +118,13 @@ fn path_space_mlt_and_erpt_agree_with_bdpt() {
     agrees_with_bdpt(Algorithm::PathSpaceMlt, true);
 }
 
-/// The surfaces scene with clear coats: a rough coat over the gold block, a smooth one
-/// (a Dirac lobe) over the half-metal block, and a rough coat with its own normal map (the
-/// checker, bending the coat's normal square by square) over the textured floor.
-fn coated_surfaces_scene() -> Scene {
+/// The surfaces scene with the material extensions: clear coats (a rough one over the gold
+/// block, a smooth one, a Dirac lobe, over the half-metal block, and a rough coat with its
+/// own normal map, the checker bending the coat's normal square by square, over the
+/// textured floor), sheen over a rough non-metal on the left wall, and a tinted, weakened
+/// specular reflection on the right wall's. (Alpha BLEND and volumes have scenes of their
+/// own, in `blended_coverage` tests and tests/volume.rs.)
+fn extensions_scene() -> Scene {
     let mut surfaces = surfaces_mesh();
     for m in &mut surfaces.mesh.materials {
         if m.base_color_texture.is_some() {
@@ -139,38 +142,94 @@ fn coated_surfaces_scene() -> Scene {
             (m.clearcoat, m.clearcoat_roughness) = (1.0, 0.1);
         } else if m.metallic == 0.5 {
             (m.clearcoat, m.clearcoat_roughness) = (0.8, 0.0);
+        } else if m.kind == mlt::MaterialKind::Diffuse && m.color[0] > 2.0 * m.color[1] {
+            // The red wall.
+            *m = Material {
+                sheen_color: [0.9, 0.7, 0.6],
+                sheen_roughness: 0.4,
+                ..Material::metallic_roughness(m.color, 0.0, 0.7)
+            };
+        } else if m.kind == mlt::MaterialKind::Diffuse && m.color[1] > 2.0 * m.color[0] {
+            // The green wall.
+            *m = Material {
+                specular: 0.6,
+                specular_color: [0.5, 1.0, 0.7],
+                ..Material::metallic_roughness(m.color, 0.0, 0.35)
+            };
         }
     }
     surfaces.scene(Backend::Bvh)
 }
 
-/// Light tracing sees the coat's non-reciprocal layering and its own normal from the
-/// other end (the adjoint): BDPT agrees with the path tracer on the coated scene, where a
-/// coat evaluated without the adjoint, or without its normal's correction, would differ.
-#[test]
-fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
-    let scene = coated_surfaces_scene();
-    let camera = canonical_camera("cornell-box");
-    let estimate = |algorithm, samples_per_pixel, renders: u64| {
-        let settings = RenderSettings {
-            algorithm,
-            samples_per_pixel,
-            width: SIZE,
-            height: SIZE,
-            max_depth: MAX_DEPTH,
-            ..Default::default()
-        };
-        estimate_over_seeds(&scene, &camera, &settings, 700..700 + renders)
+/// `renders` independent renders of the extensions scene with `settings`.
+fn extensions_estimate(settings: RenderSettings, renders: u64) -> Estimate {
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        max_depth: MAX_DEPTH,
+        ..settings
     };
+    estimate_over_seeds(
+        &extensions_scene(),
+        &canonical_camera("cornell-box"),
+        &settings,
+        700..700 + renders,
+    )
+}
 
+/// Every algorithm agrees on the extensions scene: BDPT with the path tracer (light tracing
+/// sees the coat's non-reciprocal layering and its own normal from the other end, the
+/// adjoint, where a coat evaluated without the adjoint, or without its normal's
+/// correction, would differ), and each Metropolis algorithm and ERPT with BDPT.
+#[test]
+fn every_algorithm_agrees_on_the_extensions_scene() {
+    let bdpt = extensions_estimate(
+        RenderSettings {
+            algorithm: Algorithm::Bdpt,
+            samples_per_pixel: 64,
+            ..Default::default()
+        },
+        16,
+    );
     assert_estimates_agree(
-        "coated surfaces BDPT against the path tracer",
-        &estimate(Algorithm::Bdpt, 64, 16),
-        &estimate(Algorithm::Path, 192, 16),
+        "extensions: BDPT against the path tracer",
+        &bdpt,
+        &extensions_estimate(
+            RenderSettings {
+                algorithm: Algorithm::Path,
+                samples_per_pixel: 192,
+                ..Default::default()
+            },
+            16,
+        ),
         4,
         5.0,
         6.0,
     );
+    for algorithm in [
+        Algorithm::Pssmlt,
+        Algorithm::PssmltBdpt,
+        Algorithm::Mmlt,
+        Algorithm::PathSpaceMlt,
+        Algorithm::Erpt,
+    ] {
+        let settings = RenderSettings {
+            algorithm,
+            samples_per_pixel: 40,
+            mutations_per_pixel: 64,
+            bootstrap_samples: 1 << 15,
+            chains: 256,
+            ..Default::default()
+        };
+        assert_estimates_agree(
+            &format!("extensions: {algorithm:?} against BDPT"),
+            &extensions_estimate(settings, 16),
+            &bdpt,
+            4,
+            5.0,
+            6.0,
+        );
+    }
 }
 
 /// The Cornell box with smooth coats over its blocks (metallic-roughness at roughness 0,

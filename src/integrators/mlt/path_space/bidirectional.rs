@@ -1612,7 +1612,7 @@ mod tests {
             min_vertices: 3,
             max_vertices: 4,
         };
-        let (chains, steps) = (20_000u64, 100);
+        let (chains, steps) = (20_000u64, 300);
         let run = |flawed: bool| {
             let mut counts = vec![0u64; bins];
             let (mut x, mut y, mut eye) = (Vec::new(), Vec::new(), Vec::new());
@@ -1650,7 +1650,15 @@ mod tests {
                     continue;
                 }
                 let expected = m * p;
-                stat += (count as f64 - expected).powi(2) / (expected + m * m * var);
+                let term = (count as f64 - expected).powi(2) / (expected + m * m * var);
+                if term > 4.0 {
+                    println!(
+                        "  bin {}: {count} against {expected:.1} (reference σ {:.1})",
+                        df,
+                        m * var.sqrt()
+                    );
+                }
+                stat += term;
                 df += 1;
             }
             let mirror: u64 = (0..bins).filter(|b| b % 4 != 0).map(|b| counts[b]).sum();
