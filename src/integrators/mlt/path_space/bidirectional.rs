@@ -1644,7 +1644,9 @@ mod tests {
             // reaches (the others must stay empty).
             let m = chains as f64;
             let (mut stat, mut df, mut stray) = (0.0, 0usize, 0u64);
-            for ((&count, &p), &var) in counts.iter().zip(&target).zip(&target_variance) {
+            for (b, ((&count, &p), &var)) in
+                counts.iter().zip(&target).zip(&target_variance).enumerate()
+            {
                 if p <= 0.0 {
                     stray += count;
                     continue;
@@ -1653,8 +1655,7 @@ mod tests {
                 let term = (count as f64 - expected).powi(2) / (expected + m * m * var);
                 if term > 4.0 {
                     println!(
-                        "  bin {}: {count} against {expected:.1} (reference σ {:.1})",
-                        df,
+                        "  bin {b}: {count} against {expected:.1} (reference σ {:.1})",
                         m * var.sqrt()
                     );
                 }

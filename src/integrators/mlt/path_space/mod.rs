@@ -30,7 +30,7 @@
 //! # Lobes
 //!
 //! A BSDF may have a Dirac lobe beside lobes with a density (a smooth coat over a diffuse or
-//! transmissive base). Its f is then a sum f_δ + f_c of a Dirac part and a part with a
+//! transmissive base, a smooth clear coat over any base). Its f is then a sum f_δ + f_c of a Dirac part and a part with a
 //! density, and a path's measurement contribution is a sum over its lobe signatures σ
 //! (which part scatters at each such vertex) of terms f_σ, each with that part alone at each
 //! vertex. The chain's state is (x, σ), the signature recorded in the vertices
@@ -55,6 +55,14 @@
 //!   factor and tint alone.
 //!
 //! Where a BSDF has one kind of lobe the record is not read, and paths are what they were.
+//!
+//! Which Dirac lobe scatters at an `S` vertex is not recorded: the path says it. Reflection
+//! and refraction differ by the sides of the directions; a smooth clear coat with a normal
+//! of its own over a smooth base has two mirrors, and the path's direction lies on one of
+//! them (`Bsdf::specular_lobe` names the nearer, since a direction rebuilt from vertices
+//! is off by rounding). The two mirrors' constrained paths are disjoint sets, so f_δ is
+//! the one mirror's there: `scatter_lobe` weighs the vertex by that mirror's reflectance
+//! over its probability, and the perturbations retrace it through the same mirror.
 //!
 //! # Lights that are not triangles
 //!
