@@ -1555,7 +1555,7 @@ mod tests {
                         continue;
                     };
                     let value = c.value.luminance() as f64;
-                    if !(value > 0.0) {
+                    if value.is_nan() || value <= 0.0 {
                         continue;
                     }
                     bdpt.strategy_path(&scratch, s, t, &mut path);
