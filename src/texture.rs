@@ -265,18 +265,6 @@ impl Texture {
         }
     }
 
-    /// The smallest linear value of RGBA channel `channel` over all texels (what any
-    /// lookup, a blend of texels, can reach at least).
-    pub(crate) fn channel_min(&self, channel: usize) -> f32 {
-        let mut min = f32::INFINITY;
-        for row in 0..self.height {
-            for column in 0..self.width {
-                min = min.min(self.texel(column, row)[channel]);
-            }
-        }
-        min
-    }
-
     /// The linear RGBA value of the texel in `column`, `row` (both in range).
     #[inline]
     fn texel(&self, column: u32, row: u32) -> [f32; 4] {

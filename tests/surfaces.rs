@@ -1,13 +1,11 @@
-//! Real surfaces: shading normals (and, as they land, glossy metallic-roughness BSDFs and
-//! textures) in every algorithm. The algorithms must agree with each other on the surfaces
-//! scene (tests/common/surfaces.rs): the path tracer and BDPT (whose light tracing sees the
-//! non-symmetric BSDF of shading normals from the other end), and each Metropolis algorithm
+//! Real surfaces: shading normals, glossy metallic-roughness BSDFs, textures and the
+//! material extensions (clear coats, sheen, specular, anisotropy, thin films) in every
+//! algorithm. The seven algorithms must agree with each other on the surfaces scene
+//! (tests/common/surfaces.rs) with the extensions (`extensions_scene`): the path tracer and
+//! BDPT (whose light tracing sees the non-symmetric BSDF of shading normals, and the coat's
+//! non-reciprocal layering, from the other end), and each Metropolis algorithm and ERPT
 //! against BDPT. Tolerances come from the spread of independent renders, and each check
 //! also asserts that a 2% brightness error would fail (`assert_estimates_agree`).
-//!
-//! Runs in about two minutes on 2 cores (`cargo test --test surfaces`; 70 s with the
-//! anisotropic surfaces and 85 s with the thin films, each measured without the other),
-//! mostly the smooth coats', thin films' and anisotropic surfaces' agreements.
 
 mod common {
     pub mod references;
@@ -30,7 +28,8 @@ use std::borrow::Cow;
 const SIZE: u32 = 32;
 const MAX_DEPTH: u32 = 4;
 
-/// `renders` independent renders of the surfaces scene with `settings`.
+/// `renders` independent renders of the surfaces scene with the material extensions
+/// (`extensions_scene`) with `settings`.
 fn estimate(settings: RenderSettings, renders: u64) -> Estimate {
     let settings = RenderSettings {
         width: SIZE,
@@ -39,7 +38,7 @@ fn estimate(settings: RenderSettings, renders: u64) -> Estimate {
         ..settings
     };
     estimate_over_seeds(
-        &surfaces_mesh().scene(Backend::Bvh),
+        &extensions_scene(),
         &canonical_camera("cornell-box"),
         &settings,
         900..900 + renders,
@@ -110,7 +109,8 @@ fn primary_space_metropolis_agrees_with_bdpt() {
 
 /// Through the scene's glossy vertices (rough gold, rough glass) the perturbations move
 /// microfacets (perturbation.rs); the short block, a rough coat over a diffuse base beside
-/// a compensated metal, is a diffuse vertex to them.
+/// a compensated metal, under a smooth clear coat, is a diffuse vertex to them or, through
+/// the clear coat's mirror, a specular one.
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt() {
     for algorithm in [Algorithm::PathSpaceMlt, Algorithm::Erpt] {
@@ -200,10 +200,14 @@ fn anisotropic_surfaces_agree_across_algorithms() {
     );
 }
 
-/// The surfaces scene with clear coats: a rough coat over the gold block, a smooth one
-/// (a Dirac lobe) over the half-metal block, and a rough coat with its own normal map (the
-/// checker, bending the coat's normal square by square) over the textured floor.
-fn coated_surfaces_scene() -> Scene {
+/// The surfaces scene with the material extensions: clear coats (a smooth one, a Dirac
+/// lobe, over the half-metal block, and a rough one with its own normal map, the checker
+/// bending the coat's normal square by square, over the textured floor), sheen over a
+/// rough non-metal on the red wall, and a tinted, weakened specular reflection on the
+/// green wall's. The gold block stays uncoated: a glossy vertex, whose microfacets the
+/// perturbations move. (Alpha BLEND and volumes have scenes of their own: the blended
+/// coverage tests below and tests/volume.rs.)
+fn extensions_scene() -> Scene {
     let mut surfaces = surfaces_mesh();
     for m in &mut surfaces.mesh.materials {
         if m.base_color_texture.is_some() {
@@ -217,61 +221,36 @@ fn coated_surfaces_scene() -> Scene {
                 clearcoat_normal_scale: 0.5,
                 ..*m
             };
-        } else if m.kind == mlt::MaterialKind::MetallicRoughness && m.metallic == 1.0 {
-            (m.clearcoat, m.clearcoat_roughness) = (1.0, 0.1);
         } else if m.metallic == 0.5 {
             (m.clearcoat, m.clearcoat_roughness) = (0.8, 0.0);
+        } else if m.kind == mlt::MaterialKind::Diffuse && m.color[0] > 2.0 * m.color[1] {
+            // The red wall.
+            *m = Material {
+                sheen_color: [0.9, 0.7, 0.6],
+                sheen_roughness: 0.4,
+                ..Material::metallic_roughness(m.color, 0.0, 0.7)
+            };
+        } else if m.kind == mlt::MaterialKind::Diffuse && m.color[1] > 2.0 * m.color[0] {
+            // The green wall.
+            *m = Material {
+                specular: 0.6,
+                specular_color: [0.5, 1.0, 0.7],
+                ..Material::metallic_roughness(m.color, 0.0, 0.35)
+            };
         }
     }
     surfaces.scene(Backend::Bvh)
 }
 
-/// Light tracing sees the coat's non-reciprocal layering and its own normal from the
-/// other end (the adjoint): BDPT agrees with the path tracer on the coated scene, where a
-/// coat evaluated without the adjoint, or without its normal's correction, would differ.
-/// Path-space MLT refuses the smooth coat with a clear error.
-#[test]
-fn coated_surfaces_bdpt_agrees_with_the_path_tracer() {
-    let scene = coated_surfaces_scene();
-    let camera = canonical_camera("cornell-box");
-    let estimate = |algorithm, samples_per_pixel, renders: u64| {
-        let settings = RenderSettings {
-            algorithm,
-            samples_per_pixel,
-            width: SIZE,
-            height: SIZE,
-            max_depth: MAX_DEPTH,
-            ..Default::default()
-        };
-        estimate_over_seeds(&scene, &camera, &settings, 700..700 + renders)
-    };
-
-    assert_estimates_agree(
-        "coated surfaces BDPT against the path tracer",
-        &estimate(Algorithm::Bdpt, 64, 16),
-        &estimate(Algorithm::Path, 192, 16),
-        4,
-        5.0,
-        6.0,
-    );
-    let settings = RenderSettings {
-        algorithm: Algorithm::PathSpaceMlt,
-        width: 8,
-        height: 8,
-        ..Default::default()
-    };
-    let mut image = vec![0.0; 8 * 8 * 3];
-    let error = mlt::render(&scene, &camera, &settings, &mut image, None)
-        .unwrap_err()
-        .to_string();
-    assert!(error.contains("clear coat is smooth"), "{error}");
-}
-
 /// The Cornell box with smooth coats over its blocks (metallic-roughness at roughness 0,
 /// non-metal): the short block's over a red diffuse base, the tall block's over a base
 /// half diffuse and half transmissive (Dirac reflection and refraction beside the diffuse
-/// lobe), and the floor's over its white base. Path-space MLT and ERPT record at each such
-/// vertex which lobe the path scatters through (path_space/mod.rs, "Lobes").
+/// lobe), and the floor's over its white base. Two walls have smooth clear coats (a Dirac
+/// lobe beside the base's): the back one over a white non-metal of roughness 1 (its
+/// diffuse base and a rough reflection), the green one over a green metal of roughness 0.3.
+/// (Coating the red wall too, facing the green one, makes chains of mirror reflections
+/// between them whose rare bright paths the 16 renders' spread underestimates.) Path-space MLT and ERPT record at each such vertex which lobe the path scatters
+/// through (path_space/mod.rs, "Lobes").
 fn coated_box() -> mlt::Scene {
     let mut mesh = common::scenes::canonical_mesh("cornell-box");
     let coated = mesh.materials.len() as u32;
@@ -283,9 +262,26 @@ fn coated_box() -> mlt::Scene {
     });
     mesh.materials
         .push(Material::metallic_roughness([0.8; 3], 0.0, 0.0));
+    let clear_coat = |m: Material| Material {
+        clearcoat: 1.0,
+        clearcoat_roughness: 0.0,
+        ..m
+    };
+    mesh.materials.push(clear_coat(Material::metallic_roughness(
+        [0.725, 0.71, 0.68],
+        0.0,
+        1.0,
+    )));
+    mesh.materials.push(clear_coat(Material::metallic_roughness(
+        [0.3, 0.8, 0.35],
+        1.0,
+        0.3,
+    )));
     for (triangle, material) in mesh.material_ids.iter_mut().enumerate() {
         match triangle {
             0..2 => *material = coated + 2,
+            4..6 => *material = coated + 3,
+            6..8 => *material = coated + 4,
             10..20 => *material = coated,
             20..30 => *material = coated + 1,
             _ => {}
@@ -312,7 +308,7 @@ fn coated_estimate(settings: RenderSettings, renders: u64) -> Estimate {
 
 /// Path-space MLT (its perturbations turning directions, and stepping them in their
 /// samplings' coordinates) and ERPT agree with BDPT on smooth coats over diffuse and
-/// transmissive bases.
+/// transmissive bases, and on smooth clear coats over a rough non-metal and a metal.
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
     let bdpt = coated_estimate(

@@ -457,6 +457,17 @@ mod tests {
                         {
                             continue;
                         }
+                        // Given the lobe (as a path-space vertex records it), scattering
+                        // into the sampled direction gives the sample back.
+                        let lobe = m
+                            .scatter_lobe(n, wo, s.wi, mode, s.specular)
+                            .expect(&context);
+                        assert_eq!(lobe.specular, s.specular, "{context}");
+                        assert!(
+                            (lobe.pdf - s.pdf).abs() <= tolerance * s.pdf
+                                && close(lobe.weight, s.weight, tolerance),
+                            "scatter_lobe: {context} {lobe:?}"
+                        );
                         let again = m.scatter(n, wo, s.wi, mode).expect(&context);
                         assert_eq!(again.specular, s.specular, "{context}");
                         assert!(
@@ -471,20 +482,16 @@ mod tests {
                             // The coat's mirror may fall behind the base's normal.
                             let coat_reflection =
                                 m.clearcoat.is_smooth() && (s.wi - coat_mirror).length() < 1e-5;
-                            let lobe = if coat_reflection {
+                            let by_sides = if coat_reflection {
                                 SpecularLobe::Reflection
                             } else {
                                 SpecularLobe::of(n, wo, s.wi)
                             };
-                            // Two smooth reflections about different normals: the
-                            // lobe does not name one (path-space MLT refuses them).
-                            let two_mirrors = m.roughness == 0.0
-                                && m.clearcoat.is_smooth()
-                                && m.clearcoat.normal.is_some();
-                            if lobe == SpecularLobe::Refraction || !two_mirrors {
-                                let direction = m.specular_direction(n, wo, lobe).unwrap();
-                                assert!((direction - s.wi).length() < 1e-5, "{context}");
-                            }
+                            // Two smooth reflections about different normals: the nearer
+                            // mirror names the lobe.
+                            let lobe = m.specular_lobe(n, wo, s.wi, by_sides);
+                            let direction = m.specular_direction(n, wo, lobe).unwrap();
+                            assert!((direction - s.wi).length() < 1e-5, "{context} {lobe:?}");
                             continue;
                         }
                         let pdf = m.pdf(n, wo, s.wi);

@@ -425,8 +425,11 @@ impl MetallicRoughness {
     ) -> Option<ScatterSample> {
         let view = self.view(normal, wo)?;
         let choice = self.lobe_choice(&view);
-        // Clear coat.
+        // Clear coat: without lobes with a density, every direction is a Dirac lobe's.
         if self.clearcoat.is_present() {
+            if !self.lobes().has_non_specular() {
+                return self.coated_scatter_lobe(&view, choice, normal, wo, wi, mode, true);
+            }
             return self.coated_scatter(&view, choice, normal, wo, wi, mode);
         }
         self.scatter_base(&view, choice, wi, mode)
@@ -468,6 +471,10 @@ impl MetallicRoughness {
     ) -> Option<ScatterSample> {
         let view = self.view(normal, wo)?;
         let choice = self.lobe_choice(&view);
+        // Clear coat.
+        if self.clearcoat.is_present() {
+            return self.coated_scatter_lobe(&view, choice, normal, wo, wi, mode, dirac);
+        }
         let local = view.local(wi);
         if local.z == 0.0 {
             return None;
@@ -510,9 +517,8 @@ impl MetallicRoughness {
         wo: Vec3A,
         lobe: SpecularLobe,
     ) -> Option<Vec3A> {
-        // Clear coat: a smooth one's mirror about its own normal (a smooth base's mirror
-        // about another normal is a second reflection this cannot name; path-space MLT and
-        // ERPT, the callers, refuse smooth coats).
+        // Clear coat: a smooth one's mirror about its own normal (`BaseReflection` names a
+        // smooth base's beneath it).
         if lobe == SpecularLobe::Reflection
             && self.clearcoat.is_present()
             && self.clearcoat.is_smooth()
@@ -526,11 +532,32 @@ impl MetallicRoughness {
             return None;
         }
         match lobe {
-            SpecularLobe::Reflection => Some(reflect(wo, normal)),
+            SpecularLobe::Reflection | SpecularLobe::BaseReflection => Some(reflect(wo, normal)),
             SpecularLobe::Refraction if !self.transmission_tint().is_black() => {
                 refracted(self.ior, normal, wo)
             }
             SpecularLobe::Refraction => None,
+        }
+    }
+
+    /// The specular lobe that scatters `wo` into `wi`, given `by_sides`, the one the sides
+    /// of the directions name (`SpecularLobe::of`): a reflection under a smooth coat with
+    /// a normal of its own over a smooth base is the base's mirror (`BaseReflection`) where
+    /// `wi` is nearer it than the coat's (see [`Self::nearer_base_mirror`]).
+    pub fn specular_lobe(
+        &self,
+        normal: Vec3A,
+        wo: Vec3A,
+        wi: Vec3A,
+        by_sides: SpecularLobe,
+    ) -> SpecularLobe {
+        if by_sides == SpecularLobe::Reflection
+            && self.has_two_mirrors()
+            && self.nearer_base_mirror(normal, wo, wi)
+        {
+            SpecularLobe::BaseReflection
+        } else {
+            by_sides
         }
     }
 
@@ -1345,6 +1372,77 @@ impl MetallicRoughness {
             return Some(self.coated_base_dirac(view, choice, &coat, base, mode));
         }
         self.coated_density_scatter(view, choice, &coat, base.wi, mode)
+    }
+
+    /// Whether a smooth coat with a normal of its own lies over a smooth base: two mirrors
+    /// about different normals, two Dirac reflections.
+    #[inline]
+    fn has_two_mirrors(&self) -> bool {
+        self.roughness == 0.0
+            && self.clearcoat.is_present()
+            && self.clearcoat.is_smooth()
+            && self.clearcoat.normal.is_some()
+    }
+
+    /// Whether `wi`, reflected from `wo`, is nearer the base's mirror direction (about
+    /// `normal`) than the coat's (about its own normal). A path's direction rebuilt from
+    /// its vertices is off its mirror by rounding; the nearer mirror names it without a
+    /// tolerance. (Where the two normals are within rounding of each other the mirrors are
+    /// one in all but name, and the choice is arbitrary.)
+    #[inline]
+    fn nearer_base_mirror(&self, normal: Vec3A, wo: Vec3A, wi: Vec3A) -> bool {
+        let coat_normal = self.clearcoat.normal.unwrap_or(normal);
+        wi.dot(reflect(wo, normal)) > wi.dot(reflect(wo, coat_normal))
+    }
+
+    /// `scatter_lobe` with the coat: with `dirac`, the smooth coat's mirror, the smooth
+    /// base's mirror or refraction, whichever `wi` is (by its side, and by the nearer
+    /// mirror where there are two); else the lobes with a density (the coat's and the
+    /// base's under it), as `coated_density_scatter`, where a smooth base reflects only.
+    #[allow(clippy::too_many_arguments)]
+    fn coated_scatter_lobe(
+        &self,
+        view: &View,
+        choice: LobeChoice,
+        normal: Vec3A,
+        wo: Vec3A,
+        wi: Vec3A,
+        mode: TransportMode,
+        dirac: bool,
+    ) -> Option<ScatterSample> {
+        let coat = self.clearcoat.view(normal, wo)?;
+        let local = view.local(wi);
+        if local.z == 0.0 {
+            return None;
+        }
+        let smooth_base = self.distribution().is_none();
+        if !dirac {
+            if smooth_base && local.z < 0.0 {
+                return None;
+            }
+            return self.coated_density_scatter(view, choice, &coat, wi, mode);
+        }
+        if local.z < 0.0 {
+            // Only a smooth base refracts through a Dirac lobe.
+            let refracts = smooth_base && choice.transmission > 0.0;
+            let base = refracts.then(|| self.specular_transmission(view, wi, choice, mode))?;
+            return Some(self.coated_base_dirac(view, choice, &coat, base, mode));
+        }
+        let coat_reflects = coat.is_smooth() && coat.stays_on_wo_side(coat.mirror());
+        let base_reflects = smooth_base;
+        let through_base = match (coat_reflects, base_reflects) {
+            (false, false) => return None,
+            (true, false) => false,
+            (false, true) => true,
+            // Two mirrors: one where their normals are the same (`coat_mirror` merges them).
+            (true, true) => self.has_two_mirrors() && self.nearer_base_mirror(normal, wo, wi),
+        };
+        if through_base {
+            let base = self.specular_reflection(view, wi, choice);
+            Some(self.coated_base_dirac(view, choice, &coat, base, mode))
+        } else {
+            Some(self.coat_mirror(view, choice, &coat, mode))
+        }
     }
 
     /// `scatter` with the coat: a `wi` within [`MIRROR_TOLERANCE`] of a smooth coat's
@@ -2238,7 +2336,9 @@ mod tests {
                         let (f_ours, f_exact) =
                             (ours.weight[0] * ours.pdf, theirs.weight[0] * theirs.pdf);
                         let (share_ours, share_exact) = match lobe {
-                            SpecularLobe::Reflection => (f_ours, f_exact),
+                            SpecularLobe::Reflection | SpecularLobe::BaseReflection => {
+                                (f_ours, f_exact)
+                            }
                             SpecularLobe::Refraction => {
                                 // Divide out the common η² scale: the weight of refraction
                                 // at probability (1 − F) is the scale itself there.

@@ -240,6 +240,18 @@ impl Bsdf {
         self.corrected(sample, wo, mode)
     }
 
+    /// The specular lobe that scatters `wo` into `wi` (a Dirac scattering): the sides say
+    /// reflection or refraction, and where a smooth coat with a normal of its own lies over
+    /// a smooth base, the nearer mirror says whose reflection.
+    #[inline]
+    pub fn specular_lobe(&self, wo: Vec3A, wi: Vec3A) -> SpecularLobe {
+        let by_sides = SpecularLobe::of(self.geometric_normal, wo, wi);
+        match &self.model {
+            BsdfModel::MetallicRoughness(m) => m.specular_lobe(self.normal, wo, wi, by_sides),
+            _ => by_sides,
+        }
+    }
+
     /// The direction a specular lobe scatters `wo` into (see [`specular_direction`]);
     /// `None` also where it would leak through the surface.
     #[inline]

@@ -85,15 +85,21 @@ impl std::ops::BitOr for BsdfLobes {
     }
 }
 
-/// The lobe of a specular scattering: whether `wi` stays on `wo`'s side of the surface.
+/// The lobe of a specular scattering: whether `wi` stays on `wo`'s side of the surface,
+/// and which mirror reflects it where a smooth clear coat with a normal of its own lies
+/// over a smooth base (two mirrors about different normals).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SpecularLobe {
+    /// The mirror: a smooth coat's where there is one, else the surface's.
     Reflection,
     Refraction,
+    /// A smooth base's mirror under a smooth coat that has a normal of its own.
+    BaseReflection,
 }
 
 impl SpecularLobe {
-    /// The lobe that scatters `wo` into `wi` at a surface with normal `normal`.
+    /// The lobe that scatters `wo` into `wi` at a surface with normal `normal`, by the
+    /// sides alone (`Bsdf::specular_lobe` tells the two mirrors apart).
     #[inline]
     pub fn of(normal: Vec3A, wo: Vec3A, wi: Vec3A) -> SpecularLobe {
         if wo.dot(normal) * wi.dot(normal) > 0.0 {

@@ -37,9 +37,9 @@ pub(crate) struct PathVertex {
     /// emissive triangle is `None`, told by its triangle, as any surface vertex).
     pub light: Option<Emitter>,
     /// Which lobe scatters the path here where the BSDF has a Dirac lobe beside one with a
-    /// density (a smooth coat over a diffuse base): the Dirac one (true) or the other.
-    /// Whether a Dirac scattering reflects or refracts follows from the sides of the
-    /// directions. Read only at such BSDFs: elsewhere the BSDF alone says which (see
+    /// density (a smooth coat over a diffuse base, a smooth clear coat): the Dirac one
+    /// (true) or the other. Which Dirac lobe follows from the directions: the sides say
+    /// reflection or refraction, and the nearer mirror which of two (`Bsdf::specular_lobe`). Read only at such BSDFs: elsewhere the BSDF alone says which (see
     /// `PathSpace::is_specular`). False at the path's ends.
     pub dirac: bool,
 }

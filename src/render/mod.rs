@@ -379,19 +379,6 @@ fn with_estimator<R>(
         min_depth,
         spectral: settings.spectral,
     };
-    if matches!(
-        settings.algorithm,
-        Algorithm::PathSpaceMlt | Algorithm::Erpt
-    ) && let Some(material) = scene.uncharted_clearcoat_material()
-    {
-        return Err(crate::error::Error::new(
-            crate::error::MLT_STATUS_UNSUPPORTED,
-            format!(
-                "{:?} cannot render material {material}: its clear coat is smooth, or lies over a smooth coat beside a diffuse or transmissive base (Dirac lobes beside others, which these path-space mutations handle without a clear coat only); give the clear coat and the base a roughness above 0, or use another algorithm",
-                settings.algorithm
-            ),
-        ));
-    }
     let multiplexed;
     let all_strategies;
     let estimator: Estimator = match settings.algorithm {

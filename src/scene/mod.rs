@@ -556,48 +556,6 @@ impl Scene {
         self.materials[material].disperses(channels)
     }
 
-    /// The first material with a clear coat that path-space MLT and ERPT cannot yet
-    /// explore: a coat that is smooth somewhere (a Dirac lobe over any base, beside a
-    /// smooth base's own mirror about another normal), or a coat over a base that has a
-    /// Dirac lobe beside a diffuse one somewhere (their per-vertex lobe does not know the
-    /// coat's share).
-    pub(crate) fn uncharted_clearcoat_material(&self) -> Option<usize> {
-        self.materials.iter().position(|m| {
-            if m.kind != MaterialKind::MetallicRoughness || m.clearcoat <= 0.0 {
-                return false;
-            }
-            let texture_min = |texture: Option<crate::TextureRef>, channel| {
-                texture.map_or(1.0, |t| {
-                    self.textures[t.texture as usize].channel_min(channel)
-                })
-            };
-            let packed = m.metallic_roughness_texture;
-            let (roughness, metallic) = (
-                m.roughness * texture_min(packed, 1),
-                m.metallic * texture_min(packed, 2),
-            );
-            // The least transmission leaves the most diffuse base beside the specular lobes.
-            let transmission = m.transmission * texture_min(m.transmission_texture, 0);
-            let layers = m.untextured_layers();
-            let smoothest = m.textured_bsdf_model(
-                Spectrum::from(m.color),
-                metallic,
-                0.0,
-                transmission,
-                m.ior,
-                &layers,
-                &crate::spectral::Channels::Rgb,
-            );
-            let smooth_coat =
-                m.clearcoat_roughness * texture_min(m.clearcoat_roughness_texture, 1) == 0.0;
-            smooth_coat
-                || roughness == 0.0 && {
-                    let lobes = smoothest.lobes();
-                    lobes.contains(crate::bsdf::BsdfLobes::SPECULAR) && lobes.has_non_specular()
-                }
-        })
-    }
-
     /// Whether a candidate hit at barycentrics (u, v) of internal triangle `triangle` is a
     /// surface: false where an alpha cut-out removes it, or where blended coverage lets the
     /// point through (alpha at most the point's `coverage_threshold`).

@@ -515,6 +515,12 @@ mod tests {
 
     /// The small scene with more lights.
     fn scene_with(lights: crate::scene::LightsDesc) -> Scene {
+        let albedo = Surface::Floor.albedo().as_vec3().to_array();
+        scene_with_floor(lights, Material::diffuse(albedo))
+    }
+
+    /// The small scene with more lights and the floor's material.
+    fn scene_with_floor(lights: crate::scene::LightsDesc, floor: Material) -> Scene {
         let mut positions = Vec::new();
         let mut indices = Vec::new();
         let mut material_ids = Vec::new();
@@ -536,7 +542,7 @@ mod tests {
             indices: &indices,
             material_ids: &material_ids,
             materials: &[
-                Material::diffuse(albedo(Surface::Floor)),
+                floor,
                 Material::diffuse(albedo(Surface::Wall)),
                 Material::diffuse([0.0; 3]).with_emission([EMISSION; 3]),
             ],
@@ -1469,5 +1475,211 @@ mod tests {
                 "{flaw:?} not rejected: chi-square {stat}, z {z}"
             );
         }
+    }
+
+    /// Detailed balance with mixed lobes: the small scene's floor under a smooth clear coat
+    /// (a Dirac mirror beside the rough non-metal's lobes with a density), so a path's state
+    /// includes which lobe scatters it there (path_space/mod.rs, "Lobes"). Chains of the
+    /// bidirectional mutation alone, over paths of 3 and 4 vertices, end in the cells of
+    /// `chain_cell` and the lobe signatures of their inner vertices in the proportions of
+    /// f: BDPT's MIS-weighted contributions, binned by the path and signature each strategy
+    /// built (`Bdpt::strategy_path`), estimate ∫ f over each bin independently of the
+    /// mutation. A chi-square test that counts both estimates' variances passes, and
+    /// chains whose ratio leaves out the lobe choice's probability at the floor fail it.
+    #[test]
+    fn bidirectional_chain_samples_f_through_mixed_lobes() {
+        use crate::integrators::SampleCounters;
+        use crate::integrators::bdpt::Bdpt;
+        let albedo = Surface::Floor.albedo().as_vec3().to_array();
+        let floor = Material {
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.0,
+            ..Material::metallic_roughness(albedo, 0.0, 1.0)
+        };
+        let scene = scene_with_floor(Default::default(), floor);
+        let camera = camera();
+        let space = PathSpace {
+            scene: &scene,
+            camera: &camera,
+            channels: Channels::Rgb,
+        };
+        let cells = {
+            let (three, four) = chain_grids();
+            three.len() + four.len()
+        };
+        // A path's bin: its cell, and whether each inner vertex scatters through the
+        // floor's Dirac lobe.
+        let bin = |path: &[PathVertex]| {
+            let signature = (1..path.len() - 1)
+                .filter(|&k| space.is_specular(&path[k]))
+                .fold(0, |bits, k| bits | 1 << (k - 1));
+            chain_cell(path) * 4 + signature
+        };
+        let bins = 4 * cells;
+
+        // BDPT's estimate of ∫ f over each bin, with its variance.
+        let bdpt = Bdpt {
+            scene: &scene,
+            max_depth: 2,
+            min_depth: 1,
+            spectral: false,
+        };
+        let mut scratch = crate::integrators::PixelEstimator::scratch(&bdpt);
+        let mut counters = SampleCounters::default();
+        let mut rng = Rng::new(0x10b5, 0);
+        let (mut sum, mut sum2) = (vec![0.0f64; bins], vec![0.0f64; bins]);
+        let mut sample = vec![0.0f64; bins];
+        let mut path = Vec::new();
+        let samples = 400_000u32;
+        for _ in 0..samples {
+            let [fx, fy] = rng.uniform2();
+            let (n_camera, n_light) = bdpt.trace_subpaths(
+                &camera,
+                fx * 8.0,
+                fy * 8.0,
+                4,
+                3,
+                &mut rng,
+                &mut scratch,
+                &mut counters,
+            );
+            sample.fill(0.0);
+            for t in 1..=n_camera {
+                for s in 0..=n_light {
+                    if !(3..=4).contains(&(s + t)) || (s == 1 && t == 1) {
+                        continue;
+                    }
+                    let Some(c) =
+                        bdpt.connect(&camera, &mut scratch, s, t, &mut rng, &mut counters)
+                    else {
+                        continue;
+                    };
+                    let value = c.value.luminance() as f64;
+                    if value.is_nan() || value <= 0.0 {
+                        continue;
+                    }
+                    bdpt.strategy_path(&scratch, s, t, &mut path);
+                    sample[bin(&path)] += value;
+                }
+            }
+            for ((s, s2), v) in sum.iter_mut().zip(&mut sum2).zip(&sample) {
+                *s += v;
+                *s2 += v * v;
+            }
+        }
+        let n = samples as f64;
+        let total: f64 = sum.iter().sum();
+        let target: Vec<f64> = sum.iter().map(|s| s / total).collect();
+        // The variance of each share (the total's own noise is second order).
+        let target_variance: Vec<f64> = sum
+            .iter()
+            .zip(&sum2)
+            .map(|(s, s2)| (s2 / n - (s / n) * (s / n)) / (n - 1.0) / (total / n).powi(2))
+            .collect();
+        let mirror_share: f64 = (0..bins).filter(|b| b % 4 != 0).map(|b| target[b]).sum();
+        println!("BDPT: share through the coat's mirror {mirror_share:.4}");
+        assert!(
+            mirror_share > 0.01,
+            "the coat's mirror carries {mirror_share}"
+        );
+
+        // The chains: the correct ratio, and one without the lobe choice's probability
+        // at the floor (C_s would not divide by it: the ratio gains P_y / P_x).
+        let lobe_probability = |path: &[PathVertex]| -> f64 {
+            (1..path.len() - 1)
+                .filter(|&k| Surface::of(&path[k]) == Surface::Floor)
+                .map(|k| {
+                    let (wo, _) = super::super::direction(&path[k], &path[k + 1]).unwrap();
+                    let bsdf = space.surface_bsdf(&path[k]);
+                    let mirror = crate::bsdf::reflect(wo, bsdf.shading_normal());
+                    let p = bsdf
+                        .scatter_lobe(wo, mirror, TransportMode::Radiance, true)
+                        .map_or(0.0, |s| s.pdf as f64);
+                    if space.is_specular(&path[k]) {
+                        p
+                    } else {
+                        1.0 - p
+                    }
+                })
+                .product()
+        };
+        let [light, wall, floor, lens] = vertices(&space);
+        let long_share: f64 = (0..bins)
+            .filter(|b| b / 4 >= chain_grids().0.len())
+            .map(|b| target[b])
+            .sum();
+        let mutation = Bidirectional {
+            min_vertices: 3,
+            max_vertices: 4,
+        };
+        let (chains, steps) = (20_000u64, 300);
+        let run = |flawed: bool| {
+            let mut counts = vec![0u64; bins];
+            let (mut x, mut y, mut eye) = (Vec::new(), Vec::new(), Vec::new());
+            for c in 0..chains {
+                let mut rng = Rng::new(0xC0A7, c);
+                x.clear();
+                if (c as f64 + 0.5) / (chains as f64) < long_share {
+                    x.extend_from_slice(&[light, wall, floor, lens]);
+                } else {
+                    x.extend_from_slice(&[light, floor, lens]);
+                }
+                for _ in 0..steps {
+                    let Some(proposal) =
+                        mutation.propose(&space, &x, &mut y, &mut eye, &mut rng, &mut 0)
+                    else {
+                        continue;
+                    };
+                    let mut r = proposal.ratio as f64;
+                    if flawed {
+                        r *= lobe_probability(&y) / lobe_probability(&x);
+                    }
+                    if rng.uniform() < acceptance(1.0, 1.0, r as f32) {
+                        std::mem::swap(&mut x, &mut y);
+                    }
+                }
+                counts[bin(&x)] += 1;
+            }
+            // Pearson's statistic with both estimates' variances, over the bins BDPT
+            // reaches (the others must stay empty).
+            let m = chains as f64;
+            let (mut stat, mut df, mut stray) = (0.0, 0usize, 0u64);
+            for (b, ((&count, &p), &var)) in
+                counts.iter().zip(&target).zip(&target_variance).enumerate()
+            {
+                if p <= 0.0 {
+                    stray += count;
+                    continue;
+                }
+                let expected = m * p;
+                let term = (count as f64 - expected).powi(2) / (expected + m * m * var);
+                if term > 4.0 {
+                    println!(
+                        "  bin {b}: {count} against {expected:.1} (reference σ {:.1})",
+                        m * var.sqrt()
+                    );
+                }
+                stat += term;
+                df += 1;
+            }
+            let mirror: u64 = (0..bins).filter(|b| b % 4 != 0).map(|b| counts[b]).sum();
+            println!(
+                "flawed {flawed}: chi-square {stat:.1} on {df} bins (99.9% quantile {:.1}), \
+                 through the mirror {:.4}, {stray} in bins BDPT never reached",
+                chi_square_quantile(df - 1, Z_999),
+                mirror as f64 / m
+            );
+            (stat, chi_square_quantile(df - 1, Z_999), stray)
+        };
+        let (stat, threshold, stray) = run(false);
+        assert!(
+            stat < threshold && stray == 0,
+            "chi-square {stat} ≥ {threshold}"
+        );
+        let (stat, threshold, _) = run(true);
+        assert!(
+            stat > 2.0 * threshold,
+            "without the lobe probability: chi-square {stat} < 2 × {threshold}"
+        );
     }
 }

@@ -386,10 +386,10 @@ fn caustic_start(space: &PathSpace, x: &[PathVertex]) -> usize {
 
 /// The lobe vertex `k` of `x` scatters through (x_{k+1} → x_k → x_{k-1}).
 #[inline]
-fn lobe_at(x: &[PathVertex], k: usize) -> Option<SpecularLobe> {
+fn lobe_at(space: &PathSpace, x: &[PathVertex], k: usize) -> Option<SpecularLobe> {
     let (wo, _) = direction(&x[k], &x[k + 1])?;
     let (wi, _) = direction(&x[k], &x[k - 1])?;
-    Some(SpecularLobe::of(x[k].normal, wo, wi))
+    Some(space.surface_bsdf(&x[k]).specular_lobe(wo, wi))
 }
 
 /// The density with which vertex `at` (a light, `from` = `None`, or a non-specular surface
@@ -527,7 +527,7 @@ pub(crate) fn lens(
         let next = match class {
             VertexClass::Specular => space
                 .surface_bsdf(&v)
-                .specular_direction(wo, lobe_at(x, k)?)?,
+                .specular_direction(wo, lobe_at(space_x, x, k)?)?,
             VertexClass::Glossy => glossy_onwards(
                 [space_x, space_y],
                 kernel,
@@ -645,7 +645,7 @@ pub(crate) fn caustic(
             // x's lobe at k, seen from the light side (x_{k-1} → x_k → x_{k+1}).
             let (wo_x, _) = direction(&x[k], &x[k - 1])?;
             let (wi_x, _) = direction(&x[k], &x[k + 1])?;
-            let lobe = SpecularLobe::of(x[k].normal, wo_x, wi_x);
+            let lobe = space_x.surface_bsdf(&x[k]).specular_lobe(wo_x, wi_x);
             space.surface_bsdf(&v).specular_direction(wo, lobe)?
         };
         ray = spawn_ray(space.scene, v.p, v.normal, next);
