@@ -611,6 +611,14 @@ fn bad_input_is_a_one_line_error_naming_it() {
             &["only glTF files have material variants", "\"red\""],
         ),
         ("{sky} --variant red", &["no material variants", "\"red\""]),
+        // A material value the kernel refuses, named with the file's material.
+        (
+            "{cornell} --material roughness=nan",
+            &[
+                "desc.materials[0].roughness is NaN; it must be a finite number",
+                "(material 'white')",
+            ],
+        ),
         // Settings the kernel refuses (its message comes through), and clap's own errors.
         ("{cornell} --width 0", &["width"]),
         ("{cornell} --spp many", &["--spp"]),

@@ -1459,6 +1459,49 @@ fn gltf_with_bad_volumes_is_refused() {
     }
 }
 
+/// glTF material values mlt cannot render are clear errors naming the value and the
+/// material when the scene is built: a roughness above 1 or below 0, one too large for a
+/// float (JSON has no NaN; 1e39 becomes an infinite float), and so a metalness.
+#[test]
+fn gltf_with_bad_material_values_is_refused() {
+    let buffer = quad_buffer();
+    let uri = format!("data:application/octet-stream;base64,{}", base64(&buffer));
+    let json = gltf_json(Some(&uri), buffer.len());
+    let good = r#""baseColorFactor": [0.2, 0.3, 0.4, 1]"#;
+    assert!(json.contains(good));
+    for (bad, expected) in [
+        (
+            r#""roughnessFactor": 2"#,
+            "roughness is 2; it must be in [0, 1]",
+        ),
+        (
+            r#""roughnessFactor": -1"#,
+            "roughness is -1; it must be in [0, 1]",
+        ),
+        (
+            r#""roughnessFactor": 1e39"#,
+            "roughness is inf; it must be a finite number",
+        ),
+        (
+            r#""metallicFactor": 1e39"#,
+            "metallic is inf; it must be a finite number",
+        ),
+    ] {
+        let path = temp_path("bad-material.gltf");
+        std::fs::write(&path, json.replace(good, &format!("{good}, {bad}"))).unwrap();
+        let data = io::load_scene(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let Err(error) = Scene::new(&data.desc(mlt::Backend::Bvh)) else {
+            panic!("{bad} was accepted");
+        };
+        let message = data.describe_error(&error);
+        assert!(
+            message.contains(expected) && message.contains("(material 'lamp')"),
+            "{bad}: {message}"
+        );
+    }
+}
+
 #[test]
 fn gltf_with_data_uri_buffer_loads_meshes_materials_and_camera() {
     let buffer = quad_buffer();

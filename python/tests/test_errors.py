@@ -108,6 +108,10 @@ def test_bad_materials() -> None:
         build(materials=[mlt.Material(color=(1.0, 0.0))])  # type: ignore[arg-type]
     with invalid("desc.materials is empty"):
         build(materials=[])
+    with invalid(r"desc.materials\[0\].roughness is NaN; it must be a finite number$"):
+        build(materials=[mlt.Material(kind="metallic-roughness", roughness=float("nan"))])
+    with invalid(r"desc.materials\[0\].thickness is -1; a thickness must not be negative \(0: thin-walled\)$"):
+        build(materials=[mlt.Material(kind="dielectric", thickness=-1.0)])
 
 
 def test_names_ignore_case_and_dashes() -> None:

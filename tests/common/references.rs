@@ -68,7 +68,17 @@ pub fn estimate_over_seeds(
 /// An estimate computed once per test binary under `key`: the tests comparing against the
 /// same reference share it (one asking while another computes it waits for that one).
 pub fn cached_estimate(key: &str, compute: impl FnOnce() -> Estimate) -> &'static Estimate {
-    type Slot = &'static std::sync::OnceLock<Estimate>;
+    cached(key, compute)
+}
+
+/// A value computed once per test binary under `key` (a reference, or a render several tests
+/// look at), as `cached_estimate`; a key holds one type.
+pub fn cached<T: std::any::Any + Send + Sync>(
+    key: &str,
+    compute: impl FnOnce() -> T,
+) -> &'static T {
+    type Value = Box<dyn std::any::Any + Send + Sync>;
+    type Slot = &'static std::sync::OnceLock<Value>;
     static SLOTS: std::sync::Mutex<Vec<(String, Slot)>> = std::sync::Mutex::new(Vec::new());
     let slot: Slot = {
         let mut slots = SLOTS.lock().unwrap();
@@ -81,7 +91,9 @@ pub fn cached_estimate(key: &str, compute: impl FnOnce() -> Estimate) -> &'stati
             }
         }
     };
-    slot.get_or_init(compute)
+    slot.get_or_init(|| Box::new(compute()))
+        .downcast_ref()
+        .unwrap_or_else(|| panic!("{key:?} is cached as another type"))
 }
 
 /// The path tracer's estimate of a canonical scene, the reference of the Metropolis and
