@@ -119,93 +119,15 @@ fn path_space_mlt_and_erpt_agree_with_bdpt() {
     agrees_with_bdpt(Algorithm::PathSpaceMlt, true);
 }
 
-/// The surfaces scene with anisotropic microfacets (`KHR_materials_anisotropy`): the rough
-/// gold block brushed along a direction turned from the mesh's tangent, the half-metal
-/// block and the rough glass sphere (its transmission through the stretched microfacets)
-/// less so. The tangents are MikkTSpace's from the texture coordinates.
-fn anisotropic_surfaces_scene() -> Scene {
-    let mut surfaces = surfaces_mesh();
-    for m in &mut surfaces.mesh.materials {
-        if m.kind != mlt::MaterialKind::MetallicRoughness {
-            continue;
-        }
-        (m.anisotropy, m.anisotropy_rotation) = match (m.metallic, m.transmission) {
-            (1.0, _) => (0.9, 0.5),
-            (_, t) if t > 0.0 => (0.7, -1.0),
-            _ => (0.6, 2.0),
-        };
-    }
-    surfaces.scene(Backend::Bvh)
-}
-
-/// Anisotropic GGX in every estimator it meets: BDPT (light tracing sees the stretched
-/// lobe from the other end, through the mesh's tangent frame) agrees with the path tracer,
-/// and path-space MLT, whose perturbations move the glossy vertices' microfacets in the
-/// stretched frame, agrees with BDPT.
-#[test]
-fn anisotropic_surfaces_agree_across_algorithms() {
-    let scene = anisotropic_surfaces_scene();
-    let camera = canonical_camera("cornell-box");
-    let estimate = |settings: RenderSettings, renders: u64| {
-        let settings = RenderSettings {
-            width: SIZE,
-            height: SIZE,
-            max_depth: MAX_DEPTH,
-            ..settings
-        };
-        estimate_over_seeds(&scene, &camera, &settings, 500..500 + renders)
-    };
-    let bdpt = estimate(
-        RenderSettings {
-            algorithm: Algorithm::Bdpt,
-            samples_per_pixel: 64,
-            ..Default::default()
-        },
-        16,
-    );
-    let path = estimate(
-        RenderSettings {
-            algorithm: Algorithm::Path,
-            samples_per_pixel: 192,
-            ..Default::default()
-        },
-        16,
-    );
-    assert_estimates_agree(
-        "anisotropic surfaces BDPT against the path tracer",
-        &bdpt,
-        &path,
-        4,
-        5.0,
-        6.0,
-    );
-    let path_space = estimate(
-        RenderSettings {
-            algorithm: Algorithm::PathSpaceMlt,
-            samples_per_pixel: 20,
-            mutations_per_pixel: 64,
-            bootstrap_samples: 1 << 16,
-            chains: 256,
-            ..Default::default()
-        },
-        16,
-    );
-    assert_estimates_agree(
-        "anisotropic surfaces path-space MLT against BDPT",
-        &path_space,
-        &bdpt,
-        4,
-        5.0,
-        6.0,
-    );
-}
-
 /// The surfaces scene with the material extensions: clear coats (a smooth one, a Dirac
 /// lobe, over the half-metal block, and a rough one with its own normal map, the checker
 /// bending the coat's normal square by square, over the textured floor), sheen over a
-/// rough non-metal on the red wall, and a tinted, weakened specular reflection on the
-/// green wall's. The gold block stays uncoated: a glossy vertex, whose microfacets the
-/// perturbations move. (Alpha BLEND and volumes have scenes of their own: the blended
+/// rough non-metal on the red wall, a tinted, weakened specular reflection on the green
+/// wall's, anisotropic microfacets (`KHR_materials_anisotropy`, along directions turned
+/// from MikkTSpace's tangents) on the gold block, under a thin film (index 1.8, 300 nm),
+/// and on the rough glass sphere (its refraction through the stretched microfacets). The
+/// gold block stays uncoated: a glossy vertex, whose microfacets the perturbations move in
+/// the stretched frame. (Alpha BLEND and volumes have scenes of their own: the blended
 /// coverage tests below and tests/volume.rs.)
 fn extensions_scene() -> Scene {
     let mut surfaces = surfaces_mesh();
@@ -223,6 +145,14 @@ fn extensions_scene() -> Scene {
             };
         } else if m.metallic == 0.5 {
             (m.clearcoat, m.clearcoat_roughness) = (0.8, 0.0);
+        } else if m.kind == mlt::MaterialKind::MetallicRoughness && m.metallic == 1.0 {
+            // The gold block: brushed, under a thin film.
+            (m.anisotropy, m.anisotropy_rotation) = (0.9, 0.5);
+            (m.iridescence, m.iridescence_ior) = (1.0, 1.8);
+            m.iridescence_thickness_maximum = 300.0;
+        } else if m.kind == mlt::MaterialKind::MetallicRoughness && m.transmission > 0.0 {
+            // The rough glass sphere: refraction through stretched microfacets.
+            (m.anisotropy, m.anisotropy_rotation) = (0.7, -1.0);
         } else if m.kind == mlt::MaterialKind::Diffuse && m.color[0] > 2.0 * m.color[1] {
             // The red wall.
             *m = Material {
@@ -863,67 +793,4 @@ fn a_transmission_texture_multiplies_the_transmission() {
     let full = render(glass(1.0, None));
     let ratio = common::stats::mean(&quarter_by_texture)[0] / common::stats::mean(&full)[0];
     assert!((0.2..0.3).contains(&ratio), "{ratio}");
-}
-
-/// The surfaces scene with a thin film (index 1.8, 300 nm) on every metallic-roughness
-/// material (the gold block, the half-metal block, the rough glass): the film changes the
-/// Fresnel term of every specular lobe and the albedo scaling of the diffuse base, and
-/// light tracing evaluates it from the other end. BDPT agrees with the path tracer and
-/// path-space MLT (its lobes in the path state, its microfacet perturbations) with BDPT, as
-/// on the plain scene (σ of the image mean 0.15–0.22% per channel, within the 0.29% that
-/// makes a 2% error fail; measured within 0.65 σ; about 30 s of CPU, a minute on a loaded
-/// machine).
-#[test]
-fn thin_films_bdpt_agrees_with_the_path_tracer() {
-    let mut surfaces = surfaces_mesh();
-    for m in &mut surfaces.mesh.materials {
-        if m.kind == mlt::MaterialKind::MetallicRoughness {
-            m.iridescence = 1.0;
-            m.iridescence_ior = 1.8;
-            m.iridescence_thickness_maximum = 300.0;
-        }
-    }
-    let scene = surfaces.scene(Backend::Bvh);
-    let camera = canonical_camera("cornell-box");
-    let estimate = |settings: RenderSettings| {
-        let settings = RenderSettings {
-            width: SIZE,
-            height: SIZE,
-            max_depth: MAX_DEPTH,
-            ..settings
-        };
-        estimate_over_seeds(&scene, &camera, &settings, 750..766)
-    };
-    let bdpt = estimate(RenderSettings {
-        algorithm: Algorithm::Bdpt,
-        samples_per_pixel: 64,
-        ..Default::default()
-    });
-    assert_estimates_agree(
-        "thin films BDPT against the path tracer",
-        &bdpt,
-        &estimate(RenderSettings {
-            algorithm: Algorithm::Path,
-            samples_per_pixel: 192,
-            ..Default::default()
-        }),
-        4,
-        5.0,
-        6.0,
-    );
-    assert_estimates_agree(
-        "thin films path-space MLT against BDPT",
-        &estimate(RenderSettings {
-            algorithm: Algorithm::PathSpaceMlt,
-            samples_per_pixel: 40,
-            mutations_per_pixel: 128,
-            bootstrap_samples: 1 << 16,
-            chains: 256,
-            ..Default::default()
-        }),
-        &bdpt,
-        4,
-        5.0,
-        6.0,
-    );
 }
