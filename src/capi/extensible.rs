@@ -397,10 +397,11 @@ impl Extensible for MltRenderSettings {
     /// `struct_size`). `normalization_work_fraction`, added after the filter, fits the
     /// filter layout's tail padding, so that intermediate layout has today's size and is
     /// not told apart: a host passes the filter fields with it or not at all. Then the
-    /// settings before Russian roulette's.
+    /// settings before Russian roulette's, and before `full_resolution_textures`.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltRenderSettings, filter_buffers),
         offset_of!(MltRenderSettings, roulette_start_depth),
+        offset_of!(MltRenderSettings, full_resolution_textures),
     ];
     fn defaults() -> Self {
         (&RenderSettings::default()).into()
@@ -446,6 +447,7 @@ impl From<&RenderSettings> for MltRenderSettings {
             spectral,
             roulette_start_depth,
             roulette_max_survival,
+            full_resolution_textures,
             // END GENERATED settings to C
         }
     }

@@ -1,7 +1,9 @@
 //! Unidirectional path tracing: BSDF importance sampling, next-event estimation to every
 //! kind of light, multiple importance sampling (power heuristic) against BSDF sampling for
 //! the lights rays can hit (area lights, the environment, the sun's disc), and Russian
-//! roulette.
+//! roulette. Camera paths may carry a ray cone, the pixel's footprint, over which the
+//! textures of the surfaces they meet are filtered (mip-mapped) up to their first diffuse or
+//! glossy bounce.
 
 use super::{PixelEstimator, SampleCounters, light_shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
@@ -22,6 +24,44 @@ pub struct Roulette {
     pub max_survival: f32,
 }
 
+/// A ray cone (after Akenine-Möller et al., "Texture Level of Detail Strategies for
+/// Real-Time Ray Tracing"): a camera ray with the spread of its pixel, whose width at a hit
+/// is the footprint textures are filtered over there. A specular bounce keeps the cone
+/// (growing on from its width there: exact for flat mirrors and glass, which do not bend a
+/// cone's spread, a planar approximation for curved ones); the first diffuse or glossy
+/// bounce ends it, and later vertices read textures at full resolution, as every other
+/// strategy does there (a wide lobe averages the texture itself).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayCone {
+    /// Width at the ray's origin.
+    pub width: f32,
+    /// Growth of the width per unit of distance (the spread angle, small).
+    pub spread: f32,
+}
+
+impl RayCone {
+    /// No cone: textures at full resolution.
+    pub const NONE: RayCone = RayCone {
+        width: 0.0,
+        spread: 0.0,
+    };
+
+    /// The cone of a camera ray through one pixel of `camera`.
+    #[inline]
+    pub fn through_pixel(camera: &CameraModel) -> RayCone {
+        RayCone {
+            width: 0.0,
+            spread: camera.pixel_spread_angle(),
+        }
+    }
+
+    /// The width `distance` along the ray.
+    #[inline]
+    pub fn width_at(&self, distance: f32) -> f32 {
+        self.width + self.spread * distance
+    }
+}
+
 pub struct PathTracer<'a> {
     pub scene: &'a Scene,
     /// At most this many scattering vertices between camera and light.
@@ -32,16 +72,22 @@ pub struct PathTracer<'a> {
     /// of RGB.
     pub spectral: bool,
     pub roulette: Roulette,
+    /// Whether camera samples carry ray cones (`RayCone`): textures filtered over the
+    /// pixel's footprint. Off, camera paths read textures at full resolution as the other
+    /// algorithms do.
+    pub texture_filtering: bool,
 }
 
 impl PathTracer<'_> {
-    /// Radiance arriving at `origin` from `direction` (unit length), as linear RGB. `rays`
-    /// counts traced rays.
+    /// Radiance arriving at `origin` from `direction` (unit length), as linear RGB, the
+    /// textures met filtered over `cone` (`RayCone::NONE`: full resolution). `rays` counts
+    /// traced rays.
     #[inline]
     pub fn radiance<S: Sampler>(
         &self,
         origin: Vec3A,
         direction: Vec3A,
+        mut cone: RayCone,
         rng: &mut S,
         rays: &mut u64,
     ) -> Spectrum {
@@ -89,7 +135,14 @@ impl PathTracer<'_> {
                 break;
             };
             let si = SurfaceInteraction::new(scene, &ray, &hit);
-            let bsdf = si.bsdf(scene, &channels);
+            let normal = si.geometric_normal;
+            let wo = -ray.direction;
+            let cos_o = wo.dot(normal);
+            // The cone's footprint on the surface: its width over the incidence cosine (the
+            // long axis of the ellipse it cuts). 0 without a cone (and 0/0 = NaN, grazing
+            // without a cone, reads full resolution too).
+            let cone_width = cone.width_at(hit.t);
+            let bsdf = si.filtered_bsdf(scene, cone_width / cos_o.abs(), &channels);
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
@@ -102,10 +155,7 @@ impl PathTracer<'_> {
                     &channels,
                 );
             }
-            let normal = si.geometric_normal;
-            let wo = -ray.direction;
             let p = si.p;
-            let cos_o = wo.dot(normal);
 
             // Emission from the front side.
             if si.light_area_pdf > 0.0 && cos_o > 0.0 && depth >= self.min_depth {
@@ -148,6 +198,14 @@ impl PathTracer<'_> {
             throughput *= sample.weight;
             previous_pdf = sample.pdf;
             previous_specular = sample.specular;
+            cone = if sample.specular {
+                RayCone {
+                    width: cone_width,
+                    ..cone
+                }
+            } else {
+                RayCone::NONE
+            };
             radiance_scale *= sample.radiance_scale;
             depth += 1;
 
@@ -238,6 +296,11 @@ impl PixelEstimator for PathTracer<'_> {
     ) -> Spectrum {
         let lens = sampler.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
-        self.radiance(origin, direction, sampler, &mut counters.rays)
+        let cone = if self.texture_filtering {
+            RayCone::through_pixel(camera)
+        } else {
+            RayCone::NONE
+        };
+        self.radiance(origin, direction, cone, sampler, &mut counters.rays)
     }
 }
