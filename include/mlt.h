@@ -1128,6 +1128,11 @@ typedef struct MltRenderSettings {
    * or glossy bounce). 0 or 1. Default 0.
    */
   uint32_t full_resolution_textures;
+  /**
+   * Unused (0): keeps this layout's size apart from the one before
+   * `full_resolution_textures`, which fills that one's tail padding.
+   */
+  uint32_t _reserved;
 } MltRenderSettings;
 
 /**

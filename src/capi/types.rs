@@ -603,6 +603,9 @@ pub struct MltRenderSettings {
     /// or glossy bounce). 0 or 1. Default 0.
     pub full_resolution_textures: u32,
     // END GENERATED render settings
+    /// Unused (0): keeps this layout's size apart from the one before
+    /// `full_resolution_textures`, which fills that one's tail padding.
+    pub _reserved: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.
