@@ -304,3 +304,91 @@ impl PixelEstimator for PathTracer<'_> {
         self.radiance(origin, direction, cone, sampler, &mut counters.rays)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Backend, Ray};
+    use crate::scene::{Camera, Material, SceneDesc};
+    use crate::texture::{TexelData, TextureDesc, TextureEncoding, TextureRef};
+    use std::borrow::Cow;
+
+    /// The level of detail a camera ray's cone gives a textured plane equals the analytic
+    /// one. A pinhole h = 1 above a 2 × 2 quad in y = 0 whose texture coordinates run over
+    /// it once (0.5 units of texture coordinate per unit of length) and a 1024 × 1024
+    /// texture stretched by `KHR_texture_transform`'s scale (4, 1): a ray meeting the plane
+    /// at angle θ from its normal travels t = h / cos θ, its cone is spread · t wide there
+    /// and its footprint on the plane spread · h / cos² θ, which is
+    /// spread · h / cos² θ · 0.5 · √(4 · 1) · 1024 texels wide.
+    #[test]
+    fn a_plane_at_a_known_distance_and_angle_gets_the_analytic_level_of_detail() {
+        let positions = [
+            -1.0, 0.0, -1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 1.0,
+        ];
+        let texcoords = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+        let texels = vec![0u8; 1024 * 1024];
+        let texture = TextureDesc {
+            width: 1024,
+            height: 1024,
+            channels: 1,
+            data: TexelData::U8(Cow::Owned(texels)),
+            encoding: TextureEncoding::Linear,
+            wrap_u: Default::default(),
+            wrap_v: Default::default(),
+            filter: Default::default(),
+        };
+        let reference = TextureRef {
+            scale: [4.0, 1.0],
+            ..TextureRef::new(0)
+        };
+        let materials = [Material {
+            base_color_texture: Some(reference),
+            ..Material::diffuse([0.5; 3])
+        }];
+        let scene = Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &[0, 2, 1, 0, 3, 2],
+            materials: &materials,
+            texcoords: &texcoords,
+            textures: std::slice::from_ref(&texture),
+            backend: Backend::Bvh,
+            ..Default::default()
+        })
+        .unwrap();
+        let (height, size) = (1.0f32, 64);
+        let camera = Camera {
+            eye: [0.0, height, 0.0],
+            target: [0.0, 0.0, 0.0],
+            up: [0.0, 0.0, -1.0],
+            fov_y_deg: 60.0,
+            ..Default::default()
+        }
+        .model(size, size);
+        let spread = 2.0 * (30.0f32).to_radians().tan() / size as f32;
+        let cone = RayCone::through_pixel(&camera);
+        assert!((cone.spread - spread).abs() < 1e-7);
+        for theta_degrees in [0.0f32, 10.0, 20.0] {
+            let theta = theta_degrees.to_radians();
+            let direction = Vec3A::new(theta.sin(), -theta.cos(), 0.0);
+            let ray = Ray::new(camera.eye, direction, 0.0, f32::INFINITY);
+            let hit = scene.closest_hit(&ray).unwrap();
+            let si = SurfaceInteraction::new(&scene, &ray, &hit);
+            // As the path tracer measures it.
+            let footprint = cone.width_at(hit.t) / (-direction).dot(si.geometric_normal).abs();
+            let point = crate::scene::surface::SurfacePoint {
+                footprint,
+                ..scene.surface_point(hit.triangle, si.uv)
+            };
+            let analytic =
+                (spread * height / theta.cos().powi(2) * 0.5 * 4.0f32.sqrt() * 1024.0).log2();
+            let level = point.level_of_detail(&reference);
+            assert!(
+                (level - analytic).abs() < 1e-4,
+                "θ = {theta_degrees}°: level {level}, analytic {analytic}"
+            );
+        }
+        // Without a cone, the image itself.
+        let point = scene.surface_point(0, [0.2, 0.3]);
+        assert_eq!(point.level_of_detail(&reference), f32::NEG_INFINITY);
+    }
+}

@@ -251,13 +251,19 @@ fn lookup(textures: &[Texture], texture: &TextureRef, uv: [f32; 2], footprint: f
     ];
     let image = &textures[texture.texture as usize];
     if footprint > 0.0 {
-        // The transform scales areas by |scale_u · scale_v| (a rotation keeps them).
-        let [scale_u, scale_v] = texture.scale;
-        let texels = footprint * (scale_u * scale_v).abs().sqrt() * image.texels_per_unit();
-        Vec4::from_array(image.sample_filtered(uv, texels.log2()))
+        Vec4::from_array(image.sample_filtered(uv, level_of_detail(image, texture, footprint)))
     } else {
         Vec4::from_array(image.sample(uv))
     }
+}
+
+/// The mip level of detail of a footprint `footprint` texture coordinates wide (before the
+/// transform): log2 of its width in the image's texels.
+#[inline]
+fn level_of_detail(image: &Texture, texture: &TextureRef, footprint: f32) -> f32 {
+    // The transform scales areas by |scale_u · scale_v| (a rotation keeps them).
+    let [scale_u, scale_v] = texture.scale;
+    (footprint * (scale_u * scale_v).abs().sqrt() * image.texels_per_unit()).log2()
 }
 
 /// A material's constant colour and emission with their spectral fits, made once per scene.
@@ -308,6 +314,17 @@ impl SurfacePoint<'_> {
             0.0
         };
         lookup(self.textures, texture, uv, footprint)
+    }
+
+    /// The mip level of detail texture `texture` is read at for the BSDF here (−∞ without a
+    /// footprint: the image itself).
+    #[cfg(test)]
+    pub fn level_of_detail(&self, texture: &TextureRef) -> f32 {
+        let footprint = self.footprint
+            * self
+                .attributes
+                .texcoord_density(texture.texcoord, self.triangle);
+        level_of_detail(&self.textures[texture.texture as usize], texture, footprint)
     }
 
     /// Texture `texture` for the BSDF: filtered over the point's footprint.
