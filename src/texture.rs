@@ -418,8 +418,8 @@ impl Texture {
     /// blended linearly (trilinear filtering), the coarsest beyond the pyramid.
     #[inline]
     pub(crate) fn sample_filtered(&self, uv: [f32; 2], level_of_detail: f32) -> [f32; 4] {
-        // NaN fails the comparison: level 0.
-        if !(level_of_detail > 0.0) {
+        // NaN is not above 0: level 0.
+        if level_of_detail.is_nan() || level_of_detail <= 0.0 {
             return self.sample(uv);
         }
         let last = self.levels.len() - 1;
