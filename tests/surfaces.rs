@@ -803,3 +803,28 @@ fn texture_filtering_removes_the_aliasing_of_a_distant_checker_and_keeps_its_mea
         4.0,
     );
 }
+
+/// Where textures are magnified (a texel wider than a pixel's footprint, as on the surfaces
+/// scene's floor and lamp at the size the algorithms are compared at) filtering reads level 0
+/// exactly as full resolution does: the path tracer's image is bit for bit the same, so the
+/// agreement tests above compare the algorithms on one expectation.
+#[test]
+fn filtering_leaves_magnified_textures_bit_identical() {
+    let scene = surfaces_mesh().scene(Backend::Bvh);
+    let render = |full_resolution_textures| {
+        render_image(
+            &scene,
+            &canonical_camera("cornell-box"),
+            &RenderSettings {
+                algorithm: Algorithm::Path,
+                width: SIZE,
+                height: SIZE,
+                max_depth: MAX_DEPTH,
+                samples_per_pixel: 4,
+                full_resolution_textures,
+                ..Default::default()
+            },
+        )
+    };
+    assert!(render(false) == render(true));
+}

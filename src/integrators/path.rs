@@ -27,8 +27,9 @@ pub struct Roulette {
 /// A ray cone (after Akenine-Möller et al., "Texture Level of Detail Strategies for
 /// Real-Time Ray Tracing"): a camera ray with the spread of its pixel, whose width at a hit
 /// is the footprint textures are filtered over there. A specular bounce keeps the cone
-/// (growing on from its width there: exact for flat mirrors and glass, which do not bend a
-/// cone's spread, a planar approximation for curved ones); the first diffuse or glossy
+/// (growing on from its width there with its spread: exact for flat mirrors, an
+/// approximation through refraction, which narrows or widens a cone, and off curved
+/// surfaces, which bend it); the first diffuse or glossy
 /// bounce ends it, and later vertices read textures at full resolution, as every other
 /// strategy does there (a wide lobe averages the texture itself).
 #[derive(Clone, Copy, Debug, PartialEq)]
