@@ -88,6 +88,24 @@ impl PathTracer<'_> {
         &self,
         origin: Vec3A,
         direction: Vec3A,
+        cone: RayCone,
+        rng: &mut S,
+        rays: &mut u64,
+    ) -> Spectrum {
+        // Two copies of the loop: paths without a cone pay nothing for cones.
+        if cone == RayCone::NONE {
+            self.trace::<S, false>(origin, direction, cone, rng, rays)
+        } else {
+            self.trace::<S, true>(origin, direction, cone, rng, rays)
+        }
+    }
+
+    /// `radiance`, `CONE` saying whether `cone` is not `RayCone::NONE`.
+    #[inline(always)]
+    fn trace<S: Sampler, const CONE: bool>(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
         mut cone: RayCone,
         rng: &mut S,
         rays: &mut u64,
@@ -143,7 +161,11 @@ impl PathTracer<'_> {
             // long axis of the ellipse it cuts). 0 without a cone (and 0/0 = NaN, grazing
             // without a cone, reads full resolution too).
             let cone_width = cone.width_at(hit.t);
-            let bsdf = si.filtered_bsdf(scene, cone_width / cos_o.abs(), &channels);
+            let bsdf = if CONE {
+                si.filtered_bsdf(scene, cone_width / cos_o.abs(), &channels)
+            } else {
+                si.bsdf(scene, &channels)
+            };
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
@@ -199,7 +221,9 @@ impl PathTracer<'_> {
             throughput *= sample.weight;
             previous_pdf = sample.pdf;
             previous_specular = sample.specular;
-            cone = if sample.specular {
+            cone = if !CONE {
+                RayCone::NONE
+            } else if sample.specular {
                 RayCone {
                     width: cone_width,
                     ..cone
@@ -297,7 +321,7 @@ impl PixelEstimator for PathTracer<'_> {
     ) -> Spectrum {
         let lens = sampler.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
-        let cone = if self.texture_filtering {
+        let cone = if self.texture_filtering && self.scene.has_textures() {
             RayCone::through_pixel(camera)
         } else {
             RayCone::NONE

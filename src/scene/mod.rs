@@ -550,6 +550,12 @@ impl Scene {
         self.medium_transmittance(Some(triangle), to, light.wi, distance, channels)
     }
 
+    /// Whether the scene has textures (what a ray cone could filter).
+    #[inline]
+    pub(crate) fn has_textures(&self) -> bool {
+        !self.textures.is_empty()
+    }
+
     /// Whether some material encloses an absorbing volume (see `transmittance`).
     #[inline]
     pub(crate) fn has_media(&self) -> bool {
