@@ -169,6 +169,8 @@ void check_settings() {
     show("c++", "roulette_start_depth", cpp.roulette_start_depth);
     show("c", "roulette_max_survival", c.roulette_max_survival);
     show("c++", "roulette_max_survival", cpp.roulette_max_survival);
+    show("c", "full_resolution_textures", c.full_resolution_textures);
+    show("c++", "full_resolution_textures", cpp.full_resolution_textures);
     {
         mlt::RenderSettings s;
         s.width = 0;

@@ -416,6 +416,18 @@ typedef enum MltStatus {
 typedef struct MltScene MltScene;
 
 /**
+ * A ray cone (after Akenine-Möller et al., "Texture Level of Detail Strategies for
+ * Real-Time Ray Tracing"): a camera ray with the spread of its pixel, whose width at a hit
+ * is the footprint textures are filtered over there. A specular bounce keeps the cone
+ * (growing on from its width there with its spread: exact for flat mirrors, an
+ * approximation through refraction, which narrows or widens a cone, and off curved
+ * surfaces, which bend it); the first diffuse or glossy
+ * bounce ends it, and later vertices read textures at full resolution, as every other
+ * strategy does there (a wide lobe averages the texture itself).
+ */
+typedef struct RayCone RayCone;
+
+/**
  * A material's use of a texture: which one, and glTF's `KHR_texture_transform` applied to
  * the surface's texture coordinates before the lookup (scale, then rotate, then offset).
  * Plain data inside `MltMaterial` (it has no `struct_size` of its own); the material's
@@ -1166,6 +1178,17 @@ typedef struct MltRenderSettings {
    * on. It must be in (0, 1]. Default 0.95.
    */
   float roulette_max_survival;
+  /**
+   * Path tracing: read textures at full resolution, as the other algorithms do (by default
+   * camera paths filter them over the pixel's footprint, mip-mapped, until their first diffuse
+   * or glossy bounce). 0 or 1. Default 0.
+   */
+  uint32_t full_resolution_textures;
+  /**
+   * Unused (0): keeps this layout's size apart from the one before
+   * `full_resolution_textures`, which fills that one's tail padding.
+   */
+  uint32_t _reserved;
 } MltRenderSettings;
 
 /**
@@ -1352,6 +1375,8 @@ typedef struct MltBytes {
   uint8_t *data;
   size_t size;
 } MltBytes;
+
+
 
 
 

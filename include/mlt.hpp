@@ -1093,6 +1093,10 @@ struct RenderSettings {
     /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
     /// on.
     float roulette_max_survival = 0.95f;
+    /// Path tracing: read textures at full resolution, as the other algorithms do (by default
+    /// camera paths filter them over the pixel's footprint, mip-mapped, until their first diffuse
+    /// or glossy bounce).
+    bool full_resolution_textures = false;
     // END GENERATED settings members
 
     /// The C struct: mlt_render_settings_default, then every field of this struct.
@@ -1126,6 +1130,7 @@ struct RenderSettings {
         c.spectral = spectral ? 1u : 0u;
         c.roulette_start_depth = roulette_start_depth;
         c.roulette_max_survival = roulette_max_survival;
+        c.full_resolution_textures = full_resolution_textures ? 1u : 0u;
         // END GENERATED settings to C
         return c;
     }
@@ -1158,6 +1163,7 @@ struct RenderSettings {
         s.spectral = c.spectral != 0;
         s.roulette_start_depth = c.roulette_start_depth;
         s.roulette_max_survival = c.roulette_max_survival;
+        s.full_resolution_textures = c.full_resolution_textures != 0;
         // END GENERATED settings from C
         return s;
     }

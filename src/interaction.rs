@@ -46,10 +46,17 @@ impl SurfaceInteraction {
         }
     }
 
-    /// The surface's BSDF here, its colours in `channels`.
+    /// The surface's BSDF here, its colours in `channels`, its textures at full resolution.
     #[inline]
     pub fn bsdf(&self, scene: &Scene, channels: &Channels) -> Bsdf {
-        scene.bsdf_at(self.triangle, self.uv, channels)
+        scene.bsdf_at(self.triangle, self.uv, 0.0, channels)
+    }
+
+    /// The surface's BSDF here with its textures filtered over a ray footprint `footprint`
+    /// wide in space (0: full resolution, as `bsdf`).
+    #[inline]
+    pub fn filtered_bsdf(&self, scene: &Scene, footprint: f32, channels: &Channels) -> Bsdf {
+        scene.bsdf_at(self.triangle, self.uv, footprint, channels)
     }
 
     /// Radiance the surface emits from its front side (its material's emission; only
@@ -70,7 +77,7 @@ pub(crate) fn vertex_bsdf(
     barycentrics: [f32; 2],
     channels: &Channels,
 ) -> Bsdf {
-    scene.bsdf_at(triangle, barycentrics, channels)
+    scene.bsdf_at(triangle, barycentrics, 0.0, channels)
 }
 
 #[cfg(test)]

@@ -115,25 +115,43 @@ impl TextureDesc<'_> {
     }
 }
 
-/// The texels, kept at the host's precision: an 8-bit texture takes a quarter of the
-/// memory floats would.
+/// The texels of one level, kept at the host's precision: an 8-bit texture takes a quarter
+/// of the memory floats would, at every level.
 #[derive(Clone, Debug)]
 enum Texels {
-    U8 {
-        values: Box<[u8]>,
-        /// Decodes the colour channels: the sRGB table or the linear one.
-        colour_table: &'static [f32; 256],
-    },
+    U8(Box<[u8]>),
     F32(Box<[f32]>),
 }
 
-/// A validated texture, sampled by the kernel.
+/// One level of a texture's mip pyramid: the host's image (level 0) or a reduction of it.
 #[derive(Clone, Debug)]
-pub(crate) struct Texture {
+struct Level {
     width: u32,
     height: u32,
-    channels: u32,
     texels: Texels,
+}
+
+/// A validated texture, sampled by the kernel: the host's image and its mip pyramid.
+///
+/// Level k + 1 is level k reduced to max(1, ⌊side / 2⌋) texels per side by an exact box
+/// filter: each new texel averages the old texels its area covers, weighted by the covered
+/// fraction (2 × 2 texels of ¼ for even sides; along an odd side, 3 texels partly), so every
+/// level keeps the image's mean. The boxes
+/// lie inside the image, so the reduction never reads across an edge: the wrap modes apply at
+/// lookup, at every level alike. Colours are averaged as linear values (sRGB bytes decoded
+/// first) and stored back in the level 0's encoding, each value the byte whose decoded value
+/// is nearest; the next level is reduced from the unrounded values, so rounding does not
+/// accumulate down the pyramid. A square power-of-two texture grows by a third.
+#[derive(Clone, Debug)]
+pub(crate) struct Texture {
+    channels: u32,
+    /// Level 0 first; down to 1 × 1.
+    levels: Box<[Level]>,
+    /// Decodes the colour channels of 8-bit levels: the sRGB table or the linear one.
+    colour_table: &'static [f32; 256],
+    /// √(width × height) of level 0: texels per unit of texture coordinate, on average over
+    /// the two axes (what an isotropic footprint is measured in).
+    texels_per_unit: f32,
     wrap_u: WrapMode,
     wrap_v: WrapMode,
     filter: TextureFilter,
@@ -168,8 +186,99 @@ fn srgb_u8_table() -> &'static [f32; 256] {
     })
 }
 
+/// The byte whose value in `table` (increasing) is nearest to `linear`.
+fn nearest_byte(table: &[f32; 256], linear: f32) -> u8 {
+    let above = table.partition_point(|&v| v < linear);
+    if above == 0 {
+        return 0;
+    }
+    if above == 256 {
+        return 255;
+    }
+    if linear - table[above - 1] <= table[above] - linear {
+        (above - 1) as u8
+    } else {
+        above as u8
+    }
+}
+
+/// Allocates `len` zeros, reporting an allocation failure instead of aborting.
+fn try_zeroed<T: Copy + Default>(len: usize, name: &str) -> Result<Vec<T>> {
+    let mut values = Vec::new();
+    values.try_reserve_exact(len).map_err(|_| {
+        Error::new(
+            MLT_STATUS_OUT_OF_MEMORY,
+            format!("could not allocate the mip levels of {name}"),
+        )
+    })?;
+    values.resize(len, T::default());
+    Ok(values)
+}
+
+/// The weights of an exact box reduction of `from` texels to `to` (⌊from / 2⌋, or 1): for
+/// each new texel, its first old texel and the weights of up to 3 old texels (summing to 1).
+fn box_weights(from: u32, to: u32) -> impl Iterator<Item = (usize, [f32; 3])> {
+    // New texel j covers old texels [j·from/to, (j+1)·from/to), a stretch of from/to ≥ 2
+    // (below 3) old texels; in units of 1/to of an old texel, [j·from, (j+1)·from).
+    let (from, to) = (from as u64, to as u64);
+    (0..to).map(move |j| {
+        let (start, end) = (j * from, (j + 1) * from);
+        let first = start / to;
+        let mut weights = [0.0f32; 3];
+        for (k, weight) in weights.iter_mut().enumerate() {
+            let (texel_start, texel_end) = ((first + k as u64) * to, (first + k as u64 + 1) * to);
+            let overlap = end.min(texel_end).saturating_sub(start.max(texel_start));
+            *weight = overlap as f32 / from as f32;
+        }
+        (first as usize, weights)
+    })
+}
+
+/// Level `values` (`width` × `height` texels of `channels` linear values) reduced to the
+/// next level's size, returned with it.
+fn reduce(
+    values: &[f32],
+    width: u32,
+    height: u32,
+    channels: usize,
+    name: &str,
+) -> Result<(Vec<f32>, u32, u32)> {
+    let (new_width, new_height) = ((width / 2).max(1), (height / 2).max(1));
+    // Along rows first, then along columns.
+    let mut rows = try_zeroed::<f32>(new_width as usize * height as usize * channels, name)?;
+    for row in 0..height as usize {
+        let source = &values[row * width as usize * channels..][..width as usize * channels];
+        let target =
+            &mut rows[row * new_width as usize * channels..][..new_width as usize * channels];
+        for (j, (first, weights)) in box_weights(width, new_width).enumerate() {
+            for (k, weight) in weights.into_iter().enumerate() {
+                if weight > 0.0 {
+                    for c in 0..channels {
+                        target[j * channels + c] += weight * source[(first + k) * channels + c];
+                    }
+                }
+            }
+        }
+    }
+    let row_len = new_width as usize * channels;
+    let mut reduced = try_zeroed::<f32>(row_len * new_height as usize, name)?;
+    for (j, (first, weights)) in box_weights(height, new_height).enumerate() {
+        let target = &mut reduced[j * row_len..][..row_len];
+        for (k, weight) in weights.into_iter().enumerate() {
+            if weight > 0.0 {
+                let source = &rows[(first + k) * row_len..][..row_len];
+                for (t, s) in target.iter_mut().zip(source) {
+                    *t += weight * s;
+                }
+            }
+        }
+    }
+    Ok((reduced, new_width, new_height))
+}
+
 impl Texture {
-    /// Validates `desc` (reported as `desc.textures[index]`) and copies its texels.
+    /// Validates `desc` (reported as `desc.textures[index]`), copies its texels and builds
+    /// the mip pyramid.
     pub(crate) fn new(desc: &TextureDesc, index: usize) -> Result<Texture> {
         let name = format!("desc.textures[{index}]");
         let (width, height, channels) = (desc.width, desc.height, desc.channels);
@@ -183,14 +292,12 @@ impl Texture {
                 "{name}.data has {length} {kind}, but {width} x {height} texels of {channels} channels need {expected}"
             )));
         }
+        let colour_table = match desc.encoding {
+            TextureEncoding::Srgb => srgb_u8_table(),
+            TextureEncoding::Linear => &LINEAR_U8_TO_F32,
+        };
         let texels = match &desc.data {
-            TexelData::U8(values) => Texels::U8 {
-                values: copy_texels(values.as_ref(), &name)?,
-                colour_table: match desc.encoding {
-                    TextureEncoding::Srgb => srgb_u8_table(),
-                    TextureEncoding::Linear => &LINEAR_U8_TO_F32,
-                },
-            },
+            TexelData::U8(values) => Texels::U8(copy_texels(values.as_ref(), &name)?),
             TexelData::F32(values) => {
                 if desc.encoding == TextureEncoding::Srgb {
                     return Err(Error::invalid(format!(
@@ -211,28 +318,136 @@ impl Texture {
                 Texels::F32(copy_texels(values.as_ref(), &name)?)
             }
         };
-        Ok(Texture {
-            width,
-            height,
+        let mut texture = Texture {
             channels,
-            texels,
+            levels: Box::new([Level {
+                width,
+                height,
+                texels,
+            }]),
+            colour_table,
+            texels_per_unit: ((width as f64 * height as f64).sqrt()) as f32,
             wrap_u: desc.wrap_u,
             wrap_v: desc.wrap_v,
             filter: desc.filter,
-        })
+        };
+        texture.levels = texture.pyramid(&name)?;
+        Ok(texture)
     }
 
-    /// The linear RGBA value at `uv`: grey g reads (g, g, g, 1), grey + alpha (g, g, g, a),
-    /// RGB (r, g, b, 1). A non-finite coordinate reads as 0 (so NaN from a degenerate hit
-    /// gives a texel of the image, never a panic); one beyond ±1e30 as ±1e30.
+    /// Level 0 and its reductions down to 1 × 1 (see [`Texture`]).
+    fn pyramid(&self, name: &str) -> Result<Box<[Level]>> {
+        let level0 = &self.levels[0];
+        let channels = self.channels as usize;
+        let (mut width, mut height) = (level0.width, level0.height);
+        let mut levels = vec![level0.clone()];
+        if width == 1 && height == 1 {
+            return Ok(levels.into_boxed_slice());
+        }
+        // The linear values of the level being reduced, unrounded.
+        let mut linear = try_zeroed::<f32>(width as usize * height as usize * channels, name)?;
+        for (i, value) in linear.iter_mut().enumerate() {
+            *value = self.value(0, i);
+        }
+        while width > 1 || height > 1 {
+            let (reduced, new_width, new_height) = reduce(&linear, width, height, channels, name)?;
+            let texels = match level0.texels {
+                Texels::F32(_) => Texels::F32(reduced.clone().into_boxed_slice()),
+                Texels::U8(_) => {
+                    let mut bytes = try_zeroed::<u8>(reduced.len(), name)?;
+                    for (i, (byte, &value)) in bytes.iter_mut().zip(&reduced).enumerate() {
+                        *byte = nearest_byte(self.table_of(i % channels), value);
+                    }
+                    Texels::U8(bytes.into_boxed_slice())
+                }
+            };
+            levels.push(Level {
+                width: new_width,
+                height: new_height,
+                texels,
+            });
+            (linear, width, height) = (reduced, new_width, new_height);
+        }
+        Ok(levels.into_boxed_slice())
+    }
+
+    /// The table decoding 8-bit channel `channel` (of the texture's own channels): alpha
+    /// (the last of 2 or 4) is always linear.
+    #[inline]
+    fn table_of(&self, channel: usize) -> &'static [f32; 256] {
+        let channels = self.channels as usize;
+        if channels.is_multiple_of(2) && channel == channels - 1 {
+            &LINEAR_U8_TO_F32
+        } else {
+            self.colour_table
+        }
+    }
+
+    /// The linear value of the `i`-th stored value (texel i / channels, channel i % channels)
+    /// of level `level`.
+    #[inline]
+    fn value(&self, level: usize, i: usize) -> f32 {
+        match &self.levels[level].texels {
+            Texels::U8(bytes) => self.table_of(i % self.channels as usize)[bytes[i] as usize],
+            Texels::F32(floats) => floats[i],
+        }
+    }
+
+    /// Levels in the pyramid (1 for a 1 × 1 texture).
+    pub(crate) fn level_count(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// √(width × height) of the image: texels per unit of texture coordinate.
+    #[inline]
+    pub(crate) fn texels_per_unit(&self) -> f32 {
+        self.texels_per_unit
+    }
+
+    /// The linear RGBA value at `uv` of the image itself (level 0): grey g reads (g, g, g,
+    /// 1), grey + alpha (g, g, g, a), RGB (r, g, b, 1). A non-finite coordinate reads as 0
+    /// (so NaN from a degenerate hit gives a texel of the image, never a panic); one beyond
+    /// ±1e30 as ±1e30.
+    #[inline]
     pub(crate) fn sample(&self, uv: [f32; 2]) -> [f32; 4] {
+        self.sample_level(0, uv)
+    }
+
+    /// The value at `uv` for a footprint `level_of_detail` = log2(the footprint's width in
+    /// level-0 texels): level 0 at or below 0 (and for NaN), else the two levels around it
+    /// blended linearly (trilinear filtering), the coarsest beyond the pyramid.
+    #[inline]
+    pub(crate) fn sample_filtered(&self, uv: [f32; 2], level_of_detail: f32) -> [f32; 4] {
+        // NaN is not above 0: level 0.
+        if level_of_detail.is_nan() || level_of_detail <= 0.0 {
+            return self.sample(uv);
+        }
+        let last = self.levels.len() - 1;
+        let level_of_detail = level_of_detail.min(last as f32);
+        let finer = level_of_detail.floor();
+        let blend = level_of_detail - finer;
+        let finer = finer as usize;
+        let fine = self.sample_level(finer, uv);
+        if blend == 0.0 || finer == last {
+            return fine;
+        }
+        lerp4(fine, self.sample_level(finer + 1, uv), blend)
+    }
+
+    /// The linear RGBA value at `uv` of level `level`.
+    fn sample_level(&self, level: usize, uv: [f32; 2]) -> [f32; 4] {
         let [u, v] = uv.map(sanitize_coordinate);
-        let (width, height) = (self.width as f32, self.height as f32);
+        let Level {
+            width: level_width,
+            height: level_height,
+            ..
+        } = self.levels[level];
+        let (width, height) = (level_width as f32, level_height as f32);
         match self.filter {
             TextureFilter::Nearest => {
-                let column = wrap(self.wrap_u, (u * width).floor() as i64, self.width);
-                let row = wrap(self.wrap_v, (v * height).floor() as i64, self.height);
-                self.texel(column, row)
+                let column = wrap(self.wrap_u, (u * width).floor() as i64, level_width);
+                let row = wrap(self.wrap_v, (v * height).floor() as i64, level_height);
+                self.texel(level, column, row)
             }
             TextureFilter::Bilinear => {
                 // Texel centres sit at half-integers: shift them onto the integers.
@@ -243,21 +458,21 @@ impl Texture {
                 // `as` saturates; the +1 must too, for coordinates near the i64 limits.
                 let (x0, y0) = (x0 as i64, y0 as i64);
                 let columns = [
-                    wrap(self.wrap_u, x0, self.width),
-                    wrap(self.wrap_u, x0.saturating_add(1), self.width),
+                    wrap(self.wrap_u, x0, level_width),
+                    wrap(self.wrap_u, x0.saturating_add(1), level_width),
                 ];
                 let rows = [
-                    wrap(self.wrap_v, y0, self.height),
-                    wrap(self.wrap_v, y0.saturating_add(1), self.height),
+                    wrap(self.wrap_v, y0, level_height),
+                    wrap(self.wrap_v, y0.saturating_add(1), level_height),
                 ];
                 let top = lerp4(
-                    self.texel(columns[0], rows[0]),
-                    self.texel(columns[1], rows[0]),
+                    self.texel(level, columns[0], rows[0]),
+                    self.texel(level, columns[1], rows[0]),
                     fx,
                 );
                 let bottom = lerp4(
-                    self.texel(columns[0], rows[1]),
-                    self.texel(columns[1], rows[1]),
+                    self.texel(level, columns[0], rows[1]),
+                    self.texel(level, columns[1], rows[1]),
                     fx,
                 );
                 lerp4(top, bottom, fy)
@@ -265,17 +480,15 @@ impl Texture {
         }
     }
 
-    /// The linear RGBA value of the texel in `column`, `row` (both in range).
+    /// The linear RGBA value of the texel in `column`, `row` (both in range) of `level`.
     #[inline]
-    fn texel(&self, column: u32, row: u32) -> [f32; 4] {
+    fn texel(&self, level: usize, column: u32, row: u32) -> [f32; 4] {
         let channels = self.channels as usize;
-        let start = (row as usize * self.width as usize + column as usize) * channels;
+        let Level { width, texels, .. } = &self.levels[level];
+        let start = (row as usize * *width as usize + column as usize) * channels;
         let mut values = [0.0; 4];
-        match &self.texels {
-            Texels::U8 {
-                values: bytes,
-                colour_table,
-            } => {
+        match texels {
+            Texels::U8(bytes) => {
                 let bytes = &bytes[start..start + channels];
                 // Grey + alpha and RGBA end with alpha, which is always linear.
                 let colour_channels = if channels.is_multiple_of(2) {
@@ -285,7 +498,7 @@ impl Texture {
                 };
                 for (c, &byte) in bytes.iter().enumerate() {
                     values[c] = if c < colour_channels {
-                        colour_table[byte as usize]
+                        self.colour_table[byte as usize]
                     } else {
                         LINEAR_U8_TO_F32[byte as usize]
                     };
@@ -477,7 +690,10 @@ mod tests {
             0,
         )
         .unwrap();
-        assert!(matches!(texture.texels, Texels::U8 { .. }), "kept as bytes");
+        assert!(
+            matches!(texture.levels[0].texels, Texels::U8(_)),
+            "kept as bytes"
+        );
         let at = |i: f32| texture.sample([(i + 0.5) / 4.0, 0.5]);
         assert_eq!(at(0.0), grey(0.0));
         assert_eq!(at(1.0), grey(1.0));
@@ -700,6 +916,164 @@ mod tests {
         )
         .unwrap();
         assert_eq!(texture.sample([1000.0 + 0.5 / 3.0, 0.5]), grey(10.0));
+    }
+
+    /// Deterministic pseudo-random bytes.
+    fn noise_bytes(count: usize, seed: u64) -> Vec<u8> {
+        let mut state = seed;
+        (0..count)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 56) as u8
+            })
+            .collect()
+    }
+
+    /// The mean linear value of each of the texture's channels at `level`.
+    fn level_mean(texture: &Texture, level: usize) -> Vec<f64> {
+        let channels = texture.channels as usize;
+        let Level { width, height, .. } = texture.levels[level];
+        let count = (width * height) as usize;
+        let mut sums = vec![0.0f64; channels];
+        for i in 0..count * channels {
+            sums[i % channels] += texture.value(level, i) as f64;
+        }
+        sums.iter().map(|s| s / count as f64).collect()
+    }
+
+    /// Every level keeps level 0's mean, up to rounding each texel to the nearest byte: at
+    /// most half the widest step between neighbouring decoded bytes (for sRGB, between 254
+    /// and 255: 0.0045; for linear bytes 0.5/255), and float rounding for float textures.
+    /// Odd sides (37 × 23) reduce to ⌊side / 2⌋ with exact box weights.
+    #[test]
+    fn every_level_keeps_the_mean() {
+        let srgb_step = (1..256)
+            .map(|i| srgb_u8_table()[i] - srgb_u8_table()[i - 1])
+            .fold(0.0f32, f32::max);
+        assert!((0.0085..0.0095).contains(&srgb_step), "{srgb_step}");
+        let bytes = noise_bytes(37 * 23 * 4, 1);
+        let floats: Vec<f32> = noise_bytes(37 * 23 * 3, 2)
+            .into_iter()
+            .map(|b| b as f32 * 0.37)
+            .collect();
+        let cases = [
+            (
+                TextureEncoding::Srgb,
+                4,
+                TexelData::U8(Cow::Borrowed(&bytes[..])),
+                srgb_step as f64 / 2.0,
+            ),
+            (
+                TextureEncoding::Linear,
+                2,
+                TexelData::U8(Cow::Borrowed(&bytes[..37 * 23 * 2])),
+                0.5 / 255.0,
+            ),
+            (
+                TextureEncoding::Linear,
+                3,
+                TexelData::F32(Cow::Borrowed(&floats[..])),
+                1e-4,
+            ),
+        ];
+        for (encoding, channels, data, bound) in cases {
+            let texture = Texture::new(
+                &TextureDesc {
+                    encoding,
+                    wrap_u: WrapMode::Repeat,
+                    ..desc(37, 23, channels, data)
+                },
+                0,
+            )
+            .unwrap();
+            let sizes: Vec<(u32, u32)> =
+                texture.levels.iter().map(|l| (l.width, l.height)).collect();
+            assert_eq!(sizes, [(37, 23), (18, 11), (9, 5), (4, 2), (2, 1), (1, 1)]);
+            let mean = level_mean(&texture, 0);
+            for level in 1..texture.level_count() {
+                let level_mean = level_mean(&texture, level);
+                for c in 0..channels as usize {
+                    let error = (level_mean[c] - mean[c]).abs();
+                    assert!(
+                        error <= bound,
+                        "{encoding:?} channel {c} level {level}: mean {} against {}",
+                        level_mean[c],
+                        mean[c]
+                    );
+                }
+            }
+        }
+    }
+
+    /// An odd side of 5 reduces to 2 texels covering 2.5 each: weights 0.4, 0.4, 0.2 and
+    /// 0.2, 0.4, 0.4; then to their mean, the image's.
+    #[test]
+    fn odd_sides_reduce_by_covered_fractions() {
+        let data = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let texture =
+            Texture::new(&desc(5, 1, 1, TexelData::F32(Cow::Borrowed(&data))), 0).unwrap();
+        assert_eq!(texture.level_count(), 3);
+        let level = |l: usize| -> Vec<f32> {
+            let n = texture.levels[l].width as usize;
+            (0..n).map(|i| texture.value(l, i)).collect()
+        };
+        let close = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
+        assert!(close(&level(1), &[1.8, 4.2]), "{:?}", level(1));
+        assert!(close(&level(2), &[3.0]), "{:?}", level(2));
+    }
+
+    /// sRGB texels average as light: black and white average to linear 0.5, stored as the
+    /// byte nearest to it (188: 0.503), not the encoded mean 128 (0.216). Alpha averages as
+    /// it is: 3 × 255 / 4 = 191.25 → 191.
+    #[test]
+    fn srgb_levels_average_in_linear_light() {
+        let data = [0, 0, 255, 255, 255, 255, 0, 255];
+        let texture = Texture::new(
+            &TextureDesc {
+                encoding: TextureEncoding::Srgb,
+                ..desc(2, 2, 2, TexelData::U8(Cow::Borrowed(&data)))
+            },
+            0,
+        )
+        .unwrap();
+        let Texels::U8(bytes) = &texture.levels[1].texels else {
+            panic!("kept as bytes");
+        };
+        assert_eq!(bytes[..], [188, 191]);
+    }
+
+    /// Trilinear lookups: level 0 itself at a level of detail of 0 or below (and NaN), the
+    /// 1 × 1 mean at the last level and beyond, a linear blend between.
+    #[test]
+    fn filtered_lookups_blend_the_levels_around_the_level_of_detail() {
+        let data = [1.0, 2.0, 3.0, 6.0];
+        for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+            let texture = Texture::new(
+                &TextureDesc {
+                    filter,
+                    wrap_u: WrapMode::Repeat,
+                    wrap_v: WrapMode::MirroredRepeat,
+                    ..desc(2, 2, 1, TexelData::F32(Cow::Borrowed(&data)))
+                },
+                0,
+            )
+            .unwrap();
+            let uv = [0.3, 0.2];
+            for lod in [0.0, -3.0, f32::NAN, f32::NEG_INFINITY] {
+                assert_eq!(
+                    texture.sample_filtered(uv, lod),
+                    texture.sample(uv),
+                    "{filter:?}"
+                );
+            }
+            for lod in [1.0, 1.5, f32::INFINITY] {
+                assert_eq!(texture.sample_filtered(uv, lod), grey(3.0), "{filter:?}");
+            }
+            let half = texture.sample_filtered(uv, 0.5);
+            assert_close(half, grey((texture.sample(uv)[0] + 3.0) / 2.0), 1e-6);
+        }
     }
 
     #[test]

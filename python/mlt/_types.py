@@ -346,6 +346,10 @@ class RenderSettings:
     #: Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
     #: on.
     roulette_max_survival: float = 0.95
+    #: Path tracing: read textures at full resolution, as the other algorithms do (by default camera
+    #: paths filter them over the pixel's footprint, mip-mapped, until their first diffuse or glossy
+    #: bounce).
+    full_resolution_textures: bool = False
     # END GENERATED render settings
 
 

@@ -260,6 +260,7 @@ pub(super) fn render_settings(s: &MltRenderSettings) -> Result<RenderSettings> {
         spectral,
         roulette_start_depth,
         roulette_max_survival,
+        full_resolution_textures,
         // END GENERATED settings from C
     }
 }

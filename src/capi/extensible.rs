@@ -408,10 +408,12 @@ impl Extensible for MltRenderSettings {
     /// `struct_size`). `normalization_work_fraction`, added after the filter, fits the
     /// filter layout's tail padding, so that intermediate layout has today's size and is
     /// not told apart: a host passes the filter fields with it or not at all. Then the
-    /// settings before Russian roulette's.
+    /// settings before Russian roulette's, and before `full_resolution_textures` (which fills
+    /// the roulette layout's tail padding: `_reserved` makes today's size differ).
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltRenderSettings, filter_buffers),
         offset_of!(MltRenderSettings, roulette_start_depth),
+        offset_of!(MltRenderSettings, full_resolution_textures),
     ];
     fn defaults() -> Self {
         (&RenderSettings::default()).into()
@@ -426,6 +428,7 @@ impl From<&RenderSettings> for MltRenderSettings {
                 MltRenderSettings {
                     struct_size: size_of::<Self>() as u32,
                     $($name: d.$name.to_c(),)*
+                    _reserved: 0,
                 }
             };
         }
@@ -457,6 +460,7 @@ impl From<&RenderSettings> for MltRenderSettings {
             spectral,
             roulette_start_depth,
             roulette_max_survival,
+            full_resolution_textures,
             // END GENERATED settings to C
         }
     }
@@ -544,15 +548,15 @@ mod tests {
     /// `abbe_number`, 0.4's at `transmission_texture`), its scene description at `backend`; the one with lights but no surface attributes is 112 bytes,
     /// the one without the build quality 192; the scene info without the acceleration
     /// structure's facts 64; the settings without the filter 104, without Russian roulette
-    /// 128.
+    /// 128, without `full_resolution_textures` 136.
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
         assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 520]);
         assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
-        // Before the filter, before Russian roulette, today.
-        assert_eq!(sizes::<MltRenderSettings>(), [104, 128, 136]);
+        // Before the filter, before Russian roulette, before full_resolution_textures, today.
+        assert_eq!(sizes::<MltRenderSettings>(), [104, 128, 136, 144]);
         assert_eq!(size_of::<MltTexture>(), 48);
         assert_eq!(size_of::<MltTextureRef>(), 24);
     }

@@ -635,7 +635,14 @@ pub struct MltRenderSettings {
     /// Path tracing and PSSMLT: the highest probability with which Russian roulette lets a path go
     /// on. It must be in (0, 1]. Default 0.95.
     pub roulette_max_survival: f32,
+    /// Path tracing: read textures at full resolution, as the other algorithms do (by default
+    /// camera paths filter them over the pixel's footprint, mip-mapped, until their first diffuse
+    /// or glossy bounce). 0 or 1. Default 0.
+    pub full_resolution_textures: u32,
     // END GENERATED render settings
+    /// Unused (0): keeps this layout's size apart from the one before
+    /// `full_resolution_textures`, which fills that one's tail padding.
+    pub _reserved: u32,
 }
 
 /// What a render did (filled by `mlt_render_ex`). Initialize with `mlt_render_stats_default`.

@@ -1148,6 +1148,7 @@ mod tests {
                 min_depth: bounces,
                 spectral: false,
                 roulette: crate::render::RenderSettings::default().roulette(),
+                texture_filtering: false,
             };
             let mut rng = Rng::new(3, 5);
             let (mut sum, mut sum2) = (0.0f64, 0.0f64);
@@ -1155,7 +1156,13 @@ mod tests {
                 let (x, y) = (rng.uniform() * 16.0, rng.uniform() * 16.0);
                 let (origin, direction) = camera.generate_ray(x, y, rng.uniform2());
                 let value = path_tracer
-                    .radiance(origin, direction, &mut rng, &mut 0)
+                    .radiance(
+                        origin,
+                        direction,
+                        crate::integrators::path::RayCone::NONE,
+                        &mut rng,
+                        &mut 0,
+                    )
                     .luminance() as f64;
                 sum += value;
                 sum2 += value * value;

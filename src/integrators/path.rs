@@ -1,7 +1,9 @@
 //! Unidirectional path tracing: BSDF importance sampling, next-event estimation to every
 //! kind of light, multiple importance sampling (power heuristic) against BSDF sampling for
 //! the lights rays can hit (area lights, the environment, the sun's disc), and Russian
-//! roulette.
+//! roulette. Camera paths may carry a ray cone, the pixel's footprint, over which the
+//! textures of the surfaces they meet are filtered (mip-mapped) up to their first diffuse or
+//! glossy bounce.
 
 use super::{PixelEstimator, SampleCounters, light_shadow_ray, spawn_ray};
 use crate::bsdf::{Bsdf, TransportMode};
@@ -22,6 +24,45 @@ pub struct Roulette {
     pub max_survival: f32,
 }
 
+/// A ray cone (after Akenine-Möller et al., "Texture Level of Detail Strategies for
+/// Real-Time Ray Tracing"): a camera ray with the spread of its pixel, whose width at a hit
+/// is the footprint textures are filtered over there. A specular bounce keeps the cone
+/// (growing on from its width there with its spread: exact for flat mirrors, an
+/// approximation through refraction, which narrows or widens a cone, and off curved
+/// surfaces, which bend it); the first diffuse or glossy
+/// bounce ends it, and later vertices read textures at full resolution, as every other
+/// strategy does there (a wide lobe averages the texture itself).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayCone {
+    /// Width at the ray's origin.
+    pub width: f32,
+    /// Growth of the width per unit of distance (the spread angle, small).
+    pub spread: f32,
+}
+
+impl RayCone {
+    /// No cone: textures at full resolution.
+    pub const NONE: RayCone = RayCone {
+        width: 0.0,
+        spread: 0.0,
+    };
+
+    /// The cone of a camera ray through one pixel of `camera`.
+    #[inline]
+    pub fn through_pixel(camera: &CameraModel) -> RayCone {
+        RayCone {
+            width: 0.0,
+            spread: camera.pixel_spread_angle(),
+        }
+    }
+
+    /// The width `distance` along the ray.
+    #[inline]
+    pub fn width_at(&self, distance: f32) -> f32 {
+        self.width + self.spread * distance
+    }
+}
+
 pub struct PathTracer<'a> {
     pub scene: &'a Scene,
     /// At most this many scattering vertices between camera and light.
@@ -32,16 +73,40 @@ pub struct PathTracer<'a> {
     /// of RGB.
     pub spectral: bool,
     pub roulette: Roulette,
+    /// Whether camera samples carry ray cones (`RayCone`): textures filtered over the
+    /// pixel's footprint. Off, camera paths read textures at full resolution as the other
+    /// algorithms do.
+    pub texture_filtering: bool,
 }
 
 impl PathTracer<'_> {
-    /// Radiance arriving at `origin` from `direction` (unit length), as linear RGB. `rays`
-    /// counts traced rays.
+    /// Radiance arriving at `origin` from `direction` (unit length), as linear RGB, the
+    /// textures met filtered over `cone` (`RayCone::NONE`: full resolution). `rays` counts
+    /// traced rays.
     #[inline]
     pub fn radiance<S: Sampler>(
         &self,
         origin: Vec3A,
         direction: Vec3A,
+        cone: RayCone,
+        rng: &mut S,
+        rays: &mut u64,
+    ) -> Spectrum {
+        // Two copies of the loop: paths without a cone pay nothing for cones.
+        if cone == RayCone::NONE {
+            self.trace::<S, false>(origin, direction, cone, rng, rays)
+        } else {
+            self.trace::<S, true>(origin, direction, cone, rng, rays)
+        }
+    }
+
+    /// `radiance`, `CONE` saying whether `cone` is not `RayCone::NONE`.
+    #[inline(always)]
+    fn trace<S: Sampler, const CONE: bool>(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        mut cone: RayCone,
         rng: &mut S,
         rays: &mut u64,
     ) -> Spectrum {
@@ -89,7 +154,18 @@ impl PathTracer<'_> {
                 break;
             };
             let si = SurfaceInteraction::new(scene, &ray, &hit);
-            let bsdf = si.bsdf(scene, &channels);
+            let normal = si.geometric_normal;
+            let wo = -ray.direction;
+            let cos_o = wo.dot(normal);
+            // The cone's footprint on the surface: its width over the incidence cosine (the
+            // long axis of the ellipse it cuts). 0 without a cone (and 0/0 = NaN, grazing
+            // without a cone, reads full resolution too).
+            let cone_width = cone.width_at(hit.t);
+            let bsdf = if CONE {
+                si.filtered_bsdf(scene, cone_width / cos_o.abs(), &channels)
+            } else {
+                si.bsdf(scene, &channels)
+            };
             if bsdf.is_dispersive() {
                 channels.keep_hero_only();
             }
@@ -102,10 +178,7 @@ impl PathTracer<'_> {
                     &channels,
                 );
             }
-            let normal = si.geometric_normal;
-            let wo = -ray.direction;
             let p = si.p;
-            let cos_o = wo.dot(normal);
 
             // Emission from the front side.
             if si.light_area_pdf > 0.0 && cos_o > 0.0 && depth >= self.min_depth {
@@ -148,6 +221,16 @@ impl PathTracer<'_> {
             throughput *= sample.weight;
             previous_pdf = sample.pdf;
             previous_specular = sample.specular;
+            cone = if !CONE {
+                RayCone::NONE
+            } else if sample.specular {
+                RayCone {
+                    width: cone_width,
+                    ..cone
+                }
+            } else {
+                RayCone::NONE
+            };
             radiance_scale *= sample.radiance_scale;
             depth += 1;
 
@@ -238,6 +321,99 @@ impl PixelEstimator for PathTracer<'_> {
     ) -> Spectrum {
         let lens = sampler.uniform2();
         let (origin, direction) = camera.generate_ray(x, y, lens);
-        self.radiance(origin, direction, sampler, &mut counters.rays)
+        let cone = if self.texture_filtering && self.scene.has_textures() {
+            RayCone::through_pixel(camera)
+        } else {
+            RayCone::NONE
+        };
+        self.radiance(origin, direction, cone, sampler, &mut counters.rays)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Backend, Ray};
+    use crate::scene::{Camera, Material, SceneDesc};
+    use crate::texture::{TexelData, TextureDesc, TextureEncoding, TextureRef};
+    use std::borrow::Cow;
+
+    /// The level of detail a camera ray's cone gives a textured plane equals the analytic
+    /// one. A pinhole h = 1 above a 2 × 2 quad in y = 0 whose texture coordinates run over
+    /// it once (0.5 units of texture coordinate per unit of length) and a 1024 × 1024
+    /// texture stretched by `KHR_texture_transform`'s scale (4, 1): a ray meeting the plane
+    /// at angle θ from its normal travels t = h / cos θ, its cone is spread · t wide there
+    /// and its footprint on the plane spread · h / cos² θ, which is
+    /// spread · h / cos² θ · 0.5 · √(4 · 1) · 1024 texels wide.
+    #[test]
+    fn a_plane_at_a_known_distance_and_angle_gets_the_analytic_level_of_detail() {
+        let positions = [
+            -1.0, 0.0, -1.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0, -1.0, 0.0, 1.0,
+        ];
+        let texcoords = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0];
+        let texels = vec![0u8; 1024 * 1024];
+        let texture = TextureDesc {
+            width: 1024,
+            height: 1024,
+            channels: 1,
+            data: TexelData::U8(Cow::Owned(texels)),
+            encoding: TextureEncoding::Linear,
+            wrap_u: Default::default(),
+            wrap_v: Default::default(),
+            filter: Default::default(),
+        };
+        let reference = TextureRef {
+            scale: [4.0, 1.0],
+            ..TextureRef::new(0)
+        };
+        let materials = [Material {
+            base_color_texture: Some(reference),
+            ..Material::diffuse([0.5; 3])
+        }];
+        let scene = Scene::new(&SceneDesc {
+            positions: &positions,
+            indices: &[0, 2, 1, 0, 3, 2],
+            materials: &materials,
+            texcoords: &texcoords,
+            textures: std::slice::from_ref(&texture),
+            backend: Backend::Bvh,
+            ..Default::default()
+        })
+        .unwrap();
+        let (height, size) = (1.0f32, 64);
+        let camera = Camera {
+            eye: [0.0, height, 0.0],
+            target: [0.0, 0.0, 0.0],
+            up: [0.0, 0.0, -1.0],
+            fov_y_deg: 60.0,
+            ..Default::default()
+        }
+        .model(size, size);
+        let spread = 2.0 * (30.0f32).to_radians().tan() / size as f32;
+        let cone = RayCone::through_pixel(&camera);
+        assert!((cone.spread - spread).abs() < 1e-7);
+        for theta_degrees in [0.0f32, 10.0, 20.0] {
+            let theta = theta_degrees.to_radians();
+            let direction = Vec3A::new(theta.sin(), -theta.cos(), 0.0);
+            let ray = Ray::new(camera.eye, direction, 0.0, f32::INFINITY);
+            let hit = scene.closest_hit(&ray).unwrap();
+            let si = SurfaceInteraction::new(&scene, &ray, &hit);
+            // As the path tracer measures it.
+            let footprint = cone.width_at(hit.t) / (-direction).dot(si.geometric_normal).abs();
+            let point = crate::scene::surface::SurfacePoint {
+                footprint,
+                ..scene.surface_point(hit.triangle, si.uv)
+            };
+            let analytic =
+                (spread * height / theta.cos().powi(2) * 0.5 * 4.0f32.sqrt() * 1024.0).log2();
+            let level = point.level_of_detail(&reference);
+            assert!(
+                (level - analytic).abs() < 1e-4,
+                "θ = {theta_degrees}°: level {level}, analytic {analytic}"
+            );
+        }
+        // Without a cone, the image itself.
+        let point = scene.surface_point(0, [0.2, 0.3]);
+        assert_eq!(point.level_of_detail(&reference), f32::NEG_INFINITY);
     }
 }

@@ -360,6 +360,8 @@ fn with_estimator<R>(
             min_depth: 0,
             spectral: settings.spectral,
             roulette: settings.roulette(),
+            // The chains read textures at full resolution: so does their direct pass.
+            texture_filtering: false,
         });
     let min_depth = if direct.is_some() {
         DIRECT_PASS_DEPTHS
@@ -372,6 +374,8 @@ fn with_estimator<R>(
         min_depth,
         spectral: settings.spectral,
         roulette: settings.roulette(),
+        // Only `Algorithm::Path`'s camera samples carry cones; PSSMLT's do not.
+        texture_filtering: !settings.full_resolution_textures,
     };
     let bdpt = Bdpt {
         scene,

@@ -319,6 +319,17 @@ declare_parameters! {
             range: Range::above(0.0, 1.0),
             rule: |_| "it must be in (0, 1]".into(),
         },
+        /// Path tracing reads textures at full resolution, as the other algorithms do. By
+        /// default its camera paths filter the textures they meet over their pixel's
+        /// footprint (mip-mapped lookups at the level of detail of a ray cone; see
+        /// `integrators::path::RayCone`) until their first diffuse or glossy bounce, so that
+        /// a distant high-resolution texture does not alias; then its image converges to the
+        /// other algorithms' except where a texture has detail below a pixel, which it shows
+        /// averaged.
+        full_resolution_textures: bool = false => {
+            doc: "Path tracing: read textures at full resolution, as the other algorithms do (by default camera paths filter them over the pixel's footprint, mip-mapped, until their first diffuse or glossy bounce).",
+            flag: "full-resolution-textures",
+        },
     }
 }
 

@@ -185,6 +185,14 @@ impl CameraModel {
         Ok(())
     }
 
+    /// The angle a pixel spans seen from the lens (at the image's centre; its height on the
+    /// image plane at distance 1): the spread of the ray cone through a pixel. Rays from one
+    /// lens point through a pixel's area on the focal plane form that cone, thin lens or not.
+    #[inline]
+    pub fn pixel_spread_angle(&self) -> f32 {
+        2.0 * self.half_height / self.height as f32
+    }
+
     /// The primary ray through film position (x, y) in pixels, (0, 0) the top-left corner.
     /// `lens` is a point in the unit square used only by a thin lens. Returns (origin, unit direction).
     #[inline]

@@ -340,6 +340,7 @@ impl Scene {
             attributes.push(
                 &vertex_arrays,
                 [corners[0], corners[1], corners[2]],
+                cross.length(),
                 &tangents,
                 id,
             );
@@ -360,6 +361,7 @@ impl Scene {
                     colours: &material_colours[index],
                     triangle: light.triangle,
                     barycentrics,
+                    footprint: 0.0,
                 };
                 light.power_scale = surface::mean_emission_scale(point, light.emission);
             }
@@ -432,17 +434,23 @@ impl Scene {
     }
 
     /// The BSDF at barycentrics `barycentrics` of internal triangle `triangle`: its
-    /// material with textures and vertex colours applied, in the shading frame there.
+    /// material with textures and vertex colours applied, in the shading frame there; its
+    /// textures filtered over a ray footprint `footprint` wide in space (0: read at full
+    /// resolution; `SurfacePoint::footprint`).
     #[inline(always)]
     pub(crate) fn bsdf_at(
         &self,
         triangle: u32,
         barycentrics: [f32; 2],
+        footprint: f32,
         channels: &Channels,
     ) -> crate::bsdf::Bsdf {
         let normal = self.shading[triangle as usize].normal;
-        self.surface_point(triangle, barycentrics)
-            .bsdf(normal, channels)
+        surface::SurfacePoint {
+            footprint,
+            ..self.surface_point(triangle, barycentrics)
+        }
+        .bsdf(normal, channels)
     }
 
     /// The fraction of light that travels a path segment without being absorbed: the
@@ -540,6 +548,12 @@ impl Scene {
             (to, light.distance2.sqrt())
         };
         self.medium_transmittance(Some(triangle), to, light.wi, distance, channels)
+    }
+
+    /// Whether the scene has textures (what a ray cone could filter).
+    #[inline]
+    pub(crate) fn has_textures(&self) -> bool {
+        !self.textures.is_empty()
     }
 
     /// Whether some material encloses an absorbing volume (see `transmittance`).
@@ -690,6 +704,7 @@ impl Scene {
             colours: &self.material_colours[material],
             triangle,
             barycentrics,
+            footprint: 0.0,
         }
     }
 

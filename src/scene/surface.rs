@@ -93,6 +93,10 @@ pub(crate) struct SurfaceAttributes {
     normals: Vec<[Vec3A; 3]>,
     /// The texture coordinate sets 0 and 1 (`TextureRef::texcoord`).
     texcoords: [Vec<[[f32; 2]; 3]>; 2],
+    /// Per triangle, for each set: √(area in texture coordinates / area in space), the
+    /// texture coordinates' growth per unit of length across the triangle (on average over
+    /// its two axes): what turns a footprint's width in space into one in texture coordinates.
+    texcoord_density: [Vec<f32>; 2],
     colors: Vec<[Vec4; 3]>,
     /// xyz and the bitangent sign w, per corner: the host's, or MikkTSpace's where a
     /// material has a normal map (empty otherwise).
@@ -109,18 +113,24 @@ impl SurfaceAttributes {
                 Vec::with_capacity(capacity(arrays.texcoords)),
                 Vec::with_capacity(capacity(arrays.texcoords1)),
             ],
+            texcoord_density: [
+                Vec::with_capacity(capacity(arrays.texcoords)),
+                Vec::with_capacity(capacity(arrays.texcoords1)),
+            ],
             colors: Vec::with_capacity(capacity(arrays.colors)),
             tangents: Vec::new(),
         }
     }
 
-    /// Appends the next internal triangle, whose corners are vertices `corners`, and its
-    /// corner tangents if the scene has any (`tangents`: per corner of the host's
-    /// triangles; `id` is this one's host index).
+    /// Appends the next internal triangle, whose corners are vertices `corners` and whose
+    /// edges' cross product has length `double_area` (> 0), and its corner tangents if the
+    /// scene has any (`tangents`: per corner of the host's triangles; `id` is this one's
+    /// host index).
     pub fn push(
         &mut self,
         arrays: &VertexArrays,
         corners: [u32; 3],
+        double_area: f32,
         tangents: &[[f32; 4]],
         id: u32,
     ) {
@@ -135,16 +145,25 @@ impl SurfaceAttributes {
                 Vec3A::from_slice(&arrays.normals[i..i + 3]).normalize()
             }));
         }
-        for (set, values) in self
+        for ((set, density), values) in self
             .texcoords
             .iter_mut()
+            .zip(&mut self.texcoord_density)
             .zip([arrays.texcoords, arrays.texcoords1])
         {
             if !values.is_empty() {
-                set.push(corners.map(|c| {
+                let t = corners.map(|c| {
                     let i = c as usize * 2;
                     [values[i], values[i + 1]]
-                }));
+                });
+                let (e1, e2) = (
+                    [t[1][0] - t[0][0], t[1][1] - t[0][1]],
+                    [t[2][0] - t[0][0], t[2][1] - t[0][1]],
+                );
+                let double_texcoord_area =
+                    (e1[0] as f64 * e2[1] as f64 - e1[1] as f64 * e2[0] as f64).abs();
+                density.push((double_texcoord_area / double_area as f64).sqrt() as f32);
+                set.push(t);
             }
         }
         if !arrays.colors.is_empty() {
@@ -177,6 +196,15 @@ impl SurfaceAttributes {
             }
             None => [0.0; 2],
         }
+    }
+
+    /// Texture coordinate set `set`'s `texcoord_density` on `triangle` (0 without the set).
+    #[inline]
+    fn texcoord_density(&self, set: u32, triangle: u32) -> f32 {
+        self.texcoord_density[(set & 1) as usize]
+            .get(triangle as usize)
+            .copied()
+            .unwrap_or(0.0)
     }
 
     /// The interpolated tangent (xyz) and bitangent sign (w), if the scene has tangents.
@@ -215,15 +243,31 @@ impl SurfaceAttributes {
     }
 }
 
-/// The texel of `texture` at texture coordinates `uv` (its transform applied).
+/// The value of `texture` at texture coordinates `uv` (its transform applied), for a
+/// footprint `footprint` texture coordinates wide before the transform (0: the image itself,
+/// no filtering).
 #[inline]
-fn lookup(textures: &[Texture], texture: &TextureRef, uv: [f32; 2]) -> Vec4 {
+fn lookup(textures: &[Texture], texture: &TextureRef, uv: [f32; 2], footprint: f32) -> Vec4 {
     let [row_u, row_v] = texture.matrix();
     let uv = [
         row_u[0] * uv[0] + row_u[1] * uv[1] + row_u[2],
         row_v[0] * uv[0] + row_v[1] * uv[1] + row_v[2],
     ];
-    Vec4::from_array(textures[texture.texture as usize].sample(uv))
+    let image = &textures[texture.texture as usize];
+    if footprint > 0.0 {
+        Vec4::from_array(image.sample_filtered(uv, level_of_detail(image, texture, footprint)))
+    } else {
+        Vec4::from_array(image.sample(uv))
+    }
+}
+
+/// The mip level of detail of a footprint `footprint` texture coordinates wide (before the
+/// transform): log2 of its width in the image's texels.
+#[inline]
+fn level_of_detail(image: &Texture, texture: &TextureRef, footprint: f32) -> f32 {
+    // The transform scales areas by |scale_u · scale_v| (a rotation keeps them).
+    let [scale_u, scale_v] = texture.scale;
+    (footprint * (scale_u * scale_v).abs().sqrt() * image.texels_per_unit()).log2()
 }
 
 /// A material's constant colour and emission with their spectral fits, made once per scene.
@@ -250,34 +294,73 @@ pub(crate) struct SurfacePoint<'a> {
     pub colours: &'a MaterialColours,
     pub triangle: u32,
     pub barycentrics: [f32; 2],
+    /// The width in space of the ray footprint the BSDF's textures are filtered over (a ray
+    /// cone's width over the cosine of its incidence); 0: no filtering, every lookup reads
+    /// the image itself. Alpha and emission always read the image itself (`alpha`,
+    /// `emission`): the other strategies that reach the point do.
+    pub footprint: f32,
 }
 
 impl SurfacePoint<'_> {
-    /// Texture `texture` at this point, at the texture coordinate set it names.
+    /// Texture `texture` at this point, at the texture coordinate set it names, filtered
+    /// over `footprint` (a width in space; 0: the image itself).
     #[inline]
-    fn lookup(&self, texture: &TextureRef) -> Vec4 {
+    fn lookup_over(&self, texture: &TextureRef, footprint: f32) -> Vec4 {
         let uv = self
             .attributes
             .texcoord(texture.texcoord, self.triangle, self.barycentrics);
-        lookup(self.textures, texture, uv)
+        let footprint = if footprint > 0.0 {
+            footprint
+                * self
+                    .attributes
+                    .texcoord_density(texture.texcoord, self.triangle)
+        } else {
+            0.0
+        };
+        lookup(self.textures, texture, uv, footprint)
     }
 
-    /// The base colour (RGB) and alpha: factors × vertex colour × base colour texture.
+    /// The mip level of detail texture `texture` is read at for the BSDF here (−∞ without a
+    /// footprint: the image itself).
+    #[cfg(test)]
+    pub fn level_of_detail(&self, texture: &TextureRef) -> f32 {
+        let footprint = self.footprint
+            * self
+                .attributes
+                .texcoord_density(texture.texcoord, self.triangle);
+        level_of_detail(&self.textures[texture.texture as usize], texture, footprint)
+    }
+
+    /// Texture `texture` for the BSDF: filtered over the point's footprint.
     #[inline]
-    fn base_color(&self) -> Vec4 {
+    fn lookup(&self, texture: &TextureRef) -> Vec4 {
+        self.lookup_over(texture, self.footprint)
+    }
+
+    /// Texture `texture` at full resolution, whatever the footprint.
+    #[inline]
+    fn lookup_image(&self, texture: &TextureRef) -> Vec4 {
+        self.lookup_over(texture, 0.0)
+    }
+
+    /// The base colour (RGB) and alpha: factors × vertex colour × base colour texture
+    /// (filtered over `footprint`).
+    #[inline]
+    fn base_color(&self, footprint: f32) -> Vec4 {
         let m = self.material;
         let mut color = Vec4::new(m.color[0], m.color[1], m.color[2], m.alpha)
             * self.attributes.color(self.triangle, self.barycentrics);
         if let Some(texture) = &m.base_color_texture {
-            color *= self.lookup(texture);
+            color *= self.lookup_over(texture, footprint);
         }
         color
     }
 
-    /// The coverage `AlphaMode::Mask` tests against the cutoff.
+    /// The coverage `AlphaMode::Mask` tests against the cutoff, at full resolution (ray
+    /// queries test it, whatever path they belong to).
     #[inline]
     pub fn alpha(&self) -> f32 {
-        self.base_color().w
+        self.base_color(0.0).w
     }
 
     /// Emitted radiance: the emission factor × the emission texture.
@@ -287,7 +370,7 @@ impl SurfacePoint<'_> {
         let Some(texture) = &m.emission_texture else {
             return channels.fitted_illuminant(&self.colours.emission);
         };
-        let texel = self.lookup(texture);
+        let texel = self.lookup_image(texture);
         channels.illuminant([
             m.emission[0] * texel.x,
             m.emission[1] * texel.y,
@@ -480,7 +563,7 @@ impl SurfacePoint<'_> {
             return Bsdf::new(model, geometric_normal, geometric_normal)
                 .with_dispersion(dispersive);
         }
-        let base = self.base_color();
+        let base = self.base_color(self.footprint);
         let color = channels.reflectance([base.x, base.y, base.z]);
         let m = self.material;
         let (mut metallic, mut roughness) = (m.metallic, m.roughness);

@@ -9,7 +9,7 @@ use crate::integrators::PathVertex;
 use crate::integrators::bdpt::{
     Bdpt, BdptScratch, CAMERA_STREAM, CONNECTION_STREAM, Contribution, STREAMS,
 };
-use crate::integrators::path::PathTracer;
+use crate::integrators::path::{PathTracer, RayCone};
 use crate::integrators::{PixelEstimator, SampleCounters};
 use crate::sampling::Sampler;
 use crate::scene::CameraModel;
@@ -110,7 +110,12 @@ fn trace_path(
     let (x, y, pixel) = film_position(camera, sampler.uniform2());
     let lens = sampler.uniform2();
     let (origin, direction) = camera.generate_ray(x, y, lens);
-    out.push(pixel, tracer.radiance(origin, direction, sampler, rays));
+    // Metropolis reads textures at full resolution: a footprint is a camera pixel's, and
+    // the chains' paths are not tied to one.
+    out.push(
+        pixel,
+        tracer.radiance(origin, direction, RayCone::NONE, sampler, rays),
+    );
 }
 
 /// Memory of the BDPT targets: the subpaths, a path sample for the bootstrap, and the
@@ -562,6 +567,7 @@ mod tests {
             min_depth: 2,
             spectral: false,
             roulette: crate::render::RenderSettings::default().roulette(),
+            texture_filtering: false,
         };
         check_pass_points(&BdptMultiplexed(bdpt(2)), &camera);
         check_pass_points(&BdptMultiplexed(bdpt(0)), &camera);
