@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 5
+#define MLT_VERSION_MINOR 6
 
 /**
  * Patch version.
