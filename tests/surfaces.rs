@@ -85,7 +85,9 @@ fn agrees_with_bdpt(algorithm: Algorithm, perturb_in_sample_space: bool) {
     let settings = RenderSettings {
         algorithm,
         perturb_in_sample_space,
-        samples_per_pixel: 40,
+        // ERPT's image mean spreads more here (σ 0.29% at 40, past the 0.286% a 2% error
+        // needs to fail): the glossy, stretched and filmed gold block's bright paths.
+        samples_per_pixel: if algorithm == Algorithm::Erpt { 64 } else { 40 },
         mutations_per_pixel: 128,
         bootstrap_samples: 1 << 16,
         chains: 256,

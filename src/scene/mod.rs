@@ -915,7 +915,10 @@ fn validate_arrays(desc: &SceneDesc) -> Result<()> {
 /// texture coordinates (a normal map needs texture coordinates; anisotropy can do with
 /// the host's tangents alone).
 fn corner_tangents(desc: &SceneDesc) -> Vec<[f32; 4]> {
-    let normal_mapped = desc.materials.iter().any(|m| m.normal_texture.is_some());
+    let normal_mapped = desc
+        .materials
+        .iter()
+        .any(|m| m.normal_texture.is_some() || m.clearcoat_normal_texture.is_some());
     let anisotropic = desc.materials.iter().any(|m| m.anisotropy > 0.0);
     let host_tangents_usable =
         !desc.tangents.is_empty() && (anisotropic || !desc.texcoords.is_empty());
@@ -1033,6 +1036,31 @@ mod tests {
     /// Ray queries through a scene go through its cut-outs, with either backend: a triangle
     /// whose vertex alphas make alpha = 1 - u - v is solid only where u + v <= 1/2 (the
     /// cutoff), and rays through the rest reach the opaque triangle behind it.
+    /// A clear coat's own normal map needs the mesh's tangents as the base's does: a scene
+    /// whose only normal map is a coat's gets them.
+    #[test]
+    fn a_coat_normal_map_alone_gets_tangents() {
+        let positions = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+        let texcoords = [0.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+        let coat = |normal_map: bool| Material {
+            clearcoat: 1.0,
+            clearcoat_normal_texture: normal_map.then(|| TextureRef::new(0)),
+            ..Material::metallic_roughness([0.5; 3], 0.0, 0.5)
+        };
+        for (normal_map, tangents) in [(true, 3), (false, 0)] {
+            let materials = [coat(normal_map)];
+            let desc = SceneDesc {
+                positions: &positions,
+                texcoords: &texcoords,
+                indices: &[0, 1, 2],
+                material_ids: &[0],
+                materials: &materials,
+                ..Default::default()
+            };
+            assert_eq!(corner_tangents(&desc).len(), tangents);
+        }
+    }
+
     #[test]
     fn rays_pass_through_cut_outs() {
         #[rustfmt::skip]
