@@ -32,6 +32,9 @@ use std::f32::consts::FRAC_1_PI;
 
 /// The scattering model at a surface point, with its parameters evaluated there (textures
 /// and vertex colours applied).
+// The metallic-roughness variant is much the largest, and it stays inline: a model lives on
+// the stack for one scattering event, and boxing it would allocate in the hot loop.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum BsdfModel {
     /// Lambertian with this albedo, two-sided.
