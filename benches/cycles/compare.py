@@ -4,7 +4,10 @@
 For each asset both renderers get the same file, the same camera (the model's bounding box
 framed from the front, +Z in glTF's frame), the same HDR sky as the only light besides the
 asset's own, the same size, samples and path depth:
-- mlt: `mlt-render ASSET --camera CAMERA.json --env SKY.hdr --algorithm path`, linear EXR;
+- mlt: `mlt-render ASSET --camera CAMERA.json --env SKY.hdr --algorithm path
+  --full-resolution-textures`, linear EXR (Cycles reads its images at full resolution, no
+  mip-maps, so both estimate the same pixel integral: prefiltering is not linear where
+  textures multiply each other below a pixel);
 - Cycles (Blender as a Python module, `bpy`): the stock glTF importer (glTF's PBR on the
   Principled BSDF), every Principled BSDF switched to single-scattering GGX (the glTF
   specification's BRDF has no multiple-scattering term), a 1-pixel box filter, no denoising,
@@ -332,7 +335,7 @@ def render_mlt(args, scene, camera, sky, out, directory):
                "--env-rotate", str(args.sky_rotate), "--algorithm", "path",
                "--spp", str(args.spp), "--max-depth", str(args.depth), "--seed", "1",
                "--threads", str(args.threads), "--width", str(camera["width"]),
-               "--height", str(camera["height"]), "--out", out]
+               "--height", str(camera["height"]), "--out", out, "--full-resolution-textures"]
     start = time.perf_counter()
     result = subprocess.run(command, capture_output=True, text=True)
     seconds = time.perf_counter() - start
@@ -805,7 +808,8 @@ def write_page(args, sky_rows, results, furnace_rows, tint_rows, seconds):
         "mlt's path tracer and by Blender Cycles (`bpy` 5.0.1, its stock glTF importer), with the",
         "same camera (the model's bounding box framed from the front), the same sky",
         f"(`{args.sky}`, the only light), {args.size}² pixels, {args.spp} samples per pixel,",
-        f"depth {args.depth}, a 1-pixel box filter, single-scattering GGX in Cycles' Principled",
+        f"depth {args.depth}, a 1-pixel box filter, textures at full resolution in both (mlt's",
+        "`--full-resolution-textures`: Cycles has no mip-maps), single-scattering GGX in Cycles' Principled",
         "BSDF, no denoising or clamping, linear EXR. What the script does and why is in its",
         "doc comment; [benchmarks](benchmarks.md#gltf-assets-against-blender-cycles) says what",
         f"the figures mean. Command (about {seconds / 60:.0f} minutes on the 2-core development",

@@ -406,7 +406,9 @@ impl SurfacePoint<'_> {
         ) else {
             return normal;
         };
-        let texel = self.lookup(texture);
+        // At full resolution: shading is not linear in the normal, so a normal map averaged
+        // over the footprint (flattened) would change the converged image, not its noise.
+        let texel = self.lookup_image(texture);
         let local = Vec3A::new(
             (texel.x * 2.0 - 1.0) * scale,
             (texel.y * 2.0 - 1.0) * scale,
@@ -513,7 +515,8 @@ impl SurfacePoint<'_> {
         }
         let (mut x, mut y) = (1.0, 0.0);
         if let Some(texture) = &m.anisotropy_texture {
-            let texel = self.lookup(texture);
+            // At full resolution, as normal maps: averaged directions would shorten.
+            let texel = self.lookup_image(texture);
             (x, y) = (texel.x * 2.0 - 1.0, texel.y * 2.0 - 1.0);
             strength *= texel.z;
             if strength <= 0.0 {
