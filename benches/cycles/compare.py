@@ -650,6 +650,81 @@ def tint_furnace(args, directory):
     return rows
 
 
+# (roughness, anisotropyStrength) of the anisotropy furnace's white metal spheres.
+ANISOTROPY_CASES = ((0.3, 0.5), (0.3, 1.0), (0.6, 1.0))
+
+
+def anisotropic_metal_albedo(cos_o, roughness, strength, n=512, azimuths=8):
+    """The directional albedo of a white (F = 1) metal under KHR_materials_anisotropy's
+    GGX (α_t = mix(α, 1, strength²) along the direction, α_b = α across, α = roughness²;
+    height-correlated Smith masking) at cos θo, averaged over the view's azimuth to the
+    direction (the sphere's tangents turn around it): ∫ D(h) G2 (wo·h) / μo dω_h over the
+    half vectors that reflect wo above the surface, by the midpoint rule."""
+    alpha = roughness ** 2
+    ax, ay = alpha + (1 - alpha) * strength ** 2, alpha
+    theta = (np.arange(n) + 0.5) * (math.pi / 2) / n
+    phi = (np.arange(4 * n) + 0.5) * (2 * math.pi) / (4 * n)
+    theta, phi = np.meshgrid(theta, phi, indexing="ij")
+    h = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+    d = 1 / (math.pi * ax * ay * (h[0] ** 2 / ax ** 2 + h[1] ** 2 / ay ** 2 + h[2] ** 2) ** 2)
+
+    def lam(w):
+        return (np.sqrt(1 + (ax ** 2 * w[0] ** 2 + ay ** 2 * w[1] ** 2) / w[2] ** 2) - 1) / 2
+
+    total = 0.0
+    sin_o = math.sqrt(1 - cos_o ** 2)
+    for k in range(azimuths):
+        a = math.pi * (k + 0.5) / azimuths
+        wo = np.array([sin_o * math.cos(a), sin_o * math.sin(a), cos_o])[:, None, None]
+        cos_oh = (wo * h).sum(axis=0)
+        wi = 2 * cos_oh * h - wo
+        ok = (cos_oh > 0) & (wi[2] > 0)
+        g2 = 1 / (1 + lam(wo) + lam(np.where(ok, wi, wo)))
+        integrand = np.where(ok, d * g2 * cos_oh / cos_o, 0.0) * np.sin(theta)
+        total += integrand.sum() * (math.pi / 2 / n) * (2 * math.pi / (4 * n))
+    return total / azimuths
+
+
+def anisotropy_furnace(args, directory):
+    """Rows (roughness, strength, cos θo, specification, the same isotropic, Cycles, mlt)
+    for white metal spheres with KHR_materials_anisotropy under a white sky of radiance 1:
+    a pixel's value is the directional albedo at its cos θo. The specification's column is
+    its GGX integrated by the script; the isotropic column leaves the strength out (what a
+    renderer that kept the roughness would lose)."""
+    camera = furnace_camera(args.size)
+    cosines = cosines_seen(camera, args.size)
+    rows = []
+    for roughness, strength in ANISOTROPY_CASES:
+        name = f"anisotropy_{roughness}_{strength}"
+        scene = os.path.join(directory, name + ".gltf")
+        sphere_gltf(scene, {
+            "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1,
+                                     "roughnessFactor": roughness},
+            "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": strength}},
+        })
+        theirs, ours, error = furnace_renders(args, directory, name, scene, camera)
+        inside = theirs[..., 3] >= 0.999
+        theirs = luminance(theirs)
+        ours = luminance(ours) if ours is not None else None
+        for cos_o in (0.95, 0.6):
+            ring = (np.abs(cosines - cos_o) < 0.02) & inside
+            mlt = f"{ours[ring].mean():.3f}" if ours is not None else error
+            rows.append((roughness, strength, cos_o,
+                         anisotropic_metal_albedo(cos_o, roughness, strength),
+                         anisotropic_metal_albedo(cos_o, roughness, 0.0),
+                         theirs[ring].mean(), mlt))
+    return rows
+
+
+def anisotropy_table(rows):
+    lines = ["| roughness | strength | cos θo | specification | isotropic | Cycles | mlt |",
+             "|---:|---:|---:|---:|---:|---:|---:|"]
+    for roughness, strength, cos_o, spec, iso, cycles, mlt in rows:
+        lines.append(f"| {roughness} | {strength} | {cos_o} | {spec:.3f} | {iso:.3f} | "
+                     f"{cycles:.3f} | {mlt} |")
+    return "\n".join(lines)
+
+
 def tint_table(rows):
     lines = ["| channel | base colour c | specification, c² | Cycles | mlt |",
              "|---|---:|---:|---:|---:|"]
@@ -797,7 +872,7 @@ def command_line(args):
     return " ".join(parts)
 
 
-def write_page(args, sky_rows, results, furnace_rows, tint_rows, seconds):
+def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, seconds):
     images = os.path.relpath(args.images, os.path.join(ROOT, "docs"))
     lines = [
         "# mlt against Blender Cycles",
@@ -883,6 +958,21 @@ def write_page(args, sky_rows, results, furnace_rows, tint_rows, seconds):
             tint_table(tint_rows),
             "",
         ]
+    if anisotropy_rows:
+        lines += [
+            "## Anisotropy alone in a white furnace",
+            "",
+            "White metal spheres (F = 1) with `KHR_materials_anisotropy` under a white sky of",
+            "radiance 1: a pixel's value is the directional albedo at its cos θo. The",
+            "specification widens GGX along the direction to α_t = mix(α, 1, strength²); its",
+            "column is that lobe integrated by the script (averaged over the view's azimuth to",
+            "the direction), the next the isotropic lobe of the same roughness. Blender's",
+            "importer passes the strength to the Principled BSDF's Anisotropic input and keeps",
+            "the roughness, so Cycles stretches its own way.",
+            "",
+            anisotropy_table(anisotropy_rows),
+            "",
+        ]
     lines += [
         "## A thin film alone in a white furnace",
         "",
@@ -940,13 +1030,17 @@ def main():
         print("Sheen alone in a white furnace, directional albedo:")
         print(furnace_table(furnace_rows))
     tint_rows = tint_furnace(args, directory) if args.furnace else []
+    anisotropy_rows = anisotropy_furnace(args, directory) if args.furnace else []
+    if anisotropy_rows:
+        print("White anisotropic metals in a white furnace, directional albedo:")
+        print(anisotropy_table(anisotropy_rows))
     if tint_rows:
         print("The white sky through an index-matched sphere of base colour TINT:")
         print(tint_table(tint_rows))
     seconds = time.perf_counter() - start
     print(f"{seconds:.0f} s in all")
     if args.docs:
-        write_page(args, sky_rows, results, furnace_rows, tint_rows, seconds)
+        write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, seconds)
 
 
 if __name__ == "__main__":
