@@ -86,7 +86,8 @@ pub use scene_data::{CameraFile, IoError, SceneData};
 ///   `KHR_materials_dispersion`, `KHR_texture_transform`, `KHR_materials_clearcoat`
 ///   (factors, textures and the coat's own normal map), `KHR_materials_specular` and
 ///   `KHR_materials_sheen` (factors and textures), `KHR_materials_anisotropy` (strength,
-///   rotation and texture), `KHR_materials_volume` (thickness as
+///   rotation and texture), `KHR_materials_iridescence` (the thin film's factors and
+///   textures), `KHR_materials_volume` (thickness as
 ///   the flag, attenuation colour and distance), `KHR_materials_unlit` (the base colour
 ///   emitted, nothing scattered), `KHR_materials_variants` (see [`load_scene_variant`]);
 ///   files may require any of these. Alpha modes (`BLEND` as stochastic coverage,
