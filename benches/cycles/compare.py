@@ -20,8 +20,9 @@ everything after. Then, per asset, over the pixels the model covers (Cycles' alp
 - the ratio of the mean luminances, mlt / Cycles;
 - the worst 16 x 16 block: the block ratio furthest from 1 among blocks at least a quarter
   covered.
-Two furnaces show lobes where Cycles departs from the specification: sheen alone, and the
-transmission's tint through a closed object.
+Furnaces show single lobes where Cycles departs from the specification, or where a
+block's difference needs one: sheen alone, the transmission's tint through a closed
+object, anisotropy alone, and a specular colour of 0.
 An asset mlt refuses (an unsupported required extension, say) is reported as refused, with
 mlt's message; the other assets go on. Numbers are reported, never asserted: a bench, not a
 test. It writes docs/cycles.md (the table and the images) and docs/images/cycles/NAME.png
@@ -725,6 +726,40 @@ def anisotropy_table(rows):
     return "\n".join(lines)
 
 
+def specular_furnace(args, directory):
+    """Rows (cos θo, specification, Cycles, mlt or its error) for a smooth sphere of black
+    base colour and `KHR_materials_specular`'s colour 0 under a white sky of radiance 1:
+    the specification's F0 = min(F0(ior) · specularColor, 1) · specular is 0 and its F90 =
+    specular is 1, so a pixel reflects Schlick's (1 − cos θo)⁵ of the sky."""
+    camera = furnace_camera(args.size)
+    cosines = cosines_seen(camera, args.size)
+    scene = os.path.join(directory, "specular_colour_0.gltf")
+    sphere_gltf(scene, {
+        "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0,
+                                 "roughnessFactor": 0},
+        "extensions": {"KHR_materials_specular": {"specularColorFactor": [0, 0, 0]}},
+    })
+    theirs, ours, error = furnace_renders(args, directory, "specular_colour_0", scene, camera)
+    inside = theirs[..., 3] >= 0.999
+    theirs = luminance(theirs)
+    ours = luminance(ours) if ours is not None else None
+    rows = []
+    for cos_o in FURNACE_COSINES:
+        ring = (np.abs(cosines - cos_o) < 0.02) & inside
+        mlt = f"{ours[ring].mean():.4f}" if ours is not None else error
+        # The ring's mean of (1 − cos)⁵ over its pixels' cosines.
+        rows.append((cos_o, float(((1 - cosines[ring]) ** 5).mean()), theirs[ring].mean(), mlt))
+    return rows
+
+
+def specular_table(rows):
+    lines = ["| cos θo | specification, (1 − cos θo)⁵ | Cycles | mlt |",
+             "|---:|---:|---:|---:|"]
+    for cos_o, spec, cycles, mlt in rows:
+        lines.append(f"| {cos_o} | {spec:.4f} | {cycles:.4f} | {mlt} |")
+    return "\n".join(lines)
+
+
 def tint_table(rows):
     lines = ["| channel | base colour c | specification, c² | Cycles | mlt |",
              "|---|---:|---:|---:|---:|"]
@@ -872,7 +907,8 @@ def command_line(args):
     return " ".join(parts)
 
 
-def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, seconds):
+def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, specular_rows,
+               seconds):
     images = os.path.relpath(args.images, os.path.join(ROOT, "docs"))
     lines = [
         "# mlt against Blender Cycles",
@@ -973,6 +1009,18 @@ def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows
             anisotropy_table(anisotropy_rows),
             "",
         ]
+    if specular_rows:
+        lines += [
+            "## Specular colour 0 in a white furnace",
+            "",
+            "A smooth sphere of black base colour and `KHR_materials_specular`'s colour 0 (as",
+            "SpecularTest's first column) under a white sky of radiance 1. The specification",
+            "scales F0 by the colour and keeps F90 = specular = 1, so the sphere reflects",
+            "Schlick's (1 − cos θo)⁵ of the sky: nothing face-on, all at grazing angles.",
+            "",
+            specular_table(specular_rows),
+            "",
+        ]
     lines += [
         "## A thin film alone in a white furnace",
         "",
@@ -1031,6 +1079,10 @@ def main():
         print(furnace_table(furnace_rows))
     tint_rows = tint_furnace(args, directory) if args.furnace else []
     anisotropy_rows = anisotropy_furnace(args, directory) if args.furnace else []
+    specular_rows = specular_furnace(args, directory) if args.furnace else []
+    if specular_rows:
+        print("A smooth black sphere of specular colour 0 in a white furnace:")
+        print(specular_table(specular_rows))
     if anisotropy_rows:
         print("White anisotropic metals in a white furnace, directional albedo:")
         print(anisotropy_table(anisotropy_rows))
@@ -1040,7 +1092,8 @@ def main():
     seconds = time.perf_counter() - start
     print(f"{seconds:.0f} s in all")
     if args.docs:
-        write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, seconds)
+        write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows,
+                   specular_rows, seconds)
 
 
 if __name__ == "__main__":
