@@ -430,7 +430,22 @@ mod tests {
     fn coated_sample_eval_pdf_and_scatter_agree() {
         let n = normal();
         let mut rng = Rng::new(45, 12);
-        for m in materials(&[0.0, 0.2, 1.0], &[0.0, 0.05, 0.5]) {
+        // And coats over a rough index-matched glass (a Dirac transmission straight on).
+        let index_matched = [0.0, 0.5].map(|coat| {
+            coated(
+                MetallicRoughness {
+                    ior: 1.0,
+                    ..base(0.5, 0.0, 1.0)
+                },
+                1.0,
+                coat,
+                false,
+            )
+        });
+        for m in materials(&[0.0, 0.2, 1.0], &[0.0, 0.05, 0.5])
+            .into_iter()
+            .chain(index_matched)
+        {
             for theta in ANGLES {
                 let wo = direction(theta);
                 let tolerance = if m.clearcoat.roughness == 0.05 {

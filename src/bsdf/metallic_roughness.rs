@@ -1423,8 +1423,9 @@ impl MetallicRoughness {
             return self.coated_density_scatter(view, choice, &coat, wi, mode);
         }
         if local.z < 0.0 {
-            // Only a smooth base refracts through a Dirac lobe.
-            let refracts = smooth_base && choice.transmission > 0.0;
+            // Only a smooth base, or a rough index-matched one, refracts through a Dirac
+            // lobe.
+            let refracts = (smooth_base || self.transmits_straight()) && choice.transmission > 0.0;
             let base = refracts.then(|| self.specular_transmission(view, wi, choice, mode))?;
             return Some(self.coated_base_dirac(view, choice, &coat, base, mode));
         }
