@@ -22,22 +22,12 @@ use common::scenes::{Mesh, canonical_camera, canonical_mesh, inward_icosphere};
 use common::stats::{Estimate, assert_estimates_agree};
 use common::window_room;
 
+use mlt::params::ChoiceParameter;
 use mlt::{
     Algorithm, Backend, Camera, EnvironmentDesc, LightsDesc, Material, PunctualLight,
     RenderSettings, Scene, SunDesc,
 };
 use std::f64::consts::PI;
-
-/// Every algorithm.
-const ALGORITHMS: [Algorithm; 7] = [
-    Algorithm::Path,
-    Algorithm::Bdpt,
-    Algorithm::Pssmlt,
-    Algorithm::PssmltBdpt,
-    Algorithm::Mmlt,
-    Algorithm::PathSpaceMlt,
-    Algorithm::Erpt,
-];
 
 const SIZE: u32 = 16;
 const RENDERS: u64 = 8;
@@ -85,7 +75,7 @@ fn assert_renders_match_with_effort(
     effort: u32,
 ) {
     let scene = mesh.scene_lit(Backend::Bvh, lights);
-    for algorithm in ALGORITHMS {
+    for &algorithm in Algorithm::ALL {
         let renders: Vec<Vec<f32>> = (0..RENDERS)
             .map(|seed| {
                 render_image(

@@ -25,18 +25,8 @@ use common::stats::{
     Estimate, assert_sharp, assert_within_and_sharp, luminance, mean_and_standard_error,
 };
 
-use mlt::{Algorithm, Material, MaterialKind, RenderSettings};
-
-/// Every algorithm (all render spectrally).
-const SPECTRAL_ALGORITHMS: [Algorithm; 7] = [
-    Algorithm::Path,
-    Algorithm::Bdpt,
-    Algorithm::Pssmlt,
-    Algorithm::Mmlt,
-    Algorithm::PssmltBdpt,
-    Algorithm::PathSpaceMlt,
-    Algorithm::Erpt,
-];
+use mlt::params::ChoiceParameter;
+use mlt::{Algorithm, Material, MaterialKind, RenderSettings, Scene};
 
 fn spectral_settings(algorithm: Algorithm, size: u32, depth: u32, seed: u64) -> RenderSettings {
     RenderSettings {
@@ -60,7 +50,7 @@ fn grey_furnace_is_exact_in_spectral_mode() {
     let (albedo, emission, depth) = ([0.7; 3], [1.5; 3], 3);
     let scene = furnace_scene(albedo, emission);
     let truth = furnace_truth(albedo, emission, depth);
-    for algorithm in SPECTRAL_ALGORITHMS {
+    for &algorithm in Algorithm::ALL {
         // Independent renders: a Metropolis image's pixels are correlated, so the standard
         // error comes from the spread between renders.
         let renders: Vec<Vec<f32>> = (0..8)
@@ -195,7 +185,7 @@ fn spectral_images_are_identical_for_any_thread_count() {
         }
     }
     let (scene, camera) = (mesh.scene(), canonical_camera("cornell-glass"));
-    for algorithm in SPECTRAL_ALGORITHMS {
+    for &algorithm in Algorithm::ALL {
         let bits = |threads| {
             let settings = RenderSettings {
                 threads,
@@ -222,6 +212,38 @@ fn spectral_images_are_identical_for_any_thread_count() {
 /// the largest channel of the region in RGB.
 type Row = (String, f64, f64, f64, f64);
 
+/// `scene` (the Cornell box's geometry) path-traced in RGB and spectrally at 32² pixels,
+/// 128 samples per pixel, to `max_depth`: six independent renders each, with seeds from
+/// `first_seed` on.
+fn rgb_and_spectral_path_traced(
+    scene: &Scene,
+    max_depth: u32,
+    first_seed: u64,
+) -> (Estimate, Estimate) {
+    let estimate = |spectral: bool| {
+        let settings = RenderSettings {
+            width: 32,
+            height: 32,
+            algorithm: Algorithm::Path,
+            samples_per_pixel: 128,
+            max_depth,
+            spectral,
+            ..Default::default()
+        };
+        let renders: Vec<Vec<f32>> = (first_seed..first_seed + 6)
+            .map(|seed| {
+                render_image(
+                    scene,
+                    &canonical_camera("cornell-box"),
+                    &RenderSettings { seed, ..settings },
+                )
+            })
+            .collect();
+        Estimate::from_renders(32, 32, &renders)
+    };
+    (estimate(false), estimate(true))
+}
+
 /// Spectral and RGB path tracing of the Cornell box at `max_depth`, its lamp's emission
 /// replaced by `emission` when given, each from independent renders: the image means and
 /// the means of a 4 × 4 grid of regions, per channel, as (label, RGB, spectral, standard
@@ -236,27 +258,8 @@ fn spectral_against_rgb(max_depth: u32, emission: Option<[f32; 3]>) -> Vec<Row> 
             }
         }
     }
-    let (scene, camera) = (mesh.scene(), canonical_camera("cornell-box"));
     let size = 32;
-    let estimate = |spectral: bool| {
-        let renders: Vec<Vec<f32>> = (0..6)
-            .map(|seed| {
-                let settings = RenderSettings {
-                    width: size,
-                    height: size,
-                    algorithm: Algorithm::Path,
-                    samples_per_pixel: 128,
-                    max_depth,
-                    seed: 500 + seed,
-                    spectral,
-                    ..Default::default()
-                };
-                render_image(&scene, &camera, &settings)
-            })
-            .collect();
-        Estimate::from_renders(size as usize, size as usize, &renders)
-    };
-    let (rgb, spectral) = (estimate(false), estimate(true));
+    let (rgb, spectral) = rgb_and_spectral_path_traced(&mesh.scene(), max_depth, 500);
     let mut rows = Vec::new();
     let cells = 4;
     let step = size as usize / cells;
@@ -359,30 +362,10 @@ fn thin_film_in_spectral_mode_matches_its_rgb_integral() {
             };
         }
     }
-    let (scene, camera) = (mesh.scene(), canonical_camera("cornell-box"));
-    let size = 32;
-    let estimate = |spectral: bool| {
-        let renders: Vec<Vec<f32>> = (0..6)
-            .map(|seed| {
-                let settings = RenderSettings {
-                    width: size,
-                    height: size,
-                    algorithm: Algorithm::Path,
-                    samples_per_pixel: 128,
-                    max_depth: 1,
-                    seed: 700 + seed,
-                    spectral,
-                    ..Default::default()
-                };
-                render_image(&scene, &camera, &settings)
-            })
-            .collect();
-        Estimate::from_renders(size as usize, size as usize, &renders)
-    };
+    let (rgb, spectral) = rgb_and_spectral_path_traced(&mesh.scene(), 1, 700);
     // The lower half: the floor and the blocks, without the lamp.
-    let half = |e: Estimate| e.region(0, size as usize / 2, size as usize, size as usize);
-    let ((rgb, rgb_variance), (spectral, spectral_variance)) =
-        (half(estimate(false)), half(estimate(true)));
+    let half = |e: Estimate| e.region(0, 16, 32, 32);
+    let ((rgb, rgb_variance), (spectral, spectral_variance)) = (half(rgb), half(spectral));
     for c in 0..3 {
         let error = (rgb_variance[c] + spectral_variance[c]).sqrt();
         eprintln!(
