@@ -93,14 +93,15 @@ fn set_texcoord1_slots(material: &mut Material, bits: u32, name: &str) -> Result
         }
         slots = i as u32 + 1;
     }
-    if bits.checked_shr(slots).unwrap_or(0) != 0 {
+    let beyond = bits.checked_shr(slots).unwrap_or(0);
+    if beyond != 0 {
         let names: Vec<&str> = Material::default()
             .texture_slots()
             .map(|(slot, _)| slot)
             .collect();
         return Err(Error::invalid(format!(
             "{name} is {bits:#x}; bit {} names no texture slot: bits 0 ({}) to {} ({}) are the {slots} slots",
-            31 - bits.leading_zeros(),
+            slots + beyond.trailing_zeros(),
             names[0],
             slots - 1,
             names[names.len() - 1],
@@ -504,4 +505,67 @@ pub(super) fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f64) {
         ),
         length,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `texcoord1_slots` has a bit per texture slot in declaration order, the header's
+    /// `MLT_TEXCOORD1_*`: a Rust material's sets survive the trip through C, and a bit past
+    /// the last slot is refused.
+    #[test]
+    fn texcoord1_slots_are_the_texture_slots_in_order() {
+        let slots: Vec<&str> = Material::default()
+            .texture_slots()
+            .map(|(slot, _)| slot)
+            .collect();
+        assert_eq!(slots[0], "base_color_texture");
+        assert_eq!(slots[2], "normal_texture");
+        assert_eq!(slots[14], "iridescence_thickness_texture");
+        assert_eq!(
+            (
+                MLT_TEXCOORD1_BASE_COLOR,
+                MLT_TEXCOORD1_NORMAL,
+                MLT_TEXCOORD1_IRIDESCENCE_THICKNESS
+            ),
+            (1, 1 << 2, 1 << 14)
+        );
+
+        let texture = |texture, texcoord| {
+            Some(TextureRef {
+                texcoord,
+                ..TextureRef::new(texture)
+            })
+        };
+        let rust = Material {
+            base_color_texture: texture(0, 0),
+            normal_texture: texture(1, 1),
+            iridescence_thickness_texture: texture(2, 1),
+            ..Material::default()
+        };
+        let c = MltMaterial::from(&rust);
+        assert_eq!(
+            c.texcoord1_slots,
+            MLT_TEXCOORD1_NORMAL | MLT_TEXCOORD1_IRIDESCENCE_THICKNESS
+        );
+        assert_eq!(material(&c, 0).unwrap(), rust);
+
+        // A bit of a slot without a texture is ignored, as its transform is.
+        let empty_slot = MltMaterial {
+            texcoord1_slots: c.texcoord1_slots | MLT_TEXCOORD1_EMISSION,
+            ..c
+        };
+        assert_eq!(material(&empty_slot, 0).unwrap(), rust);
+
+        let beyond = MltMaterial {
+            texcoord1_slots: MLT_TEXCOORD1_BASE_COLOR | 1 << 15 | 1 << 20,
+            ..c
+        };
+        assert_eq!(
+            material(&beyond, 3).unwrap_err().message,
+            "desc.materials[3].texcoord1_slots is 0x108001; bit 15 names no texture slot: bits 0 \
+             (base_color_texture) to 14 (iridescence_thickness_texture) are the 15 slots"
+        );
+    }
 }
