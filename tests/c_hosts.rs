@@ -661,8 +661,14 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
                 }
                 sum / n as f64
             };
-            let diagonal = [("top-left", quarter(0, 0)), ("bottom-right", quarter(16, 16))];
-            let antidiagonal = [("top-right", quarter(16, 0)), ("bottom-left", quarter(0, 16))];
+            let diagonal = [
+                ("top-left", quarter(0, 0)),
+                ("bottom-right", quarter(16, 16)),
+            ];
+            let antidiagonal = [
+                ("top-right", quarter(16, 0)),
+                ("bottom-left", quarter(0, 16)),
+            ];
             // Set 0 is upright, set 1 mirrored.
             let (dark, white) = match set {
                 "0" => (diagonal, antidiagonal),
