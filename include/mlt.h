@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 6
+#define MLT_VERSION_MINOR 7
 
 /**
  * Patch version.

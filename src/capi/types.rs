@@ -6,7 +6,7 @@ use std::ffi::c_void;
 /// Major version of the mlt library this header belongs to.
 pub const MLT_VERSION_MAJOR: u32 = 0;
 /// Minor version.
-pub const MLT_VERSION_MINOR: u32 = 6;
+pub const MLT_VERSION_MINOR: u32 = 7;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
 /// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
