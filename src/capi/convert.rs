@@ -558,14 +558,29 @@ mod tests {
         };
         assert_eq!(material(&empty_slot, 0).unwrap(), rust);
 
+        // Bits past the last slot (the slots may grow to 30 before these are any).
         let beyond = MltMaterial {
-            texcoord1_slots: MLT_TEXCOORD1_BASE_COLOR | 1 << 15 | 1 << 20,
+            texcoord1_slots: MLT_TEXCOORD1_BASE_COLOR | 1 << 30 | 1 << 31,
             ..c
         };
         assert_eq!(
             material(&beyond, 3).unwrap_err().message,
-            "desc.materials[3].texcoord1_slots is 0x108001; bit 15 names no texture slot: bits 0 \
-             (base_color_texture) to 14 (iridescence_thickness_texture) are the 15 slots"
+            format!(
+                "desc.materials[3].texcoord1_slots is 0xc0000001; bit 30 names no texture slot: \
+                 bits 0 (base_color_texture) to {} ({}) are the {} slots",
+                slots.len() - 1,
+                slots[slots.len() - 1],
+                slots.len()
+            )
+        );
+        let next = MltMaterial {
+            texcoord1_slots: 1 << slots.len(),
+            ..c
+        };
+        let message = material(&next, 0).unwrap_err().message;
+        assert!(
+            message.contains(&format!("bit {} names no texture slot", slots.len())),
+            "{message}"
         );
     }
 }
