@@ -86,7 +86,7 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
 fn set_texcoord1_slots(material: &mut Material, bits: u32, name: &str) -> Result<()> {
     let mut slots = 0;
     for (i, (_, slot)) in material.texture_slots_mut().enumerate() {
-        if bits >> i & 1 == 1
+        if bits.checked_shr(i as u32).unwrap_or(0) & 1 == 1
             && let Some(texture) = slot
         {
             texture.texcoord = 1;
@@ -520,6 +520,10 @@ mod tests {
             .texture_slots()
             .map(|(slot, _)| slot)
             .collect();
+        assert!(
+            slots.len() < 32,
+            "a u32 has a bit for 31 slots and one past them"
+        );
         assert_eq!(slots[0], "base_color_texture");
         assert_eq!(slots[2], "normal_texture");
         assert_eq!(slots[14], "iridescence_thickness_texture");
