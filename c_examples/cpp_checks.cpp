@@ -428,6 +428,50 @@ void callbacks() {
     }
 }
 
+// Texture coordinate set 1 (glTF's TEXCOORD_1): a slot whose TextureRef::texcoord is 1 reads
+// SceneDesc::texcoords1 (its MLT_TEXCOORD1_* bit of MltMaterial.texcoord1_slots in C). Set 1
+// mirrors u here, so the checker's dark and white quarters swap places in the image.
+void textureCoordinateSets() {
+    mlt::Material material;
+    material.normal_texture.texture = 0;
+    material.normal_texture.texcoord = 1;
+    const MltMaterial c = material.to_c();
+    CHECK(c.texcoord1_slots == MLT_TEXCOORD1_NORMAL);
+    CHECK(mlt::Material::from_c(c).normal_texture.texcoord == 1);
+    CHECK(mlt::Material::from_c(c).base_color_texture.texcoord == 0);
+    material.base_color_texture.texcoord = 2;
+    expectError([&] { material.to_c(); }, mlt::Status::InvalidArgument,
+                "material.base_color_texture.texcoord is 2", __LINE__);
+
+    Ground ground;
+    ground.materials[0].base_color_texture.texcoord = 1;
+    expectError([&] { mlt::Scene s(ground.desc()); }, mlt::Status::InvalidArgument,
+                "desc.materials[0].base_color_texture uses texture coordinate set 1 but "
+                "desc.texcoords1 is empty",
+                __LINE__);
+    const std::vector<float> mirrored{1, 0, 1, 1, 0, 1, 0, 0};
+    // The mean of the image's quarter whose top-left pixel is (x0, y0), 2 pixels in.
+    auto quarter = [](const mlt::Image &image, std::uint32_t x0, std::uint32_t y0) {
+        double sum = 0.0;
+        for (std::uint32_t y = y0 + 2; y < y0 + 6; ++y)
+            for (std::uint32_t x = x0 + 2; x < x0 + 6; ++x)
+                for (const float v : image.pixel(x, y)) sum += v;
+        return sum / (4 * 4 * 3);
+    };
+    double contrast[2] = {0.0, 0.0};
+    for (std::uint32_t set = 0; set < 2; ++set) {
+        ground.materials[0].base_color_texture.texcoord = set;
+        mlt::SceneDesc desc = ground.desc();
+        desc.texcoords1 = mirrored;
+        const mlt::Image image = mlt::render_image(mlt::Scene(desc), topCamera(), quickSettings());
+        contrast[set] = quarter(image, 0, 0) / quarter(image, 8, 0);
+    }
+    // One set's top-left quarter is dark where the other's is white (sRGB 64 against 255).
+    CHECK((contrast[0] < 0.5 && contrast[1] > 2.0) || (contrast[0] > 2.0 && contrast[1] < 0.5));
+    ok("TextureRef::texcoord 1 reads SceneDesc::texcoords1; texcoord1_slots round-trips; "
+       "set 1 without texcoords1, and set 2, throw");
+}
+
 void spansAndImages() {
     const Ground ground;
     const mlt::Scene scene(ground.desc());
@@ -599,6 +643,7 @@ int main() try {
     defaultsAreTheLibrarys();
     errorsCarryStatusAndMessage();
     callbacks();
+    textureCoordinateSets();
     spansAndImages();
     sceneOwnership();
     splitRenders();

@@ -6,11 +6,14 @@
  * texels top-left and bottom-right, white ones top-right and bottom-left), under a uniform
  * white sky of radiance 1, seen from straight above and path traced. Texture coordinates
  * follow glTF: uv (0, 0) is the texture's top-left texel, v grows downwards; here they are
- * laid out so that the texture appears upright in the image. The program prints the mean
- * of each quarter of the image, and writes the image
+ * laid out so that the texture appears upright in the image. A second set of texture
+ * coordinates (glTF's TEXCOORD_1) mirrors u: with `set` 1 the base colour texture reads it
+ * (its bit of texcoord1_slots) and the checker appears mirrored. The program prints the
+ * mean of each quarter of the image, and writes the image
  * as PFM (see minimal.c for the conventions every mlt call follows, and for write_pfm).
  *
- * Usage:  textured [out.pfm] [width height samples-per-pixel]   (defaults: textured.pfm 32 32 16)
+ * Usage:  textured [out.pfm] [width height samples-per-pixel [set]]
+ *         (defaults: textured.pfm 32 32 16 0)
  *
  * Build (from the crate root, after `cargo build --release`):
  *   cc -std=c99 -Wall -Wextra -I include c_examples/textured.c \
@@ -76,6 +79,10 @@ static const float normals[4 * 3] = {
 static const float texcoords[4 * 2] = {
     0.0f, 0.0f,   1.0f, 0.0f,   1.0f, 1.0f,   0.0f, 1.0f,
 };
+/* Texture coordinate set 1: u mirrored. */
+static const float texcoords1[4 * 2] = {
+    1.0f, 0.0f,   0.0f, 0.0f,   0.0f, 1.0f,   1.0f, 1.0f,
+};
 /* The checker: 2 x 2 texels of 8-bit sRGB RGB, rows from the top. sRGB 64 is about 0.05
  * linear, 255 is 1. */
 static const uint8_t checker[2 * 2 * 3] = {
@@ -99,9 +106,11 @@ int main(int argc, char **argv) {
     double sums[4] = {0.0, 0.0, 0.0, 0.0};
     size_t counts[4] = {0, 0, 0, 0};
     int ok = 0;
+    const int set = argc == 6 ? atoi(argv[5]) : 0;
 
-    if (argc != 1 && argc != 2 && argc != 5) {
-        fprintf(stderr, "usage: %s [out.pfm] [width height samples-per-pixel]\n", argv[0]);
+    if ((argc != 1 && argc != 2 && argc != 5 && argc != 6) || set < 0 || set > 1) {
+        fprintf(stderr, "usage: %s [out.pfm] [width height samples-per-pixel [set]]\n",
+                argv[0]);
         return 2;
     }
 
@@ -126,6 +135,8 @@ int main(int argc, char **argv) {
     surface.metallic = 0.0f;
     surface.roughness = 1.0f;
     surface.base_color_texture.texture = 0;
+    /* Each texture slot reads texture coordinate set 0 unless its MLT_TEXCOORD1_* bit is set. */
+    if (set == 1) surface.texcoord1_slots = MLT_TEXCOORD1_BASE_COLOR;
 
     if (!check(mlt_environment_constant(&environment, sky), "mlt_environment_constant"))
         return 1;
@@ -139,6 +150,8 @@ int main(int argc, char **argv) {
     desc.normals_len = 4 * 3;
     desc.texcoords = texcoords;
     desc.texcoords_len = 4 * 2;
+    desc.texcoords1 = texcoords1;
+    desc.texcoords1_len = 4 * 2;
     desc.textures = &texture;
     desc.textures_len = 1;
     desc.materials = &surface;
@@ -158,7 +171,7 @@ int main(int argc, char **argv) {
     settings.algorithm = MLT_ALGORITHM_PATH;
     settings.width = settings.height = 32;
     settings.samples_per_pixel = 16;
-    if (argc == 5) {
+    if (argc >= 5) {
         settings.width = (uint32_t)strtoul(argv[2], NULL, 10);
         settings.height = (uint32_t)strtoul(argv[3], NULL, 10);
         settings.samples_per_pixel = (uint32_t)strtoul(argv[4], NULL, 10);

@@ -40,7 +40,7 @@
 /**
  * Minor version.
  */
-#define MLT_VERSION_MINOR 6
+#define MLT_VERSION_MINOR 7
 
 /**
  * Patch version.
@@ -99,6 +99,81 @@
  * `MltTextureRef.texture` of a material slot without a texture.
  */
 #define MLT_NO_TEXTURE -1
+
+/**
+ * `MltMaterial.texcoord1_slots`: `base_color_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_BASE_COLOR (1 << 0)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `metallic_roughness_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_METALLIC_ROUGHNESS (1 << 1)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `normal_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_NORMAL (1 << 2)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `emission_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_EMISSION (1 << 3)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `transmission_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_TRANSMISSION (1 << 4)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `clearcoat_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_CLEARCOAT (1 << 5)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `clearcoat_roughness_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_CLEARCOAT_ROUGHNESS (1 << 6)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `clearcoat_normal_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_CLEARCOAT_NORMAL (1 << 7)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `specular_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_SPECULAR (1 << 8)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `specular_color_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_SPECULAR_COLOR (1 << 9)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `sheen_color_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_SHEEN_COLOR (1 << 10)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `sheen_roughness_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_SHEEN_ROUGHNESS (1 << 11)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `anisotropy_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_ANISOTROPY (1 << 12)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `iridescence_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_IRIDESCENCE (1 << 13)
+
+/**
+ * `MltMaterial.texcoord1_slots`: `iridescence_thickness_texture` reads texture coordinate set 1.
+ */
+#define MLT_TEXCOORD1_IRIDESCENCE_THICKNESS (1 << 14)
 
 /**
  * `MltTexture.texel_type`: 8-bit values (`uint8_t`), 255 meaning 1, decoded by `encoding`.
@@ -458,7 +533,8 @@ typedef struct MltTextureRef {
  * A material. Initialize with `mlt_material_default`.
  *
  * Textures are looked up at the surface's texture coordinates (`MltSceneDesc.texcoords`,
- * which a scene with a textured material must have), each through its `MltTextureRef`:
+ * which a scene with a textured material must have, or `MltSceneDesc.texcoords1` for the
+ * slots whose bit of `texcoord1_slots` is set), each through its `MltTextureRef`:
  * `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
  * `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
  * by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
@@ -721,6 +797,13 @@ typedef struct MltMaterial {
    * index into `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
    */
   struct MltTextureRef iridescence_thickness_texture;
+  /**
+   * The texture slots that read texture coordinate set 1 (`MltSceneDesc.texcoords1`, glTF's
+   * texCoord 1) instead of set 0: bit i is the i-th texture slot in field order,
+   * `MLT_TEXCOORD1_<SLOT>` (`MLT_TEXCOORD1_BASE_COLOR` is bit 0). A bit past the last slot is
+   * refused; a bit of a slot without a texture is ignored. Default 0: every slot reads set 0.
+   */
+  uint32_t texcoord1_slots;
 } MltMaterial;
 
 /**
@@ -1007,6 +1090,16 @@ typedef struct MltSceneDesc {
    * work the acceleration structure's build spends for faster rays.
    */
   int32_t build_quality;
+  /**
+   * Per-vertex texture coordinate set 1 (glTF's `TEXCOORD_1`), u v per vertex as
+   * `texcoords`, or NULL with 0 (the default). Read by the texture slots whose bit of
+   * `MltMaterial.texcoord1_slots` is set, which need it.
+   */
+  const float *texcoords1;
+  /**
+   * Number of floats in `texcoords1`: 0 or 2 × the vertex count.
+   */
+  size_t texcoords1_len;
 } MltSceneDesc;
 
 /**

@@ -419,8 +419,20 @@ struct TextureRef {
     std::array<float, 2> offset{0.0f, 0.0f};
     float rotation = 0.0f;
     std::array<float, 2> scale{1.0f, 1.0f};
+    /// The texture coordinate set it is looked up at: 0 (SceneDesc::texcoords) or 1
+    /// (SceneDesc::texcoords1), glTF's texCoord. In C, a bit of MltMaterial.texcoord1_slots.
+    std::uint32_t texcoord = 0;
 
-    MltTextureRef to_c() const noexcept {
+    /// The C slot `name` of a material; sets `bit` (its MLT_TEXCOORD1_*) of `texcoord1_slots`
+    /// for set 1. Throws for a set other than 0 and 1.
+    MltTextureRef to_c(const char *name, std::uint32_t bit, std::uint32_t &texcoord1_slots) const {
+        if (texcoord > 1) {
+            throw Error(Status::InvalidArgument,
+                        std::string("material.") + name + ".texcoord is " +
+                            std::to_string(texcoord) + "; the texture coordinate sets are 0 and 1",
+                        "mlt::Material::to_c");
+        }
+        if (texcoord == 1) texcoord1_slots |= bit;
         MltTextureRef c{};
         c.texture = texture;
         detail::copy_to(c.offset, offset);
@@ -428,12 +440,14 @@ struct TextureRef {
         detail::copy_to(c.scale, scale);
         return c;
     }
-    static TextureRef from_c(const MltTextureRef &c) noexcept {
+    /// The slot `c` whose bit of MltMaterial.texcoord1_slots is `texcoord1_bit` (0: clear).
+    static TextureRef from_c(const MltTextureRef &c, std::uint32_t texcoord1_bit) noexcept {
         TextureRef r;
         r.texture = c.texture;
         r.offset = detail::to_array(c.offset);
         r.rotation = c.rotation;
         r.scale = detail::to_array(c.scale);
+        r.texcoord = texcoord1_bit != 0 ? 1u : 0u;
         return r;
     }
 };
@@ -622,40 +636,55 @@ struct Material {
         c.alpha = alpha;
         c.alpha_mode = detail::c_value(alpha_mode);
         c.alpha_cutoff = alpha_cutoff;
-        c.base_color_texture = base_color_texture.to_c();
-        c.metallic_roughness_texture = metallic_roughness_texture.to_c();
-        c.normal_texture = normal_texture.to_c();
-        c.emission_texture = emission_texture.to_c();
+        c.base_color_texture =
+            base_color_texture.to_c("base_color_texture", MLT_TEXCOORD1_BASE_COLOR, c.texcoord1_slots);
+        c.metallic_roughness_texture =
+            metallic_roughness_texture.to_c("metallic_roughness_texture", MLT_TEXCOORD1_METALLIC_ROUGHNESS, c.texcoord1_slots);
+        c.normal_texture =
+            normal_texture.to_c("normal_texture", MLT_TEXCOORD1_NORMAL, c.texcoord1_slots);
+        c.emission_texture =
+            emission_texture.to_c("emission_texture", MLT_TEXCOORD1_EMISSION, c.texcoord1_slots);
         c.normal_scale = normal_scale;
         c.energy_compensation = energy_compensation ? 1u : 0u;
         c.abbe_number = abbe_number;
-        c.transmission_texture = transmission_texture.to_c();
+        c.transmission_texture =
+            transmission_texture.to_c("transmission_texture", MLT_TEXCOORD1_TRANSMISSION, c.texcoord1_slots);
         c.clearcoat = clearcoat;
         c.clearcoat_roughness = clearcoat_roughness;
-        c.clearcoat_texture = clearcoat_texture.to_c();
-        c.clearcoat_roughness_texture = clearcoat_roughness_texture.to_c();
-        c.clearcoat_normal_texture = clearcoat_normal_texture.to_c();
+        c.clearcoat_texture =
+            clearcoat_texture.to_c("clearcoat_texture", MLT_TEXCOORD1_CLEARCOAT, c.texcoord1_slots);
+        c.clearcoat_roughness_texture =
+            clearcoat_roughness_texture.to_c("clearcoat_roughness_texture", MLT_TEXCOORD1_CLEARCOAT_ROUGHNESS, c.texcoord1_slots);
+        c.clearcoat_normal_texture =
+            clearcoat_normal_texture.to_c("clearcoat_normal_texture", MLT_TEXCOORD1_CLEARCOAT_NORMAL, c.texcoord1_slots);
         c.clearcoat_normal_scale = clearcoat_normal_scale;
         c.thickness = thickness;
         detail::copy_to(c.attenuation_color, attenuation_color);
         c.attenuation_distance = attenuation_distance;
         c.specular = specular;
         detail::copy_to(c.specular_color, specular_color);
-        c.specular_texture = specular_texture.to_c();
-        c.specular_color_texture = specular_color_texture.to_c();
+        c.specular_texture =
+            specular_texture.to_c("specular_texture", MLT_TEXCOORD1_SPECULAR, c.texcoord1_slots);
+        c.specular_color_texture =
+            specular_color_texture.to_c("specular_color_texture", MLT_TEXCOORD1_SPECULAR_COLOR, c.texcoord1_slots);
         detail::copy_to(c.sheen_color, sheen_color);
         c.sheen_roughness = sheen_roughness;
-        c.sheen_color_texture = sheen_color_texture.to_c();
-        c.sheen_roughness_texture = sheen_roughness_texture.to_c();
+        c.sheen_color_texture =
+            sheen_color_texture.to_c("sheen_color_texture", MLT_TEXCOORD1_SHEEN_COLOR, c.texcoord1_slots);
+        c.sheen_roughness_texture =
+            sheen_roughness_texture.to_c("sheen_roughness_texture", MLT_TEXCOORD1_SHEEN_ROUGHNESS, c.texcoord1_slots);
         c.anisotropy = anisotropy;
         c.anisotropy_rotation = anisotropy_rotation;
-        c.anisotropy_texture = anisotropy_texture.to_c();
+        c.anisotropy_texture =
+            anisotropy_texture.to_c("anisotropy_texture", MLT_TEXCOORD1_ANISOTROPY, c.texcoord1_slots);
         c.iridescence = iridescence;
-        c.iridescence_texture = iridescence_texture.to_c();
+        c.iridescence_texture =
+            iridescence_texture.to_c("iridescence_texture", MLT_TEXCOORD1_IRIDESCENCE, c.texcoord1_slots);
         c.iridescence_ior = iridescence_ior;
         c.iridescence_thickness_minimum = iridescence_thickness_minimum;
         c.iridescence_thickness_maximum = iridescence_thickness_maximum;
-        c.iridescence_thickness_texture = iridescence_thickness_texture.to_c();
+        c.iridescence_thickness_texture =
+            iridescence_thickness_texture.to_c("iridescence_thickness_texture", MLT_TEXCOORD1_IRIDESCENCE_THICKNESS, c.texcoord1_slots);
         // END GENERATED material to C
         return c;
     }
@@ -672,40 +701,55 @@ struct Material {
         m.alpha = c.alpha;
         m.alpha_mode = detail::from_c<AlphaMode>(c.alpha_mode);
         m.alpha_cutoff = c.alpha_cutoff;
-        m.base_color_texture = TextureRef::from_c(c.base_color_texture);
-        m.metallic_roughness_texture = TextureRef::from_c(c.metallic_roughness_texture);
-        m.normal_texture = TextureRef::from_c(c.normal_texture);
-        m.emission_texture = TextureRef::from_c(c.emission_texture);
+        m.base_color_texture =
+            TextureRef::from_c(c.base_color_texture, c.texcoord1_slots & MLT_TEXCOORD1_BASE_COLOR);
+        m.metallic_roughness_texture =
+            TextureRef::from_c(c.metallic_roughness_texture, c.texcoord1_slots & MLT_TEXCOORD1_METALLIC_ROUGHNESS);
+        m.normal_texture =
+            TextureRef::from_c(c.normal_texture, c.texcoord1_slots & MLT_TEXCOORD1_NORMAL);
+        m.emission_texture =
+            TextureRef::from_c(c.emission_texture, c.texcoord1_slots & MLT_TEXCOORD1_EMISSION);
         m.normal_scale = c.normal_scale;
         m.energy_compensation = c.energy_compensation != 0;
         m.abbe_number = c.abbe_number;
-        m.transmission_texture = TextureRef::from_c(c.transmission_texture);
+        m.transmission_texture =
+            TextureRef::from_c(c.transmission_texture, c.texcoord1_slots & MLT_TEXCOORD1_TRANSMISSION);
         m.clearcoat = c.clearcoat;
         m.clearcoat_roughness = c.clearcoat_roughness;
-        m.clearcoat_texture = TextureRef::from_c(c.clearcoat_texture);
-        m.clearcoat_roughness_texture = TextureRef::from_c(c.clearcoat_roughness_texture);
-        m.clearcoat_normal_texture = TextureRef::from_c(c.clearcoat_normal_texture);
+        m.clearcoat_texture =
+            TextureRef::from_c(c.clearcoat_texture, c.texcoord1_slots & MLT_TEXCOORD1_CLEARCOAT);
+        m.clearcoat_roughness_texture =
+            TextureRef::from_c(c.clearcoat_roughness_texture, c.texcoord1_slots & MLT_TEXCOORD1_CLEARCOAT_ROUGHNESS);
+        m.clearcoat_normal_texture =
+            TextureRef::from_c(c.clearcoat_normal_texture, c.texcoord1_slots & MLT_TEXCOORD1_CLEARCOAT_NORMAL);
         m.clearcoat_normal_scale = c.clearcoat_normal_scale;
         m.thickness = c.thickness;
         m.attenuation_color = detail::to_array(c.attenuation_color);
         m.attenuation_distance = c.attenuation_distance;
         m.specular = c.specular;
         m.specular_color = detail::to_array(c.specular_color);
-        m.specular_texture = TextureRef::from_c(c.specular_texture);
-        m.specular_color_texture = TextureRef::from_c(c.specular_color_texture);
+        m.specular_texture =
+            TextureRef::from_c(c.specular_texture, c.texcoord1_slots & MLT_TEXCOORD1_SPECULAR);
+        m.specular_color_texture =
+            TextureRef::from_c(c.specular_color_texture, c.texcoord1_slots & MLT_TEXCOORD1_SPECULAR_COLOR);
         m.sheen_color = detail::to_array(c.sheen_color);
         m.sheen_roughness = c.sheen_roughness;
-        m.sheen_color_texture = TextureRef::from_c(c.sheen_color_texture);
-        m.sheen_roughness_texture = TextureRef::from_c(c.sheen_roughness_texture);
+        m.sheen_color_texture =
+            TextureRef::from_c(c.sheen_color_texture, c.texcoord1_slots & MLT_TEXCOORD1_SHEEN_COLOR);
+        m.sheen_roughness_texture =
+            TextureRef::from_c(c.sheen_roughness_texture, c.texcoord1_slots & MLT_TEXCOORD1_SHEEN_ROUGHNESS);
         m.anisotropy = c.anisotropy;
         m.anisotropy_rotation = c.anisotropy_rotation;
-        m.anisotropy_texture = TextureRef::from_c(c.anisotropy_texture);
+        m.anisotropy_texture =
+            TextureRef::from_c(c.anisotropy_texture, c.texcoord1_slots & MLT_TEXCOORD1_ANISOTROPY);
         m.iridescence = c.iridescence;
-        m.iridescence_texture = TextureRef::from_c(c.iridescence_texture);
+        m.iridescence_texture =
+            TextureRef::from_c(c.iridescence_texture, c.texcoord1_slots & MLT_TEXCOORD1_IRIDESCENCE);
         m.iridescence_ior = c.iridescence_ior;
         m.iridescence_thickness_minimum = c.iridescence_thickness_minimum;
         m.iridescence_thickness_maximum = c.iridescence_thickness_maximum;
-        m.iridescence_thickness_texture = TextureRef::from_c(c.iridescence_thickness_texture);
+        m.iridescence_thickness_texture =
+            TextureRef::from_c(c.iridescence_thickness_texture, c.texcoord1_slots & MLT_TEXCOORD1_IRIDESCENCE_THICKNESS);
         // END GENERATED material from C
         return m;
     }
@@ -985,6 +1029,9 @@ struct SceneDesc {
     Span<const float> tangents;
     Span<const float> colors;
     Span<const Texture> textures;
+    /// Texture coordinate set 1 (u v per vertex, glTF's TEXCOORD_1), or empty: read by the
+    /// texture slots whose TextureRef::texcoord is 1.
+    Span<const float> texcoords1;
 };
 
 /// A perspective camera (MltCamera). The defaults are mlt_camera_default's: the Cornell
@@ -1333,6 +1380,8 @@ public:
         c.colors_len = desc.colors.size();
         c.textures = textures.data();
         c.textures_len = textures.size();
+        c.texcoords1 = desc.texcoords1.data();
+        c.texcoords1_len = desc.texcoords1.size();
         detail::check(mlt_scene_create(&c, &handle_), "mlt_scene_create");
     }
 

@@ -245,6 +245,16 @@ pub trait ParameterType: Copy {
     fn texture(&self) -> Option<TextureRef> {
         None
     }
+    /// The slot's texture or none, for a texture slot.
+    #[doc(hidden)]
+    fn texture_slot(&self) -> Option<Option<TextureRef>> {
+        None
+    }
+    /// The slot, for a texture slot (holding a texture or not).
+    #[doc(hidden)]
+    fn texture_slot_mut(&mut self) -> Option<&mut Option<TextureRef>> {
+        None
+    }
 }
 
 macro_rules! integer_parameter {
@@ -346,6 +356,12 @@ impl ParameterType for Option<TextureRef> {
     #[inline(always)]
     fn texture(&self) -> Option<TextureRef> {
         *self
+    }
+    fn texture_slot(&self) -> Option<Option<TextureRef>> {
+        Some(*self)
+    }
+    fn texture_slot_mut(&mut self) -> Option<&mut Option<TextureRef>> {
+        Some(self)
     }
 }
 
@@ -554,6 +570,31 @@ macro_rules! declare_parameters {
                 )*]
                 .into_iter()
                 .filter_map(|(name, texture)| Some((name, texture?)))
+            }
+
+            /// Every texture slot, holding a texture or not, with its name, in declaration
+            /// order (the order of the C material's `texcoord1_slots` bits).
+            #[allow(dead_code)]
+            pub(crate) fn texture_slots(
+                &self,
+            ) -> impl Iterator<Item = (&'static str, Option<$crate::texture::TextureRef>)> {
+                [$(
+                    (stringify!($name), $crate::params::ParameterType::texture_slot(&self.$name)),
+                )*]
+                .into_iter()
+                .filter_map(|(name, slot)| Some((name, slot?)))
+            }
+
+            /// [`Self::texture_slots`], to change.
+            #[allow(dead_code)]
+            pub(crate) fn texture_slots_mut(
+                &mut self,
+            ) -> impl Iterator<Item = (&'static str, &mut Option<$crate::texture::TextureRef>)> {
+                [$(
+                    (stringify!($name), $crate::params::ParameterType::texture_slot_mut(&mut self.$name)),
+                )*]
+                .into_iter()
+                .filter_map(|(name, slot)| Some((name, slot?)))
             }
         }
 

@@ -482,6 +482,7 @@ fn cpp_header_reports_errors_and_cancels_from_callbacks() {
             "ok: mlt::RenderSettings{} is mlt_render_settings_default",
             "ok: a bad setting throws mlt::Error: mlt_render: invalid argument: settings.width is 0",
             "ok: a lambda returning false cancels the render",
+            "ok: TextureRef::texcoord 1 reads SceneDesc::texcoords1; texcoord1_slots round-trips; set 1 without texcoords1, and set 2, throw",
             "ok: a lambda's exception cancels the render and is rethrown after it",
             "ok: an exception from the final progress call is rethrown",
             "ok: mlt::Scene moves, copies (sharing), releases and adopts its handle; ray queries answer",
@@ -620,7 +621,9 @@ fn sky_c_lights_a_scene_with_a_constant_environment() {
 /// sRGB, nearest texel), per-vertex normals and texture coordinates under a white sky,
 /// with a metallic-roughness material. The checker must appear upright: uv
 /// (0, 0) is the texture's top-left texel, whose dark value lands in the image's top-left
-/// quarter. Built as C99 and as C++.
+/// quarter. With set 1 the texture reads the second set of texture coordinates (u
+/// mirrored, `MLT_TEXCOORD1_BASE_COLOR`), and the checker must appear mirrored. Built as
+/// C99 and as C++.
 #[test]
 fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
     for (exe_name, as_cpp, flags) in [
@@ -628,48 +631,61 @@ fn textured_c_renders_a_checker_with_normals_and_texture_coordinates() {
         ("textured_cpp", true, &["-x", "c++"][..]),
     ] {
         let exe = build("textured.c", exe_name, as_cpp, flags);
-        let pfm_path = scratch_dir().join(format!("{exe_name}.pfm"));
-        let _ = std::fs::remove_file(&pfm_path);
-        let output = Command::new(exe)
-            .arg(&pfm_path)
-            .args(["32", "32", "16"])
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&output.stdout);
-        assert!(
-            output.status.success(),
-            "{exe_name}: {stdout}{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-        let image = read_pfm(&pfm_path);
-        assert_eq!((image.width, image.height), (32, 32));
-        assert!(image.rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
-        // Each quarter's mean, 2 pixels away from the checker's edges.
-        let quarter = |x0: usize, y0: usize| {
-            let mut sum = 0.0f64;
-            let mut n = 0;
-            for y in y0 + 2..y0 + 14 {
-                for x in x0 + 2..x0 + 14 {
-                    let i = (y * 32 + x) * 3;
-                    sum += image.rgb[i..i + 3].iter().map(|&v| v as f64).sum::<f64>() / 3.0;
-                    n += 1;
+        for set in ["0", "1"] {
+            let pfm_path = scratch_dir().join(format!("{exe_name}_set{set}.pfm"));
+            let _ = std::fs::remove_file(&pfm_path);
+            let output = Command::new(&exe)
+                .arg(&pfm_path)
+                .args(["32", "32", "16", set])
+                .output()
+                .unwrap();
+            let stdout = String::from_utf8_lossy(&output.stdout);
+            assert!(
+                output.status.success(),
+                "{exe_name} set {set}: {stdout}{}",
+                String::from_utf8_lossy(&output.stderr)
+            );
+            let image = read_pfm(&pfm_path);
+            assert_eq!((image.width, image.height), (32, 32));
+            assert!(image.rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+            // Each quarter's mean, 2 pixels away from the checker's edges.
+            let quarter = |x0: usize, y0: usize| {
+                let mut sum = 0.0f64;
+                let mut n = 0;
+                for y in y0 + 2..y0 + 14 {
+                    for x in x0 + 2..x0 + 14 {
+                        let i = (y * 32 + x) * 3;
+                        sum += image.rgb[i..i + 3].iter().map(|&v| v as f64).sum::<f64>() / 3.0;
+                        n += 1;
+                    }
                 }
+                sum / n as f64
+            };
+            let diagonal = [
+                ("top-left", quarter(0, 0)),
+                ("bottom-right", quarter(16, 16)),
+            ];
+            let antidiagonal = [
+                ("top-right", quarter(16, 0)),
+                ("bottom-left", quarter(0, 16)),
+            ];
+            // Set 0 is upright, set 1 mirrored.
+            let (dark, white) = match set {
+                "0" => (diagonal, antidiagonal),
+                _ => (antidiagonal, diagonal),
+            };
+            for (name, value) in dark {
+                assert!(
+                    value < 0.2,
+                    "{exe_name} set {set}: the {name} quarter is {value}, not dark (sRGB 64 is 0.05)\n{stdout}"
+                );
             }
-            sum / n as f64
-        };
-        let (top_left, top_right) = (quarter(0, 0), quarter(16, 0));
-        let (bottom_left, bottom_right) = (quarter(0, 16), quarter(16, 16));
-        for (name, value) in [("top-left", top_left), ("bottom-right", bottom_right)] {
-            assert!(
-                value < 0.2,
-                "{exe_name}: the {name} quarter is {value}, not dark (sRGB 64 is 0.05)\n{stdout}"
-            );
-        }
-        for (name, value) in [("top-right", top_right), ("bottom-left", bottom_left)] {
-            assert!(
-                (0.6..1.3).contains(&value),
-                "{exe_name}: the {name} quarter is {value}, not white\n{stdout}"
-            );
+            for (name, value) in white {
+                assert!(
+                    (0.6..1.3).contains(&value),
+                    "{exe_name} set {set}: the {name} quarter is {value}, not white\n{stdout}"
+                );
+            }
         }
     }
 }

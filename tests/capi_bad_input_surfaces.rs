@@ -21,11 +21,14 @@ use std::ptr::{null, null_mut};
 /// RGB (a flat normal map). The floor (material 0, diffuse so that every build renders it)
 /// uses textures 0, 1 and 2 as base colour, metallic-roughness and normal map, with a
 /// texture transform and an alpha cut-out; the light (material 1) has texture 0 as its
-/// emission texture.
+/// emission texture. A second set of texture coordinates (u mirrored) is there for the slots
+/// that ask for it (none by default).
 struct HostSurfaces {
     host: HostScene,
     normals: Vec<f32>,
     texcoords: Vec<f32>,
+    /// NULL in the description when empty.
+    texcoords1: Vec<f32>,
     tangents: Vec<f32>,
     colors: Vec<f32>,
     /// What the textures' `texels` point to (set at construction: the vectors' buffers do
@@ -98,12 +101,18 @@ impl HostSurfaces {
         ];
         let up = [0.0, 1.0, 0.0];
         let down = [0.0, -1.0, 0.0];
+        let texcoords = vec![
+            0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, // floor
+            0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, // light
+        ];
+        let texcoords1 = texcoords
+            .chunks(2)
+            .flat_map(|uv| [1.0 - uv[0], uv[1]])
+            .collect();
         HostSurfaces {
             normals: [up, up, up, up, down, down, down, down].concat(),
-            texcoords: vec![
-                0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 0.0, // floor
-                0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 0.0, 1.0, // light
-            ],
+            texcoords,
+            texcoords1,
             tangents: [[1.0, 0.0, 0.0, -1.0]; 8].concat(),
             colors: [[0.9, 0.8, 0.7, 1.0]; 8].concat(),
             host,
@@ -120,6 +129,12 @@ impl HostSurfaces {
             normals_len: self.normals.len(),
             texcoords: self.texcoords.as_ptr(),
             texcoords_len: self.texcoords.len(),
+            texcoords1: if self.texcoords1.is_empty() {
+                null()
+            } else {
+                self.texcoords1.as_ptr()
+            },
+            texcoords1_len: self.texcoords1.len(),
             tangents: self.tangents.as_ptr(),
             tangents_len: self.tangents.len(),
             colors: self.colors.as_ptr(),
@@ -158,18 +173,20 @@ fn surface_defaults_are_valid_and_documented() {
             (MLT_NO_TEXTURE, [0.0; 2], 0.0, [1.0; 2])
         );
     }
+    assert_eq!(m.texcoord1_slots, 0);
     let d = default_desc();
     assert!(d.normals.is_null() && d.texcoords.is_null() && d.tangents.is_null());
-    assert!(d.colors.is_null() && d.textures.is_null());
+    assert!(d.colors.is_null() && d.textures.is_null() && d.texcoords1.is_null());
     assert_eq!(
         (
             d.normals_len,
             d.texcoords_len,
             d.tangents_len,
             d.colors_len,
-            d.textures_len
+            d.textures_len,
+            d.texcoords1_len
         ),
-        (0, 0, 0, 0, 0)
+        (0, 0, 0, 0, 0, 0)
     );
     let t = default_texture();
     assert!(t.texels.is_null());
@@ -269,6 +286,16 @@ fn scene_create_bad_surfaces() {
         h.host.materials[1].emission_texture.texture = 3
             => ["desc.materials[1].emission_texture.texture is 3", "3 textures"],
         h.host.materials[1].kind = 4 => ["desc.materials[1].kind is 4"],
+        // Texture coordinate set 1.
+        {
+            h.host.materials[0].texcoord1_slots = MLT_TEXCOORD1_NORMAL;
+            h.texcoords1.clear();
+        } => ["desc.materials[0].normal_texture uses texture coordinate set 1", "desc.texcoords1 is empty"],
+        h.host.materials[1].texcoord1_slots = 1 << 31
+            => ["desc.materials[1].texcoord1_slots is 0x80000000", "bit 31 names no texture slot",
+                "bits 0 (base_color_texture)"],
+        h.host.materials[0].texcoord1_slots = u32::MAX
+            => ["desc.materials[0].texcoord1_slots is 0xffffffff", "names no texture slot"],
         // Textures: enums.
         h.textures[0].texel_type = 2
             => ["desc.textures[0].texel_type is 2", "MLT_TEXEL_U8", "MLT_TEXEL_F32"],
@@ -310,6 +337,7 @@ fn scene_create_bad_surfaces() {
         // Vertex attributes: lengths.
         h.normals.pop() => ["desc.normals has 23 floats", "3 per vertex", "24 for 8 vertices"],
         h.texcoords.push(0.0) => ["desc.texcoords has 17 floats", "2 per vertex", "16"],
+        h.texcoords1.pop() => ["desc.texcoords1 has 15 floats", "2 per vertex", "16"],
         h.tangents.truncate(28) => ["desc.tangents has 28 floats", "4 per vertex", "32"],
         h.colors.truncate(24) => ["desc.colors has 24 floats", "4 per vertex", "32"],
         // Vertex attributes: values.
@@ -345,6 +373,7 @@ fn scene_create_bad_surfaces() {
             => "desc.materials[1].emission_texture.scale.v" + "finite",
         h.normals[4] => "desc.normals[4] (vertex 1, y)" + "finite",
         h.texcoords[3] => "desc.texcoords[3] (vertex 1, v)" + "finite",
+        h.texcoords1[4] => "desc.texcoords1[4] (vertex 2, u)" + "finite",
         h.tangents[8] => "desc.tangents[8] (vertex 2, x)" + "finite",
         h.colors[2] => "desc.colors[2] (vertex 0, b)",
     ]);
@@ -355,6 +384,10 @@ fn scene_create_bad_surfaces() {
     let cases = cases![d = surfaces.desc();
         d.normals = null() => ["desc.normals is NULL"],
         d.texcoords = null() => ["desc.texcoords is NULL"],
+        d.texcoords1 = null() => ["desc.texcoords1 is NULL"],
+        d.texcoords1 = odd.cast() => ["desc.texcoords1", "aligned"],
+        d.texcoords1_len = usize::MAX => ["desc.texcoords1", "address space"],
+        d.texcoords1_len = 14 => ["desc.texcoords1 has 14 floats"],
         d.tangents = null() => ["desc.tangents is NULL"],
         d.colors = null() => ["desc.colors is NULL"],
         d.textures = null() => ["desc.textures[0] is NULL"],
@@ -490,4 +523,158 @@ fn older_materials_and_scene_descs_default_the_surface_fields() {
     let (status, image) = Handle(out).render(&floor_camera(), &settings, 48);
     assert_ok(status);
     assert_eq!(image, expected, "a 112-byte desc: the same scene");
+}
+
+/// The floor of `HostScene::floor_and_light` with a base colour texture of two texels, black
+/// (left) and white (right), read at a constant point of each set of texture coordinates.
+struct TwoSets {
+    host: HostScene,
+    texcoords: Vec<f32>,
+    texcoords1: Vec<f32>,
+    #[allow(dead_code)]
+    texels: Vec<u8>,
+    texture: MltTexture,
+}
+
+/// The texel centres of `TwoSets`' texture.
+const BLACK_TEXEL: [f32; 2] = [0.25, 0.5];
+const WHITE_TEXEL: [f32; 2] = [0.75, 0.5];
+
+impl TwoSets {
+    /// Set 0 at `set0`, set 1 at `set1` on every vertex; the floor's base colour slot reads
+    /// the sets `texcoord1_slots` says.
+    fn new(set0: [f32; 2], set1: [f32; 2], texcoord1_slots: u32) -> Self {
+        let mut host = HostScene::floor_and_light();
+        host.materials[0].base_color_texture = slot(0);
+        host.materials[0].color = [1.0; 3];
+        host.materials[0].texcoord1_slots = texcoord1_slots;
+        let texels = vec![0, 0, 0, 255, 255, 255];
+        let texture = MltTexture {
+            width: 2,
+            height: 1,
+            channels: 3,
+            texels: texels.as_ptr().cast(),
+            encoding: MLT_TEXTURE_LINEAR,
+            wrap_u: MLT_WRAP_CLAMP_TO_EDGE,
+            wrap_v: MLT_WRAP_CLAMP_TO_EDGE,
+            filter: MLT_FILTER_NEAREST,
+            ..default_texture()
+        };
+        TwoSets {
+            host,
+            texcoords: set0.repeat(8),
+            texcoords1: set1.repeat(8),
+            texels,
+            texture,
+        }
+    }
+
+    fn render(&self) -> Vec<f32> {
+        let desc = MltSceneDesc {
+            texcoords: self.texcoords.as_ptr(),
+            texcoords_len: self.texcoords.len(),
+            texcoords1: self.texcoords1.as_ptr(),
+            texcoords1_len: self.texcoords1.len(),
+            textures: &self.texture,
+            textures_len: 1,
+            ..self.host.desc()
+        };
+        let mut out = null_mut();
+        // SAFETY: the desc points into live values.
+        assert_ok(unsafe { mlt_scene_create(&desc, &mut out) });
+        let (status, image) = Handle(out).render(&TwoSets::camera(), &small_settings(8, 8, 4), 192);
+        assert_ok(status);
+        image
+    }
+
+    /// Straight down at the floor from below the light: the floor fills the image.
+    fn camera() -> MltCamera {
+        MltCamera {
+            eye: [0.0, 1.5, 0.0],
+            target: [0.0, 0.0, 0.0],
+            up: [0.0, 0.0, 1.0],
+            fov_y_deg: 60.0,
+            ..default_camera()
+        }
+    }
+}
+
+/// A slot whose bit of `texcoord1_slots` is set reads texture coordinate set 1, the others
+/// set 0: the floor reading the white texel through set 1 is the image of the floor reading
+/// it through set 0, bit for bit, and the floor reading the black texel is darker.
+#[test]
+fn a_slot_reads_texture_coordinate_set_1_where_its_bit_is_set() {
+    let white_through_set1 =
+        TwoSets::new(BLACK_TEXEL, WHITE_TEXEL, MLT_TEXCOORD1_BASE_COLOR).render();
+    let white_through_set0 = TwoSets::new(WHITE_TEXEL, BLACK_TEXEL, 0).render();
+    let black_through_set0 = TwoSets::new(BLACK_TEXEL, WHITE_TEXEL, 0).render();
+    // A bit of a slot without a texture changes nothing.
+    let black_with_other_bits = TwoSets::new(
+        BLACK_TEXEL,
+        WHITE_TEXEL,
+        MLT_TEXCOORD1_EMISSION | MLT_TEXCOORD1_NORMAL,
+    )
+    .render();
+    assert_valid_image(&white_through_set1, "set 1");
+    assert_eq!(white_through_set1, white_through_set0);
+    assert_eq!(black_with_other_bits, black_through_set0);
+    // The floor fills the image: black reflects nothing, white every pixel.
+    assert!(black_through_set0.iter().all(|&v| v == 0.0));
+    assert!(
+        white_through_set1.iter().all(|&v| v > 0.0),
+        "{white_through_set1:?}"
+    );
+}
+
+/// Hosts built against the header before texture coordinate set 1 (materials of 520 bytes,
+/// scene descriptions of 200) get set 0 everywhere, whatever their memory holds past their
+/// structs: the image of a current host's scene without set 1.
+#[test]
+fn layouts_before_texture_coordinate_set_1_read_set_0() {
+    let two_sets = TwoSets::new(WHITE_TEXEL, BLACK_TEXEL, 0);
+    let expected = two_sets.render();
+
+    let old_material = std::mem::offset_of!(MltMaterial, texcoord1_slots);
+    assert_eq!(earlier_size::<MltMaterial>(old_material), 520);
+    let old_desc = std::mem::offset_of!(MltSceneDesc, texcoords1);
+    assert_eq!(earlier_size::<MltSceneDesc>(old_desc), 200);
+
+    // Two 520-byte materials, then bits no header has (every texcoord1 bit set): read past
+    // the array, they would be refused.
+    let count = two_sets.host.materials.len();
+    let mut words = vec![u32::MAX; (old_material * count) / 4 + 64];
+    for (i, material) in two_sets.host.materials.iter().enumerate() {
+        let material = MltMaterial {
+            struct_size: old_material as u32,
+            ..*material
+        };
+        // SAFETY: the first 520 bytes of a material into element i of the 520-byte stride
+        // array, which `words` holds.
+        unsafe {
+            std::ptr::copy_nonoverlapping(
+                (&raw const material).cast::<u8>(),
+                words.as_mut_ptr().cast::<u8>().add(i * old_material),
+                old_material,
+            )
+        };
+    }
+    let desc = MltSceneDesc {
+        struct_size: old_desc as u32,
+        materials: words.as_ptr().cast(),
+        texcoords: two_sets.texcoords.as_ptr(),
+        texcoords_len: two_sets.texcoords.len(),
+        textures: &two_sets.texture,
+        textures_len: 1,
+        // Garbage an older host's memory may hold: mlt must not read it.
+        texcoords1: std::ptr::dangling(),
+        texcoords1_len: 3,
+        ..two_sets.host.desc()
+    };
+    let mut out = null_mut();
+    // SAFETY: older layouts' structs; mlt reads the first 200 bytes of the desc and 520 of
+    // each material.
+    assert_ok(unsafe { mlt_scene_create(&desc, &mut out) });
+    let (status, image) = Handle(out).render(&TwoSets::camera(), &small_settings(8, 8, 4), 192);
+    assert_ok(status);
+    assert_eq!(image, expected, "older layouts: the scene reading set 0");
 }

@@ -148,7 +148,61 @@ fn c_default<S>(p: &Parameter<S>) -> String {
     }
 }
 
-fn c_struct_fields<S: Parameters>() -> String {
+/// A field of a C struct that is no parameter of its own.
+struct COnlyField {
+    /// The parameter it follows: the last one when it was added, as the C struct only grows
+    /// at its end.
+    after: &'static str,
+    name: &'static str,
+    c_type: &'static str,
+    doc: &'static str,
+}
+
+/// `MltMaterial`'s fields beyond its parameters: what the other languages hold in each
+/// texture slot (`TextureRef::texcoord`), which `MltTextureRef` cannot hold without moving
+/// every later field.
+const MATERIAL_C_ONLY: [COnlyField; 1] = [COnlyField {
+    after: "iridescence_thickness_texture",
+    name: "texcoord1_slots",
+    c_type: "u32",
+    doc: "The texture slots that read texture coordinate set 1 (`MltSceneDesc.texcoords1`, glTF's \
+          texCoord 1) instead of set 0: bit i is the i-th texture slot in field order, \
+          `MLT_TEXCOORD1_<SLOT>` (`MLT_TEXCOORD1_BASE_COLOR` is bit 0). A bit past the last slot \
+          is refused; a bit of a slot without a texture is ignored. Default 0: every slot reads \
+          set 0.",
+}];
+
+/// The texture slots in declaration order, the order of `MltMaterial.texcoord1_slots`' bits.
+fn texture_slots() -> impl Iterator<Item = &'static str> {
+    materials()
+        .iter()
+        .filter(|p| matches!(p.kind, Kind::Texture))
+        .map(|p| p.name)
+}
+
+/// `MLT_TEXCOORD1_BASE_COLOR` for `base_color_texture`.
+fn texcoord1_constant(slot: &str) -> String {
+    format!(
+        "MLT_TEXCOORD1_{}",
+        upper(slot.strip_suffix("_texture").unwrap_or(slot))
+    )
+}
+
+/// The C constants of `MltMaterial.texcoord1_slots`' bits.
+fn c_texcoord1_constants() -> String {
+    texture_slots()
+        .enumerate()
+        .map(|(i, slot)| {
+            format!(
+                "/// `MltMaterial.texcoord1_slots`: `{slot}` reads texture coordinate set 1.\n\
+                 pub const {}: u32 = 1 << {i};\n",
+                texcoord1_constant(slot)
+            )
+        })
+        .collect()
+}
+
+fn c_struct_fields<S: Parameters>(c_only: &[COnlyField]) -> String {
     let mut out = String::new();
     for p in S::parameters() {
         let valid = match p.kind {
@@ -162,6 +216,10 @@ fn c_struct_fields<S: Parameters>() -> String {
             &format!("{} {valid}. Default {}.", p.doc, c_default(p)),
         );
         out += &format!("    pub {}: {},\n", p.name, c_type(p.kind));
+        for field in c_only.iter().filter(|f| f.after == p.name) {
+            out += &wrapped("    ///", field.doc);
+            out += &format!("    pub {}: {},\n", field.name, field.c_type);
+        }
     }
     out
 }
@@ -233,7 +291,10 @@ fn cpp_to_c<S: Parameters>() -> String {
                 Kind::Bool => format!("        c.{n} = {n} ? 1u : 0u;\n"),
                 Kind::Choice(_) => format!("        c.{n} = detail::c_value({n});\n"),
                 Kind::F32x3 | Kind::F32x4 => format!("        detail::copy_to(c.{n}, {n});\n"),
-                Kind::Texture => format!("        c.{n} = {n}.to_c();\n"),
+                Kind::Texture => format!(
+                    "        c.{n} =\n            {n}.to_c(\"{n}\", {}, c.texcoord1_slots);\n",
+                    texcoord1_constant(n)
+                ),
                 _ => format!("        c.{n} = {n};\n"),
             }
         })
@@ -255,7 +316,10 @@ fn cpp_from_c<S: Parameters>(var: &str) -> String {
                 Kind::F32x3 | Kind::F32x4 => {
                     format!("        {var}.{n} = detail::to_array(c.{n});\n")
                 }
-                Kind::Texture => format!("        {var}.{n} = TextureRef::from_c(c.{n});\n"),
+                Kind::Texture => format!(
+                    "        {var}.{n} =\n            TextureRef::from_c(c.{n}, c.texcoord1_slots & {});\n",
+                    texcoord1_constant(n)
+                ),
                 _ => format!("        {var}.{n} = c.{n};\n"),
             }
         })
@@ -435,7 +499,9 @@ fn docs() -> String {
          line sets a parameter on every material of the scene it loads with\n\
          `--material NAME=VALUE` (a texture slot takes `none` or a texture's index). Every\n\
          number must be finite. Choices are `MLT_MATERIAL_*` and `MLT_ALPHA_*` in C, texture\n\
-         slots `MltTextureRef`.\n\n\
+         slots `MltTextureRef`. A texture slot reads texture coordinate set 0 (`texcoords`), or\n\
+         set 1 (`texcoords1`) where its `texcoord` is 1: in C, where its bit of\n\
+         `MltMaterial.texcoord1_slots` (`MLT_TEXCOORD1_<SLOT>`) is set.\n\n\
          | Parameter | Type | Default | Valid values | What it does |\n\
          |---|---|---|---|---|\n";
     for p in materials() {
@@ -475,13 +541,22 @@ fn with_block(text: &str, tag: &str, block: &str, path: &Path) -> String {
 fn generated_code_and_docs_follow_the_declarations() {
     type S = RenderSettings;
     type M = Material;
-    let blocks: [(&str, &str, String); 18] = [
+    let blocks: [(&str, &str, String); 19] = [
         (
             "src/capi/types.rs",
             "render settings",
-            c_struct_fields::<S>(),
+            c_struct_fields::<S>(&[]),
         ),
-        ("src/capi/types.rs", "material", c_struct_fields::<M>()),
+        (
+            "src/capi/types.rs",
+            "material",
+            c_struct_fields::<M>(&MATERIAL_C_ONLY),
+        ),
+        (
+            "src/capi/types.rs",
+            "texcoord1 slots",
+            c_texcoord1_constants(),
+        ),
         (
             "src/capi/convert.rs",
             "settings from C",

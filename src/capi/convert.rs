@@ -12,21 +12,24 @@ use crate::texture::{TextureEncoding, TextureFilter, WrapMode};
 use glam::Vec3A;
 
 /// The host's material `index`; its values are validated with the scene (`Material::validate`),
-/// its choices and texture indices below -1 here.
+/// its choices, texture indices below -1 and `texcoord1_slots` here.
 pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
     let name = |field: &str| format!("desc.materials[{index}].{field}");
     macro_rules! from_c {
         ($($field:ident,)*) => {
             // The defaults fill in a parameter declared since the list was generated, so
             // that the crate builds to run the generator (`tests/parameters.rs`).
-            #[allow(clippy::needless_update)]
-            Ok(Material {
-                $($field: CField::from_c(m.$field, &name(stringify!($field)))?,)*
-                ..Material::default()
-            })
+            {
+                #[allow(clippy::needless_update)]
+                let material = Material {
+                    $($field: CField::from_c(m.$field, &name(stringify!($field)))?,)*
+                    ..Material::default()
+                };
+                material
+            }
         };
     }
-    from_c! {
+    let mut material = from_c! {
         // BEGIN GENERATED material from C: tests/parameters.rs writes these lines from src/scene/material.rs
         kind,
         color,
@@ -73,7 +76,48 @@ pub(super) fn material(m: &MltMaterial, index: usize) -> Result<Material> {
         iridescence_thickness_maximum,
         iridescence_thickness_texture,
         // END GENERATED material from C
+    };
+    set_texcoord1_slots(&mut material, m.texcoord1_slots, &name("texcoord1_slots"))?;
+    Ok(material)
+}
+
+/// Gives the texture slots whose bits of `bits` are set (bit i: the i-th slot in declaration
+/// order, `MLT_TEXCOORD1_*`) texture coordinate set 1; a bit past the last slot is refused.
+fn set_texcoord1_slots(material: &mut Material, bits: u32, name: &str) -> Result<()> {
+    let mut slots = 0;
+    for (i, (_, slot)) in material.texture_slots_mut().enumerate() {
+        if bits.checked_shr(i as u32).unwrap_or(0) & 1 == 1
+            && let Some(texture) = slot
+        {
+            texture.texcoord = 1;
+        }
+        slots = i as u32 + 1;
     }
+    let beyond = bits.checked_shr(slots).unwrap_or(0);
+    if beyond != 0 {
+        let names: Vec<&str> = Material::default()
+            .texture_slots()
+            .map(|(slot, _)| slot)
+            .collect();
+        return Err(Error::invalid(format!(
+            "{name} is {bits:#x}; bit {} names no texture slot: bits 0 ({}) to {} ({}) are the {slots} slots",
+            slots + beyond.trailing_zeros(),
+            names[0],
+            slots - 1,
+            names[names.len() - 1],
+        )));
+    }
+    Ok(())
+}
+
+/// The C material's `texcoord1_slots` of `material`: a bit for each slot whose texture reads
+/// texture coordinate set 1.
+pub(super) fn texcoord1_slots(material: &Material) -> u32 {
+    material
+        .texture_slots()
+        .enumerate()
+        .filter(|(_, (_, slot))| slot.is_some_and(|t| t.texcoord == 1))
+        .fold(0, |bits, (i, _)| bits | 1 << i)
 }
 
 /// The enums of the host's texture `index`, and the pairing of sRGB with 8-bit texels,
@@ -359,8 +403,8 @@ impl CField for Option<TextureRef> {
             index if index < 0 => Err(Error::invalid(format!(
                 "{name}.texture is {index}; use an index into desc.textures, or MLT_NO_TEXTURE (-1) for none"
             ))),
-            // C hosts have one texture coordinate set (`MltTextureRef` cannot grow without
-            // moving the material's later fields).
+            // The set is `MltMaterial.texcoord1_slots`' (`MltTextureRef` cannot grow without
+            // moving the material's later fields): `material` sets it.
             index => Ok(Some(TextureRef {
                 texture: index as u32,
                 texcoord: 0,
@@ -461,4 +505,86 @@ pub(super) fn unit_ray(ray: &MltRay) -> (crate::accel::Ray, f64) {
         ),
         length,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `texcoord1_slots` has a bit per texture slot in declaration order, the header's
+    /// `MLT_TEXCOORD1_*`: a Rust material's sets survive the trip through C, and a bit past
+    /// the last slot is refused.
+    #[test]
+    fn texcoord1_slots_are_the_texture_slots_in_order() {
+        let slots: Vec<&str> = Material::default()
+            .texture_slots()
+            .map(|(slot, _)| slot)
+            .collect();
+        assert!(
+            slots.len() < 32,
+            "a u32 has a bit for 31 slots and one past them"
+        );
+        assert_eq!(slots[0], "base_color_texture");
+        assert_eq!(slots[2], "normal_texture");
+        assert_eq!(slots[14], "iridescence_thickness_texture");
+        assert_eq!(
+            (
+                MLT_TEXCOORD1_BASE_COLOR,
+                MLT_TEXCOORD1_NORMAL,
+                MLT_TEXCOORD1_IRIDESCENCE_THICKNESS
+            ),
+            (1, 1 << 2, 1 << 14)
+        );
+
+        let texture = |texture, texcoord| {
+            Some(TextureRef {
+                texcoord,
+                ..TextureRef::new(texture)
+            })
+        };
+        let rust = Material {
+            base_color_texture: texture(0, 0),
+            normal_texture: texture(1, 1),
+            iridescence_thickness_texture: texture(2, 1),
+            ..Material::default()
+        };
+        let c = MltMaterial::from(&rust);
+        assert_eq!(
+            c.texcoord1_slots,
+            MLT_TEXCOORD1_NORMAL | MLT_TEXCOORD1_IRIDESCENCE_THICKNESS
+        );
+        assert_eq!(material(&c, 0).unwrap(), rust);
+
+        // A bit of a slot without a texture is ignored, as its transform is.
+        let empty_slot = MltMaterial {
+            texcoord1_slots: c.texcoord1_slots | MLT_TEXCOORD1_EMISSION,
+            ..c
+        };
+        assert_eq!(material(&empty_slot, 0).unwrap(), rust);
+
+        // Bits past the last slot (the slots may grow to 30 before these are any).
+        let beyond = MltMaterial {
+            texcoord1_slots: MLT_TEXCOORD1_BASE_COLOR | 1 << 30 | 1 << 31,
+            ..c
+        };
+        assert_eq!(
+            material(&beyond, 3).unwrap_err().message,
+            format!(
+                "desc.materials[3].texcoord1_slots is 0xc0000001; bit 30 names no texture slot: \
+                 bits 0 (base_color_texture) to {} ({}) are the {} slots",
+                slots.len() - 1,
+                slots[slots.len() - 1],
+                slots.len()
+            )
+        );
+        let next = MltMaterial {
+            texcoord1_slots: 1 << slots.len(),
+            ..c
+        };
+        let message = material(&next, 0).unwrap_err().message;
+        assert!(
+            message.contains(&format!("bit {} names no texture slot", slots.len())),
+            "{message}"
+        );
+    }
 }

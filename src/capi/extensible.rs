@@ -199,12 +199,13 @@ impl Extensible for MltMaterial {
     const INITIALIZER: &'static str = "mlt_material_default";
     /// Before the metallic-roughness model and textures (mlt 0.2's header): 36 bytes; before
     /// the transmission texture (0.3's): 168; before the clear coat, the volume, specular and sheen (0.4's): 192;
-    /// before the anisotropy: 424.
+    /// before the anisotropy: 424; before the texture coordinate set 1 (0.6's): 520.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltMaterial, metallic),
         offset_of!(MltMaterial, transmission_texture),
         offset_of!(MltMaterial, clearcoat),
         offset_of!(MltMaterial, anisotropy),
+        offset_of!(MltMaterial, texcoord1_slots),
     ];
     fn defaults() -> Self {
         (&Material::default()).into()
@@ -219,6 +220,7 @@ impl From<&Material> for MltMaterial {
                 MltMaterial {
                     struct_size: size_of::<Self>() as u32,
                     $($name: d.$name.to_c(),)*
+                    texcoord1_slots: super::convert::texcoord1_slots(d),
                 }
             };
         }
@@ -298,11 +300,13 @@ impl Extensible for MltSceneDesc {
     const INITIALIZER: &'static str = "mlt_scene_desc_default";
     /// Before the lights besides emissive triangles (mlt 0.2's header, 80 bytes): no
     /// lights; before the surface attributes and textures (112 bytes): flat triangles, no
-    /// textures; before the build quality (208 bytes): the default quality.
+    /// textures; before the build quality (192 bytes): the default quality; before the
+    /// texture coordinate set 1 (200 bytes, 0.6's): none.
     const EARLIER_LAYOUTS: &'static [usize] = &[
         offset_of!(MltSceneDesc, environment),
         offset_of!(MltSceneDesc, normals),
         offset_of!(MltSceneDesc, build_quality),
+        offset_of!(MltSceneDesc, texcoords1),
     ];
     fn defaults() -> Self {
         MltSceneDesc {
@@ -331,6 +335,8 @@ impl Extensible for MltSceneDesc {
             textures: std::ptr::null(),
             textures_len: 0,
             build_quality: MLT_BUILD_QUALITY_HIGH,
+            texcoords1: std::ptr::null(),
+            texcoords1_len: 0,
         }
     }
 }
@@ -552,8 +558,8 @@ mod tests {
     #[test]
     #[cfg(target_pointer_width = "64")]
     fn earlier_layouts_have_the_sizes_of_the_older_headers() {
-        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 520]);
-        assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200]);
+        assert_eq!(sizes::<MltMaterial>(), [36, 168, 192, 424, 520, 524]);
+        assert_eq!(sizes::<MltSceneDesc>(), [80, 112, 192, 200, 216]);
         assert_eq!(sizes::<MltSceneInfo>(), [64, 80]);
         // Before the filter, before Russian roulette, before full_resolution_textures, today.
         assert_eq!(sizes::<MltRenderSettings>(), [104, 128, 136, 144]);

@@ -274,6 +274,8 @@ pub unsafe extern "C" fn mlt_scene_create(
         let normals = unsafe { host_slice(desc.normals, desc.normals_len, "desc.normals") }?;
         let texcoords =
             unsafe { host_slice(desc.texcoords, desc.texcoords_len, "desc.texcoords") }?;
+        let texcoords1 =
+            unsafe { host_slice(desc.texcoords1, desc.texcoords1_len, "desc.texcoords1") }?;
         let tangents = unsafe { host_slice(desc.tangents, desc.tangents_len, "desc.tangents") }?;
         let colors = unsafe { host_slice(desc.colors, desc.colors_len, "desc.colors") }?;
         let textures = unsafe { read_textures(desc.textures, desc.textures_len) }?;
@@ -294,7 +296,7 @@ pub unsafe extern "C" fn mlt_scene_create(
                 build_quality: build_quality(desc.build_quality)?,
                 normals,
                 texcoords,
-                texcoords1: &[],
+                texcoords1,
                 tangents,
                 colors,
                 textures: &textures,

@@ -6,7 +6,7 @@ use std::ffi::c_void;
 /// Major version of the mlt library this header belongs to.
 pub const MLT_VERSION_MAJOR: u32 = 0;
 /// Minor version.
-pub const MLT_VERSION_MINOR: u32 = 6;
+pub const MLT_VERSION_MINOR: u32 = 7;
 /// Patch version.
 pub const MLT_VERSION_PATCH: u32 = 0;
 /// The version as one number, MAJOR * 10000 + MINOR * 100 + PATCH, for `#if MLT_VERSION >= …`
@@ -39,6 +39,40 @@ pub const MLT_ALPHA_BLEND: i32 = 2;
 
 /// `MltTextureRef.texture` of a material slot without a texture.
 pub const MLT_NO_TEXTURE: i32 = -1;
+
+// The bits of `MltMaterial.texcoord1_slots`, one per texture slot in field order.
+// BEGIN GENERATED texcoord1 slots: tests/parameters.rs writes these lines from src/scene/material.rs
+/// `MltMaterial.texcoord1_slots`: `base_color_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_BASE_COLOR: u32 = 1 << 0;
+/// `MltMaterial.texcoord1_slots`: `metallic_roughness_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_METALLIC_ROUGHNESS: u32 = 1 << 1;
+/// `MltMaterial.texcoord1_slots`: `normal_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_NORMAL: u32 = 1 << 2;
+/// `MltMaterial.texcoord1_slots`: `emission_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_EMISSION: u32 = 1 << 3;
+/// `MltMaterial.texcoord1_slots`: `transmission_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_TRANSMISSION: u32 = 1 << 4;
+/// `MltMaterial.texcoord1_slots`: `clearcoat_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_CLEARCOAT: u32 = 1 << 5;
+/// `MltMaterial.texcoord1_slots`: `clearcoat_roughness_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_CLEARCOAT_ROUGHNESS: u32 = 1 << 6;
+/// `MltMaterial.texcoord1_slots`: `clearcoat_normal_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_CLEARCOAT_NORMAL: u32 = 1 << 7;
+/// `MltMaterial.texcoord1_slots`: `specular_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_SPECULAR: u32 = 1 << 8;
+/// `MltMaterial.texcoord1_slots`: `specular_color_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_SPECULAR_COLOR: u32 = 1 << 9;
+/// `MltMaterial.texcoord1_slots`: `sheen_color_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_SHEEN_COLOR: u32 = 1 << 10;
+/// `MltMaterial.texcoord1_slots`: `sheen_roughness_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_SHEEN_ROUGHNESS: u32 = 1 << 11;
+/// `MltMaterial.texcoord1_slots`: `anisotropy_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_ANISOTROPY: u32 = 1 << 12;
+/// `MltMaterial.texcoord1_slots`: `iridescence_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_IRIDESCENCE: u32 = 1 << 13;
+/// `MltMaterial.texcoord1_slots`: `iridescence_thickness_texture` reads texture coordinate set 1.
+pub const MLT_TEXCOORD1_IRIDESCENCE_THICKNESS: u32 = 1 << 14;
+// END GENERATED texcoord1 slots
 
 /// `MltTexture.texel_type`: 8-bit values (`uint8_t`), 255 meaning 1, decoded by `encoding`.
 pub const MLT_TEXEL_U8: i32 = 0;
@@ -157,7 +191,8 @@ pub struct MltTextureRef {
 /// A material. Initialize with `mlt_material_default`.
 ///
 /// Textures are looked up at the surface's texture coordinates (`MltSceneDesc.texcoords`,
-/// which a scene with a textured material must have), each through its `MltTextureRef`:
+/// which a scene with a textured material must have, or `MltSceneDesc.texcoords1` for the
+/// slots whose bit of `texcoord1_slots` is set), each through its `MltTextureRef`:
 /// `base_color_texture` multiplies `color` (RGB) and `alpha` (A) for every kind;
 /// `metallic_roughness_texture` multiplies `roughness` by its green channel and `metallic`
 /// by its blue one (glTF's packing; red is unused); `normal_texture` is a tangent-space
@@ -332,6 +367,11 @@ pub struct MltMaterial {
     /// maximum (1) (KHR_materials_iridescence's iridescenceThicknessTexture); usually linear. An
     /// index into `MltSceneDesc.textures` and its transform. Default `MLT_NO_TEXTURE` (-1).
     pub iridescence_thickness_texture: MltTextureRef,
+    /// The texture slots that read texture coordinate set 1 (`MltSceneDesc.texcoords1`, glTF's
+    /// texCoord 1) instead of set 0: bit i is the i-th texture slot in field order,
+    /// `MLT_TEXCOORD1_<SLOT>` (`MLT_TEXCOORD1_BASE_COLOR` is bit 0). A bit past the last slot is
+    /// refused; a bit of a slot without a texture is ignored. Default 0: every slot reads set 0.
+    pub texcoord1_slots: u32,
     // END GENERATED material
 }
 
@@ -529,6 +569,14 @@ pub struct MltSceneDesc {
     /// One of `MLT_BUILD_QUALITY_*` (the default, 0, is `MLT_BUILD_QUALITY_HIGH`): how much
     /// work the acceleration structure's build spends for faster rays.
     pub build_quality: i32,
+    // A header before the texture coordinate set 1 ends the struct here: such a host's
+    // textures read set 0.
+    /// Per-vertex texture coordinate set 1 (glTF's `TEXCOORD_1`), u v per vertex as
+    /// `texcoords`, or NULL with 0 (the default). Read by the texture slots whose bit of
+    /// `MltMaterial.texcoord1_slots` is set, which need it.
+    pub texcoords1: *const f32,
+    /// Number of floats in `texcoords1`: 0 or 2 × the vertex count.
+    pub texcoords1_len: usize,
 }
 
 /// A perspective camera. Image right is normalize(cross(target - eye, up)). Initialize with

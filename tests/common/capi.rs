@@ -569,11 +569,16 @@ pub fn earlier_size<T>(first_missing: usize) -> u32 {
     first_missing.next_multiple_of(align_of::<T>()) as u32
 }
 
-/// Sizes no header ever had: never initialized, too small, between layouts (4 short of
-/// today's: a layout ends at a multiple of the alignment, and the last two may be only 8
-/// apart), from the future.
+/// Sizes no header ever had: never initialized, too small, between layouts (2 short of
+/// today's: a layout's size is a multiple of the alignment, at least 4, and the last two may
+/// be only 4 apart), from the future.
 pub fn unknown_sizes<T>() -> [usize; 4] {
-    [0, 3, size_of::<T>() - 4, size_of::<T>() + 8]
+    unknown_sizes_of(size_of::<T>())
+}
+
+/// [`unknown_sizes`] of a struct of `size` bytes.
+pub fn unknown_sizes_of(size: usize) -> [usize; 4] {
+    [0, 3, size - 2, size + 8]
 }
 
 /// The Cornell box at 8 × 8: every pixel sees a lit surface.
@@ -630,8 +635,8 @@ pub fn assert_initializers_refuse_null_and_unknown_sizes(
 ) {
     let mut results = Vec::new();
     for &(name, size, init) in initializers {
-        // Holds any size tried (size + 8 < 512 - 8 for every struct).
-        let mut storage = [0xABu8; 512];
+        // Holds any size tried (size + 8 < 1024 - 8 for every struct).
+        let mut storage = [0xABu8; 1024];
         let aligned = storage
             .as_mut_ptr()
             .wrapping_add(storage.as_ptr().align_offset(8));
@@ -640,7 +645,8 @@ pub fn assert_initializers_refuse_null_and_unknown_sizes(
             format!("{name}: out NULL"),
             check_error(status, MLT_STATUS_INVALID_ARGUMENT, &["out", "NULL"]),
         ));
-        for bad in [0, 3, size - 4, size + 8] {
+        assert!(size + 8 < storage.len() - 8, "{name}: storage too small");
+        for bad in unknown_sizes_of(size) {
             let status = init(aligned, bad);
             let needles = ["out.struct_size", &bad.to_string(), name];
             let result = check_error(status, MLT_STATUS_INVALID_ARGUMENT, &needles)
