@@ -1893,7 +1893,10 @@ mod tests {
     }
 
     /// Reflection is reciprocal, and transmission's importance mode is radiance's adjoint:
-    /// f_importance(wo, wi) = f_radiance(wi, wo); both modes agree on reflection.
+    /// f_importance(wo, wi) = f_radiance(wi, wo); both modes agree on reflection. To 2e-4
+    /// relative (f32 rounding leaves at most 2.2e-5 at this seed, and four others pass): a
+    /// factor read at a different cosine in one mode (an albedo table, a Fresnel term) or
+    /// an η² off would show.
     #[test]
     fn reflection_is_reciprocal_and_transmission_adjoint() {
         let n = normal();
@@ -1911,12 +1914,12 @@ mod tests {
                 let forward = m.eval(n, wo, wi, TransportMode::Radiance);
                 let adjoint = m.eval(n, wi, wo, TransportMode::Importance);
                 assert!(
-                    close(forward, adjoint, 5e-3),
+                    close(forward, adjoint, 2e-4),
                     "{m:?} {wo} {wi}: {forward} {adjoint}"
                 );
                 if wo.dot(n) * wi.dot(n) > 0.0 {
                     let reversed = m.eval(n, wi, wo, TransportMode::Radiance);
-                    assert!(close(forward, reversed, 5e-3), "{m:?} {wo} {wi}");
+                    assert!(close(forward, reversed, 2e-4), "{m:?} {wo} {wi}");
                 }
             }
         }
