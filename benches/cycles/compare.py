@@ -38,7 +38,7 @@ Run from the repository root (mlt-render from $CARGO_TARGET_DIR, else target/):
 
     nice -n 10 target/cycles-venv/bin/python benches/cycles/compare.py [--spp 64] [--size 128]
         [--depth 8] [--sky pedestrian_overpass] [--sky-rotate 0] [--threads 2]
-        [--assets ClearCoatTest,SheenCloth,...] [--no-docs]
+        [--assets ClearCoatTest,SheenCloth,...] [--flat-normals] [--no-docs]
 
 Defaults: 128 x 128, 64 spp, depth 8 (scattering vertices; Cycles' bounces are one fewer),
 the soft pedestrian_overpass sky, 2 threads each.
@@ -127,6 +127,39 @@ def features_of(path):
     features += [f"alpha {mode}" for mode in
                  sorted({m.get("alphaMode", "OPAQUE") for m in materials} - {"OPAQUE"})]
     return ", ".join(features) if features else "—"
+
+
+def without_normal_maps(path, directory):
+    """A copy of the asset in `directory` without its normal maps (`normalTexture`, and
+    `KHR_materials_clearcoat`'s `clearcoatNormalTexture`), for both renderers: how much of a
+    difference the normal maps make (`--flat-normals`). Returns the copy's path."""
+    document = gltf_json(path)
+    for material in document.get("materials", []):
+        material.pop("normalTexture", None)
+        material.get("extensions", {}).get("KHR_materials_clearcoat", {}).pop(
+            "clearcoatNormalTexture", None)
+    name, extension = os.path.splitext(os.path.basename(path))
+    copy = os.path.join(directory, name + "_flat" + extension)
+    if extension == ".gltf":
+        # Files beside the original, reached from the copy's folder.
+        for item in document.get("buffers", []) + document.get("images", []):
+            uri = item.get("uri")
+            if uri and not uri.startswith("data:"):
+                item["uri"] = os.path.relpath(os.path.join(os.path.dirname(path), uri),
+                                              directory)
+        with open(copy, "w") as f:
+            json.dump(document, f)
+        return copy
+    with open(path, "rb") as f:
+        data = f.read()
+    length = struct.unpack_from("<I", data, 12)[0]
+    chunk = json.dumps(document).encode()
+    chunk += b" " * (-len(chunk) % 4)
+    rest = data[20 + length :]
+    header = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(chunk) + len(rest))
+    with open(copy, "wb") as f:
+        f.write(header + struct.pack("<II", len(chunk), 0x4E4F534A) + chunk + rest)
+    return copy
 
 
 # ---------------------------------------------------------------- frames and cameras
@@ -818,6 +851,8 @@ def sky_check(args, sky, directory):
 
 def run_asset(args, name, sky, directory):
     scene = asset_file(name)
+    if args.flat_normals:
+        scene = without_normal_maps(scene, directory)
     reset_blender()
     setup_cycles(args, transparent=True)
     setup_world(sky, args.sky_rotate)
@@ -1050,6 +1085,9 @@ def main():
     parser.add_argument("--spec-tint", action="store_true",
                         help="square transmissive base colours in Cycles (see "
                              "squared_transmission_tint); for a look, with --no-docs")
+    parser.add_argument("--flat-normals", action="store_true",
+                        help="render copies of the assets without their normal maps (see "
+                             "without_normal_maps); for a look, with --no-docs")
     parser.add_argument("--no-docs", dest="docs", action="store_false",
                         help="print the tables only; leave docs/ alone")
     args = parser.parse_args()
