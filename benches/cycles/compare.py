@@ -22,7 +22,8 @@ everything after. Then, per asset, over the pixels the model covers (Cycles' alp
   covered.
 Furnaces show single lobes where Cycles departs from the specification, or where a
 block's difference needs one: sheen alone, the transmission's tint through a closed
-object, anisotropy alone, and a specular colour of 0.
+object, anisotropy alone, a specular colour of 0, and a normal-mapped square (with the
+assets that have normal maps rendered again without them).
 An asset mlt refuses (an unsupported required extension, say) is reported as refused, with
 mlt's message; the other assets go on. Numbers are reported, never asserted: a bench, not a
 test. It writes docs/cycles.md (the table and the images) and docs/images/cycles/NAME.png
@@ -38,7 +39,7 @@ Run from the repository root (mlt-render from $CARGO_TARGET_DIR, else target/):
 
     nice -n 10 target/cycles-venv/bin/python benches/cycles/compare.py [--spp 64] [--size 128]
         [--depth 8] [--sky pedestrian_overpass] [--sky-rotate 0] [--threads 2]
-        [--assets ClearCoatTest,SheenCloth,...] [--no-docs]
+        [--assets ClearCoatTest,SheenCloth,...] [--flat-normals] [--no-docs]
 
 Defaults: 128 x 128, 64 spp, depth 8 (scattering vertices; Cycles' bounces are one fewer),
 the soft pedestrian_overpass sky, 2 threads each.
@@ -127,6 +128,39 @@ def features_of(path):
     features += [f"alpha {mode}" for mode in
                  sorted({m.get("alphaMode", "OPAQUE") for m in materials} - {"OPAQUE"})]
     return ", ".join(features) if features else "—"
+
+
+def without_normal_maps(path, directory):
+    """A copy of the asset in `directory` without its normal maps (`normalTexture`, and
+    `KHR_materials_clearcoat`'s `clearcoatNormalTexture`), for both renderers: how much of a
+    difference the normal maps make (`--flat-normals`). Returns the copy's path."""
+    document = gltf_json(path)
+    for material in document.get("materials", []):
+        material.pop("normalTexture", None)
+        material.get("extensions", {}).get("KHR_materials_clearcoat", {}).pop(
+            "clearcoatNormalTexture", None)
+    name, extension = os.path.splitext(os.path.basename(path))
+    copy = os.path.join(directory, name + "_flat" + extension)
+    if extension == ".gltf":
+        # Files beside the original, reached from the copy's folder.
+        for item in document.get("buffers", []) + document.get("images", []):
+            uri = item.get("uri")
+            if uri and not uri.startswith("data:"):
+                item["uri"] = os.path.relpath(os.path.join(os.path.dirname(path), uri),
+                                              directory)
+        with open(copy, "w") as f:
+            json.dump(document, f)
+        return copy
+    with open(path, "rb") as f:
+        data = f.read()
+    length = struct.unpack_from("<I", data, 12)[0]
+    chunk = json.dumps(document).encode()
+    chunk += b" " * (-len(chunk) % 4)
+    rest = data[20 + length :]
+    header = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(chunk) + len(rest))
+    with open(copy, "wb") as f:
+        f.write(header + struct.pack("<II", len(chunk), 0x4E4F534A) + chunk + rest)
+    return copy
 
 
 # ---------------------------------------------------------------- frames and cameras
@@ -778,6 +812,194 @@ def furnace_table(rows):
     return "\n".join(lines)
 
 
+# ---------------------------------------------------------------- a normal-mapped square
+
+
+# The tilts of the normal map's single texel, and the turns of the square about the vertical
+# axis (the view's angle to the geometric normal; positive: the map tilts the normal
+# further from the view, negative: towards it).
+NORMAL_MAP_TILTS = (30.0, 60.0)
+NORMAL_MAP_TURNS = (0.0, 20.0, -20.0, 45.0, -45.0)
+# (label, glTF material without its normal texture) of the normal-mapped squares.
+NORMAL_MAP_MATERIALS = (
+    ("white metal, roughness 0.3",
+     {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 1,
+                               "roughnessFactor": 0.3}}),
+    # KHR_materials_specular's factor 0: no specular layer, Lambert alone.
+    ("white diffuse",
+     {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0,
+                               "roughnessFactor": 1},
+      "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}),
+)
+
+
+def normal_texel(tilt_deg):
+    """The 8-bit texel of a tangent-space normal tilted by `tilt_deg` towards the tangent,
+    and the unit normal it decodes to."""
+    t = math.radians(tilt_deg)
+    texel = [round((c + 1) / 2 * 255) for c in (math.sin(t), 0.0, math.cos(t))]
+    normal = np.array([c / 255 * 2 - 1 for c in texel])
+    return texel, normal / np.linalg.norm(normal)
+
+
+def square_gltf(path, material, texel, turn_deg):
+    """A single-sided square [-1, 1]² facing +Z, turned by `turn_deg` about +Y (towards +X),
+    texture coordinates u along +X (so its MikkTSpace tangent is +X), with glTF material
+    `material` and a normal texture of the single `texel`."""
+    image = np.array(texel, np.uint8)[None, None, :].repeat(4, 0).repeat(4, 1)
+    png = iio.imwrite("<bytes>", image, extension=".png")
+    positions = struct.pack("<12f", -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0)
+    normals = struct.pack("<12f", *([0, 0, 1] * 4))
+    uvs = struct.pack("<8f", 0, 1, 1, 1, 1, 0, 0, 0)
+    indices = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    data = positions + normals + uvs + indices
+    half = math.radians(turn_deg) / 2
+    material = dict(material, normalTexture={"index": 0})
+    document = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": sorted(material.get("extensions", {})),
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "rotation": [0, math.sin(half), 0, math.cos(half)]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1,
+                                                   "TEXCOORD_0": 2},
+                                    "indices": 3, "material": 0}]}],
+        "materials": [material],
+        "samplers": [{"magFilter": 9728, "minFilter": 9728}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 96, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 128, "byteLength": 12},
+        ],
+        "buffers": [{"byteLength": len(data),
+                     "uri": "data:application/octet-stream;base64,"
+                            + base64.b64encode(data).decode()}],
+    }
+    with open(path, "w") as f:
+        json.dump(document, f)
+
+
+def frame_of(normal):
+    """Two unit vectors completing `normal` to a right-handed orthonormal frame."""
+    helper = np.array([1.0, 0, 0]) if abs(normal[0]) < 0.9 else np.array([0, 1.0, 0])
+    x = np.cross(helper, normal)
+    x /= np.linalg.norm(x)
+    return x, np.cross(normal, x)
+
+
+def normal_mapped_albedo(metal, wo, ns, ng, above_geometric, n=512):
+    """What a white sky of radiance 1 gives, seen from `wo`, on a surface whose
+    specification BRDF scatters about shading normal `ns`: ∫ f(wo, wi) (wi·ns) dwi over the
+    directions above ns, and with `above_geometric` only over those also above geometric
+    normal `ng` (Veach's rule: light from below the surface does not reach it). Where `wo`
+    is below ns, about -ns (mlt's model is two-sided: it scatters into the side of ns the
+    view is on). `metal`: white GGX metal of roughness 0.3 (F = 1, height-correlated
+    Smith masking), integrated over the half vectors; else Lambert of albedo 1. Midpoint
+    rule."""
+    if wo @ ns < 0:
+        ns = -ns
+    cos_o = wo @ ns
+    x, y = frame_of(ns)
+    theta = (np.arange(n) + 0.5) * (math.pi / 2) / n
+    phi = (np.arange(4 * n) + 0.5) * (2 * math.pi) / (4 * n)
+    theta, phi = np.meshgrid(theta, phi, indexing="ij")
+    local = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi),
+                      np.cos(theta)])
+    w = (x[:, None, None] * local[0] + y[:, None, None] * local[1]
+         + ns[:, None, None] * local[2])
+    area = np.sin(theta) * (math.pi / 2 / n) * (2 * math.pi / (4 * n))
+    if not metal:
+        keep = (np.einsum("i,ijk->jk", ng, w) > 0) if above_geometric else True
+        return float((np.where(keep, local[2], 0.0) / math.pi * area).sum())
+    alpha2 = 0.3 ** 4
+    h, cos_h = w, local[2]
+    d = alpha2 / (math.pi * (cos_h ** 2 * (alpha2 - 1) + 1) ** 2)
+    cos_oh = np.einsum("i,ijk->jk", wo, h)
+    wi = 2 * cos_oh * h - wo[:, None, None]
+    cos_i = np.einsum("i,ijk->jk", ns, wi)
+    keep = (cos_oh > 0) & (cos_i > 0)
+    if above_geometric:
+        keep &= np.einsum("i,ijk->jk", ng, wi) > 0
+
+    def lam(cos):
+        cos = np.clip(cos, 1e-6, 1.0)
+        return (np.sqrt(1 + alpha2 * (1 - cos ** 2) / cos ** 2) - 1) / 2
+
+    g2 = 1 / (1 + lam(cos_o) + lam(cos_i))
+    return float((np.where(keep, d * g2 * cos_oh / cos_o, 0.0) * area).sum())
+
+
+def normal_map_furnace(args, directory):
+    """Rows (material, tilt, turn, wo·ns, shading hemisphere, Veach, Cycles, mlt or its
+    error) for a flat single-sided square whose normal map is one texel tilting the normal
+    by a known angle, turned about the vertical axis and seen along -Z from far away,
+    under a white sky of radiance 1 (over the pixels the square covers fully)."""
+    camera = {"eye": [0.0, 0.0, 100.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 1.0, 0.0],
+              "fov_y_deg": 2 * math.degrees(math.atan(1.04 / 100.0)), "width": args.size,
+              "height": args.size}
+    wo = np.array([0.0, 0.0, 1.0])
+    rows = []
+    for label, material in NORMAL_MAP_MATERIALS:
+        metal = material["pbrMetallicRoughness"]["metallicFactor"] == 1
+        for tilt in NORMAL_MAP_TILTS:
+            texel, local_normal = normal_texel(tilt)
+            for turn in NORMAL_MAP_TURNS:
+                name = f"normal_map_{'metal' if metal else 'diffuse'}_{tilt:.0f}_{turn:.0f}"
+                scene = os.path.join(directory, name + ".gltf")
+                square_gltf(scene, material, texel, turn)
+                theirs, ours, error = furnace_renders(args, directory, name, scene, camera)
+                covered = theirs[..., 3] >= 0.999
+                # The square's frame turned about +Y: tangent, bitangent and normal.
+                t = math.radians(turn)
+                ng = np.array([math.sin(t), 0.0, math.cos(t)])
+                tangent = np.array([math.cos(t), 0.0, -math.sin(t)])
+                ns = local_normal[0] * tangent + local_normal[2] * ng
+                mlt = (f"{luminance(ours)[covered].mean():.3f}" if ours is not None
+                       else error)
+                # The specification's BRDF has no value for a view below the normal.
+                rows.append((label, tilt, turn, float(wo @ ns),
+                             normal_mapped_albedo(metal, wo, ns, ng, False)
+                             if wo @ ns > 0 else None,
+                             normal_mapped_albedo(metal, wo, ns, ng, True),
+                             luminance(theirs)[covered].mean(), mlt))
+    return rows
+
+
+def normal_map_table(rows):
+    lines = ["| material | tilt | view to ng | the map tilts the normal | wo·ns | "
+             "over ns's hemisphere | Veach: also above ng | Cycles | mlt |",
+             "|---|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for label, tilt, turn, cos_o, hemisphere, veach, cycles, mlt in rows:
+        way = "—" if turn == 0 else ("away from the view" if turn > 0 else "towards the view")
+        hemisphere = "—" if hemisphere is None else f"{hemisphere:.3f}"
+        lines.append(f"| {label} | {tilt:.0f}° | {abs(turn):.0f}° | {way} | {cos_o:.3f} | "
+                     f"{hemisphere} | {veach:.3f} | {cycles:.3f} | {mlt} |")
+    return "\n".join(lines)
+
+
+def flat_table(pairs):
+    lines = ["| asset | mean luminance | worst 16×16 block | without normal maps: mean | "
+             "worst block |",
+             "|---|---:|---:|---:|---:|"]
+    for with_maps, without in pairs:
+        def cell(r, key):
+            return "—" if r.get(key) is None else f"{r[key]:.3f}"
+        lines.append(f"| {with_maps['name']} | {cell(with_maps, 'mean')} | "
+                     f"{cell(with_maps, 'worst')} | {cell(without, 'mean')} | "
+                     f"{cell(without, 'worst')} |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- the runs
 
 
@@ -816,8 +1038,18 @@ def sky_check(args, sky, directory):
     return rows
 
 
-def run_asset(args, name, sky, directory):
+def has_normal_maps(path):
+    return any("normalTexture" in m or "clearcoatNormalTexture"
+               in json.dumps(m.get("extensions", {}))
+               for m in gltf_json(path).get("materials", []))
+
+
+def run_asset(args, name, sky, directory, flat=False):
+    """Renders asset `name` with both renderers and compares them; `flat`: a copy without
+    its normal maps (and no picture)."""
     scene = asset_file(name)
+    if flat:
+        scene = without_normal_maps(scene, directory)
     reset_blender()
     setup_cycles(args, transparent=True)
     setup_world(sky, args.sky_rotate)
@@ -858,7 +1090,7 @@ def run_asset(args, name, sky, directory):
     if error is None:
         ours = read_exr(mlt_path)
         result["mean"], result["worst"] = compare(ours, composite, mask)
-        if args.docs:
+        if args.docs and not flat:
             side_by_side(os.path.join(args.images, name + ".png"), ours, composite, mask)
     return result
 
@@ -908,7 +1140,7 @@ def command_line(args):
 
 
 def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows, specular_rows,
-               seconds):
+               flat_results, normal_rows, seconds):
     images = os.path.relpath(args.images, os.path.join(ROOT, "docs"))
     lines = [
         "# mlt against Blender Cycles",
@@ -1021,6 +1253,43 @@ def write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows
             specular_table(specular_rows),
             "",
         ]
+    if normal_rows:
+        lines += [
+            "## Normal maps",
+            "",
+            "Where the conventions part: a normal map bends the shading normal ns away from the",
+            "geometric normal ng, and a direction can then be above one and below the other.",
+            "mlt follows Veach: the model scatters about ns (about −ns for a view below ns: its",
+            "model is two-sided), light from below the geometric surface does not reach it,",
+            "and a direction that is a reflection for one normal and a transmission for the",
+            "other scatters nothing. Cycles bends a glossy lobe's normal towards ng until the",
+            "view's mirror reflection is just above the surface (`ensure_valid_specular_reflection`,",
+            "for the Principled BSDF's specular, metallic, transmission and coat lobes), and",
+            "darkens a diffuse lobe by Estevez, Lecocq and Stein's shadowing term for bumped",
+            "normals (Smith's G1 of GGX with α² = tan²θ/8, θ the normal map's tilt, at the",
+            "light's angle to the unmapped normal; the furnace's 0.880 and 0.564 are that",
+            "term integrated). A rough or smooth glossy surface whose map tilts the normal",
+            "far from the view therefore shows the sky's horizon in Cycles where it reflects",
+            "below the surface, into itself, in mlt.",
+            "",
+            "The assets that have normal maps, rendered again from copies without them (both",
+            "renderers; `--flat-normals` does it for every asset):",
+            "",
+            flat_table(flat_results),
+            "",
+            "A flat single-sided square whose normal map is a single texel tilting the",
+            "normal by a known angle towards the tangent, turned about the vertical axis so",
+            "that the view makes a known angle with ng, under a white sky of radiance 1. The",
+            "reference columns integrate the specification's BRDF (the metal: GGX of",
+            "roughness 0.3, F = 1; the diffuse: Lambert, `KHR_materials_specular`'s factor 0)",
+            "times wi·ns over the directions above ns (what a rasteriser such as the Khronos",
+            "sample viewer shows; — where the view is below ns, where the BRDF has no value),",
+            "and over those also above ng (Veach's rule; about −ns where the view is below ns):",
+            "the last is what mlt's path tracer converges to.",
+            "",
+            normal_map_table(normal_rows),
+            "",
+        ]
     lines += [
         "## A thin film alone in a white furnace",
         "",
@@ -1046,10 +1315,13 @@ def main():
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--assets", default=",".join(DEFAULT_ASSETS))
     parser.add_argument("--no-furnace", dest="furnace", action="store_false",
-                        help="leave out the sphere of sheen alone in a white furnace")
+                        help="leave out the furnaces (and the assets again without normal maps)")
     parser.add_argument("--spec-tint", action="store_true",
                         help="square transmissive base colours in Cycles (see "
                              "squared_transmission_tint); for a look, with --no-docs")
+    parser.add_argument("--flat-normals", action="store_true",
+                        help="render copies of the assets without their normal maps (see "
+                             "without_normal_maps); for a look, with --no-docs")
     parser.add_argument("--no-docs", dest="docs", action="store_false",
                         help="print the tables only; leave docs/ alone")
     args = parser.parse_args()
@@ -1069,10 +1341,23 @@ def main():
     print(sky_table(sky_rows), flush=True)
     results = []
     for name in args.assets.split(","):
-        result = run_asset(args, name, sky, directory)
+        result = run_asset(args, name, sky, directory, flat=args.flat_normals)
         results.append(result)
         print(f"{name}: {result.get('mean', result['error'])}", flush=True)
     print(table(results), flush=True)
+    # What the normal maps change: each asset that has some, again without them.
+    flat_results = []
+    if args.furnace and not args.flat_normals:
+        for result in results:
+            if result["error"] is None and has_normal_maps(asset_file(result["name"])):
+                flat_results.append((result, run_asset(args, result["name"], sky, directory,
+                                                       flat=True)))
+        if flat_results:
+            print(flat_table(flat_results), flush=True)
+    normal_rows = normal_map_furnace(args, directory) if args.furnace else []
+    if normal_rows:
+        print("A normal-mapped square in a white furnace:")
+        print(normal_map_table(normal_rows), flush=True)
     furnace_rows = sheen_furnace(args, directory) if args.furnace else []
     if furnace_rows:
         print("Sheen alone in a white furnace, directional albedo:")
@@ -1093,7 +1378,7 @@ def main():
     print(f"{seconds:.0f} s in all")
     if args.docs:
         write_page(args, sky_rows, results, furnace_rows, tint_rows, anisotropy_rows,
-                   specular_rows, seconds)
+                   specular_rows, flat_results, normal_rows, seconds)
 
 
 if __name__ == "__main__":
