@@ -188,6 +188,11 @@ fn extensions_scene() -> Scene {
 /// between them whose rare bright paths the 16 renders' spread underestimates.) Path-space MLT and ERPT record at each such vertex which lobe the path scatters
 /// through (path_space/mod.rs, "Lobes").
 fn coated_box() -> mlt::Scene {
+    coated_box_mesh().scene()
+}
+
+/// The mesh of `coated_box`.
+fn coated_box_mesh() -> common::scenes::Mesh {
     let mut mesh = common::scenes::canonical_mesh("cornell-box");
     let coated = mesh.materials.len() as u32;
     mesh.materials
@@ -223,7 +228,7 @@ fn coated_box() -> mlt::Scene {
             _ => {}
         }
     }
-    mesh.scene()
+    mesh
 }
 
 /// `renders` independent renders of the coated box with `settings`.
@@ -276,6 +281,220 @@ fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
             &coated_estimate(settings, 16),
             &bdpt,
             4,
+            5.0,
+            6.0,
+        );
+    }
+}
+
+/// The coated box with the red wall under a smooth clear coat too (over a red non-metal of
+/// roughness 1), facing the coated green wall: paths bounce between the two coats' mirrors.
+fn facing_coats_box() -> mlt::Scene {
+    let mut mesh = coated_box_mesh();
+    let red_coat = mesh.materials.len() as u32;
+    mesh.materials.push(Material {
+        clearcoat: 1.0,
+        clearcoat_roughness: 0.0,
+        ..Material::metallic_roughness([0.63, 0.065, 0.05], 0.0, 1.0)
+    });
+    let is_red_wall =
+        |m: &Material| m.kind == mlt::MaterialKind::Diffuse && m.color[0] > 2.0 * m.color[1];
+    let mut red_triangles = 0;
+    for id in mesh.material_ids.iter_mut() {
+        if is_red_wall(&mesh.materials[*id as usize]) {
+            *id = red_coat;
+            red_triangles += 1;
+        }
+    }
+    assert_eq!(red_triangles, 2, "the red wall is two triangles");
+    mesh.scene()
+}
+
+/// Summary statistics of independent samples (the per-render means of one region).
+struct Spread {
+    mean: f64,
+    standard_error: f64,
+    skewness: f64,
+    /// The largest sample's excess over the mean, as a share of the sum of the samples.
+    largest_share: f64,
+}
+
+fn spread(samples: &[f64]) -> Spread {
+    let n = samples.len() as f64;
+    let mean = samples.iter().sum::<f64>() / n;
+    let moment = |k: i32| samples.iter().map(|v| (v - mean).powi(k)).sum::<f64>() / n;
+    let variance = moment(2) * n / (n - 1.0);
+    let largest = samples.iter().copied().fold(f64::MIN, f64::max);
+    Spread {
+        mean,
+        standard_error: (variance / n).sqrt(),
+        skewness: moment(3) / moment(2).powf(1.5),
+        largest_share: (largest - mean) / (n * mean),
+    }
+}
+
+/// Bootstrap of the difference of two sets of independent samples' means: its 0.05% and
+/// 99.95% quantiles (a 99.9% interval that does not assume normal means).
+fn bootstrap_interval(a: &[f64], b: &[f64], rounds: usize) -> (f64, f64) {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move |n: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % n as u64) as usize
+    };
+    let mut resample =
+        |s: &[f64]| (0..s.len()).map(|_| s[next(s.len())]).sum::<f64>() / s.len() as f64;
+    let mut differences: Vec<f64> = (0..rounds).map(|_| resample(a) - resample(b)).collect();
+    differences.sort_by(f64::total_cmp);
+    let at = |q: f64| differences[((q * rounds as f64) as usize).min(rounds - 1)];
+    (at(0.0005), at(0.9995))
+}
+
+/// Path-space MLT (both perturbations) and ERPT against BDPT on `facing_coats_box`, with
+/// many more renders than the suite's tests afford (`MLT_FACING_RENDERS`, default 96, at
+/// `MLT_FACING_MAX_DEPTH`, default 4, otherwise the settings of
+/// `path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats`). Prints, per algorithm, the
+/// image mean's ratio to BDPT, every 4 × 4 region's difference in combined standard errors
+/// (from the spread of the renders), and for the worst region the distribution of the
+/// per-render means (skewness, the largest render's share) and a bootstrap interval.
+#[test]
+#[ignore = "minutes: run by hand (see its doc comment)"]
+fn facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt() {
+    let variable = |name: &str, default: u64| {
+        std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
+    };
+    let renders = variable("MLT_FACING_RENDERS", 96);
+    let max_depth = variable("MLT_FACING_MAX_DEPTH", MAX_DEPTH as u64) as u32;
+    let scene = facing_coats_box();
+    let camera = canonical_camera("cornell-box");
+    const GRID: usize = 4;
+    let size = SIZE as usize;
+    // Per algorithm: its estimate and, per region and channel, the per-render means.
+    let run = |settings: RenderSettings| {
+        let settings = RenderSettings {
+            width: SIZE,
+            height: SIZE,
+            max_depth,
+            ..settings
+        };
+        let start = std::time::Instant::now();
+        let images: Vec<Vec<f32>> = (0..renders)
+            .map(|seed| {
+                let settings = RenderSettings {
+                    seed: 40_000 + seed,
+                    ..settings
+                };
+                render_image(&scene, &camera, &settings)
+            })
+            .collect();
+        eprintln!(
+            "{:?} (perturbing in sample space: {}): {renders} renders in {:.1} s",
+            settings.algorithm,
+            settings.perturb_in_sample_space,
+            start.elapsed().as_secs_f64()
+        );
+        let regions: Vec<Vec<[f64; 3]>> = images
+            .iter()
+            .map(|image| common::stats::region_means(image, size, size, GRID))
+            .collect();
+        let per_region: Vec<[Vec<f64>; 3]> = (0..GRID * GRID)
+            .map(|cell| std::array::from_fn(|c| regions.iter().map(|r| r[cell][c]).collect()))
+            .collect();
+        let whole: [Vec<f64>; 3] = std::array::from_fn(|c| {
+            images
+                .iter()
+                .map(|image| common::stats::mean(image)[c])
+                .collect()
+        });
+        (
+            Estimate::from_correlated_renders(size, size, &images),
+            per_region,
+            whole,
+        )
+    };
+    let (bdpt, bdpt_regions, bdpt_whole) = run(RenderSettings {
+        algorithm: Algorithm::Bdpt,
+        samples_per_pixel: 48,
+        ..Default::default()
+    });
+    let mut checked = Vec::new();
+    for (algorithm, perturb_in_sample_space) in [
+        (Algorithm::PathSpaceMlt, false),
+        (Algorithm::PathSpaceMlt, true),
+        (Algorithm::Erpt, false),
+    ] {
+        let (estimate, regions, whole) = run(RenderSettings {
+            algorithm,
+            perturb_in_sample_space,
+            samples_per_pixel: 40,
+            mutations_per_pixel: 64,
+            bootstrap_samples: 1 << 15,
+            chains: 256,
+            ..Default::default()
+        });
+        let label =
+            format!("{algorithm:?} (perturbing in sample space: {perturb_in_sample_space})");
+        for c in 0..3 {
+            let (a, b) = (spread(&whole[c]), spread(&bdpt_whole[c]));
+            let ratio = a.mean / b.mean;
+            let ratio_error = ratio
+                * ((a.standard_error / a.mean).powi(2) + (b.standard_error / b.mean).powi(2))
+                    .sqrt();
+            eprintln!(
+                "{label}: image channel {c}: ratio to BDPT {ratio:.4} ± {ratio_error:.4} ({:+.2} σ); skewness {:.2} (BDPT {:.2}), largest render's share {:.4} (BDPT {:.4})",
+                (ratio - 1.0) / ratio_error,
+                a.skewness,
+                b.skewness,
+                a.largest_share,
+                b.largest_share,
+            );
+        }
+        let mut worst = (0.0f64, 0, 0);
+        for cell in 0..GRID * GRID {
+            let row: Vec<String> = (0..3)
+                .map(|c| {
+                    let (a, b) = (spread(&regions[cell][c]), spread(&bdpt_regions[cell][c]));
+                    let t = (a.mean - b.mean)
+                        / (a.standard_error.powi(2) + b.standard_error.powi(2)).sqrt();
+                    if t.abs() > worst.0.abs() {
+                        worst = (t, cell, c);
+                    }
+                    format!("{t:+.2}")
+                })
+                .collect();
+            eprintln!(
+                "{label}: region ({}, {}): {} σ",
+                cell % GRID,
+                cell / GRID,
+                row.join(" ")
+            );
+        }
+        let (t, cell, c) = worst;
+        let (a, b) = (&regions[cell][c], &bdpt_regions[cell][c]);
+        let (sa, sb) = (spread(a), spread(b));
+        let (low, high) = bootstrap_interval(a, b, 20_000);
+        eprintln!(
+            "{label}: worst region ({}, {}) channel {c}: {t:+.2} σ; ratio to BDPT {:.4}, bootstrap 99.9% interval of the difference [{:+.4}, {:+.4}] of BDPT's mean; skewness {:.2} (BDPT {:.2}), largest render's share {:.4} (BDPT {:.4})",
+            cell % GRID,
+            cell / GRID,
+            sa.mean / sb.mean,
+            low / sb.mean,
+            high / sb.mean,
+            sa.skewness,
+            sb.skewness,
+            sa.largest_share,
+            sb.largest_share,
+        );
+        checked.push((label, estimate));
+    }
+    // Asserted after all are printed.
+    for (label, estimate) in checked {
+        assert_estimates_agree(
+            &format!("facing coats {label} against BDPT"),
+            &estimate,
+            &bdpt,
+            GRID,
             5.0,
             6.0,
         );
