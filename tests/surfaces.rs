@@ -365,13 +365,13 @@ fn bootstrap_interval(a: &[f64], b: &[f64], rounds: usize) -> (f64, f64) {
 /// -- --ignored --nocapture`, 16 minutes on two busy cores): the image means' ratios to
 /// BDPT are 0.9995–0.9998 ± 0.0004 (path-space MLT, both perturbations) and 0.9993 ± 0.0004
 /// (ERPT), within 1.6 σ: a 0.2% bias would show. No region of 48 (channels included) is
-/// beyond 2.2 σ (path-space MLT) or 2.5 σ (ERPT), with σ from 0.07% to 1.15% of the
-/// region's mean (path-space MLT; ERPT's up to 0.74%): a 2% bias of any but the noisiest
-/// regions would show. The per-render region means have skewness below 0.5 and no render
-/// carries more than 0.05% of a region's sum: no heavy tail. Over 32 groups of 16 renders
-/// the 16-render statistic exceeds 3 in 7–9 of 1536 comparisons per algorithm and 4 in at
-/// most one, as Student's t with 15 to 30 degrees of freedom predicts (0.5–0.9%, 0.04–0.12%),
-/// and never 6: the suite's tolerances hold here.
+/// beyond 2.2 σ (path-space MLT) or 2.5 σ (ERPT); a region's σ is typically 0.45% of its
+/// mean for path-space MLT (0.07–1.15%) and 0.23% for ERPT (0.07–0.74%), so a bias of 2%
+/// (1%) in a typical region would show. The worst regions' per-render means have skewness
+/// below 0.5 and their largest exceeds their mean by about a fifth at most: no heavy tail.
+/// Over 32 groups of 16 renders the suite's 16-render statistic exceeds 3 in 7–9 of 1536
+/// comparisons per algorithm and 4 in at most one, as Student's t with 15 to 30 degrees of
+/// freedom predicts (0.5–0.9%, 0.04–0.12%), and never 6: the suite's tolerances hold here.
 #[test]
 #[ignore = "minutes: run by hand (see its doc comment)"]
 fn facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt() {
