@@ -186,9 +186,10 @@ fn extensions_scene() -> Scene {
 /// diffuse base and a rough reflection), the green one over a green metal of roughness 0.3.
 /// Path-space MLT and ERPT record at each such vertex which lobe the path scatters through
 /// (path_space/mod.rs, "Lobes"). The red wall is left uncoated: with it coated too, facing
-/// the green one, they agree as well over hundreds of renders, but mirror-to-mirror paths
-/// skew the per-render region means, so 16 renders' spread can understate the error (6.4 σ
-/// once, without the back wall's coat): `facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt`.
+/// the green one, they agree as well over hundreds of renders, but (with the back wall
+/// uncoated) mirror-to-mirror paths skew the per-render region means, so 16 renders' spread
+/// can understate the error (6.4 σ at these seeds; see
+/// `facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt`).
 fn coated_box() -> mlt::Scene {
     coated_box_mesh().scene()
 }
