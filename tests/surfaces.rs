@@ -181,21 +181,13 @@ fn extensions_scene() -> Scene {
 /// The Cornell box with smooth coats over its blocks (metallic-roughness at roughness 0,
 /// non-metal): the short block's over a red diffuse base, the tall block's over a base
 /// half diffuse and half transmissive (Dirac reflection and refraction beside the diffuse
-/// lobe), and the floor's over its white base. Two walls have smooth clear coats (a Dirac
+/// lobe), and the floor's over its white base. The walls have smooth clear coats (a Dirac
 /// lobe beside the base's): the back one over a white non-metal of roughness 1 (its
-/// diffuse base and a rough reflection), the green one over a green metal of roughness 0.3.
-/// Path-space MLT and ERPT record at each such vertex which lobe the path scatters through
-/// (path_space/mod.rs, "Lobes"). The red wall is left uncoated: with it coated too, facing
-/// the green one, they agree as well over hundreds of renders, but (with the back wall
-/// uncoated) mirror-to-mirror paths skew the per-render region means, so 16 renders' spread
-/// can understate the error (6.4 σ at these seeds; see
-/// `facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt`).
+/// diffuse base and a rough reflection), the green one over a green metal of roughness 0.3,
+/// and the red one, facing it, over a red non-metal of roughness 1, so that paths also
+/// bounce between two coats' mirrors. Path-space MLT and ERPT record at each such vertex
+/// which lobe the path scatters through (path_space/mod.rs, "Lobes").
 fn coated_box() -> mlt::Scene {
-    coated_box_mesh().scene()
-}
-
-/// The mesh of `coated_box`.
-fn coated_box_mesh() -> common::scenes::Mesh {
     let mut mesh = common::scenes::canonical_mesh("cornell-box");
     let coated = mesh.materials.len() as u32;
     mesh.materials
@@ -221,17 +213,23 @@ fn coated_box_mesh() -> common::scenes::Mesh {
         1.0,
         0.3,
     )));
+    mesh.materials.push(clear_coat(Material::metallic_roughness(
+        [0.63, 0.065, 0.05],
+        0.0,
+        1.0,
+    )));
     for (triangle, material) in mesh.material_ids.iter_mut().enumerate() {
         match triangle {
             0..2 => *material = coated + 2,
             4..6 => *material = coated + 3,
             6..8 => *material = coated + 4,
+            8..10 => *material = coated + 5,
             10..20 => *material = coated,
             20..30 => *material = coated + 1,
             _ => {}
         }
     }
-    mesh
+    mesh.scene()
 }
 
 /// `renders` independent renders of the coated box with `settings`.
@@ -252,16 +250,21 @@ fn coated_estimate(settings: RenderSettings, renders: u64) -> Estimate {
 
 /// Path-space MLT (its perturbations turning directions, and stepping them in their
 /// samplings' coordinates) and ERPT agree with BDPT on smooth coats over diffuse and
-/// transmissive bases, and on smooth clear coats over a rough non-metal and a metal.
+/// transmissive bases, and on smooth clear coats over a rough non-metal and a metal, two of
+/// them facing each other. 16 renders each; `MLT_COATED_RENDERS` asks for more (over 512,
+/// the image means were within 0.07% of BDPT's at σ 0.04%, every region within 2.7 σ, and
+/// the per-render region means not skewed: the mirror-to-mirror paths have no heavy tail
+/// that 16 renders would miss).
 #[test]
 fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
+    let renders = std::env::var("MLT_COATED_RENDERS").map_or(16, |v| v.parse().expect("a count"));
     let bdpt = coated_estimate(
         RenderSettings {
             algorithm: Algorithm::Bdpt,
             samples_per_pixel: 48,
             ..Default::default()
         },
-        16,
+        renders,
     );
     for (algorithm, perturb_in_sample_space) in [
         (Algorithm::PathSpaceMlt, false),
@@ -281,311 +284,9 @@ fn path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats() {
             &format!(
                 "coated box {algorithm:?} (perturbing in sample space: {perturb_in_sample_space}) against BDPT"
             ),
-            &coated_estimate(settings, 16),
+            &coated_estimate(settings, renders),
             &bdpt,
             4,
-            5.0,
-            6.0,
-        );
-    }
-}
-
-/// The coated box with the red wall under a smooth clear coat too (over a red non-metal of
-/// roughness 1), facing the coated green wall: paths bounce between the two coats' mirrors.
-/// With `MLT_FACING_BACK_UNCOATED` set, the back wall is left white and diffuse.
-fn facing_coats_box() -> mlt::Scene {
-    let mut mesh = coated_box_mesh();
-    let red_coat = mesh.materials.len() as u32;
-    mesh.materials.push(Material {
-        clearcoat: 1.0,
-        clearcoat_roughness: 0.0,
-        ..Material::metallic_roughness([0.63, 0.065, 0.05], 0.0, 1.0)
-    });
-    let is_red_wall =
-        |m: &Material| m.kind == mlt::MaterialKind::Diffuse && m.color[0] > 2.0 * m.color[1];
-    let mut red_triangles = 0;
-    for id in mesh.material_ids.iter_mut() {
-        if is_red_wall(&mesh.materials[*id as usize]) {
-            *id = red_coat;
-            red_triangles += 1;
-        }
-    }
-    assert_eq!(red_triangles, 2, "the red wall is two triangles");
-    if std::env::var_os("MLT_FACING_BACK_UNCOATED").is_some() {
-        // The back wall (triangles 4 and 5, as in `coated_box_mesh`) white and diffuse again.
-        let plain = common::scenes::canonical_mesh("cornell-box");
-        mesh.material_ids[4..6].copy_from_slice(&plain.material_ids[4..6]);
-    }
-    mesh.scene()
-}
-
-/// Summary statistics of independent samples (the per-render means of one region).
-struct Spread {
-    mean: f64,
-    standard_error: f64,
-    skewness: f64,
-    /// The largest sample's excess over the mean, as a share of the sum of the samples.
-    largest_share: f64,
-}
-
-fn spread(samples: &[f64]) -> Spread {
-    let n = samples.len() as f64;
-    let mean = samples.iter().sum::<f64>() / n;
-    let moment = |k: i32| samples.iter().map(|v| (v - mean).powi(k)).sum::<f64>() / n;
-    let variance = moment(2) * n / (n - 1.0);
-    let largest = samples.iter().copied().fold(f64::MIN, f64::max);
-    Spread {
-        mean,
-        standard_error: (variance / n).sqrt(),
-        skewness: moment(3) / moment(2).powf(1.5),
-        largest_share: (largest - mean) / (n * mean),
-    }
-}
-
-/// Bootstrap of the difference of two sets of independent samples' means: its 0.05% and
-/// 99.95% quantiles (a 99.9% interval that does not assume normal means).
-fn bootstrap_interval(a: &[f64], b: &[f64], rounds: usize) -> (f64, f64) {
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move |n: usize| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % n as u64) as usize
-    };
-    let mut resample =
-        |s: &[f64]| (0..s.len()).map(|_| s[next(s.len())]).sum::<f64>() / s.len() as f64;
-    let mut differences: Vec<f64> = (0..rounds).map(|_| resample(a) - resample(b)).collect();
-    differences.sort_by(f64::total_cmp);
-    let at = |q: f64| differences[((q * rounds as f64) as usize).min(rounds - 1)];
-    (at(0.0005), at(0.9995))
-}
-
-/// Path-space MLT (both perturbations) and ERPT against BDPT on `facing_coats_box`, with
-/// many more renders than the suite's tests afford (`MLT_FACING_RENDERS`, default 96, at
-/// `MLT_FACING_MAX_DEPTH`, default 4, otherwise the settings and seeds of
-/// `path_space_mlt_and_erpt_agree_with_bdpt_on_smooth_coats`). Prints, per algorithm, the
-/// image mean's ratio to BDPT, every 4 × 4 region's difference in combined standard errors
-/// (from the spread of the renders), for the worst region the distribution of the
-/// per-render means (skewness, the largest render's share) and a bootstrap interval, and
-/// the suite's 16-render statistic over consecutive groups of 16 renders.
-///
-/// Measured (`MLT_FACING_RENDERS=512 cargo test --test surfaces facing_clear_coats
-/// -- --ignored --nocapture`, 16 minutes on two busy cores): the image means' ratios to
-/// BDPT are 0.9995–0.9998 ± 0.0004 (path-space MLT, both perturbations) and 0.9993 ± 0.0004
-/// (ERPT), within 1.6 σ: a 0.2% bias would show. No region of 48 (channels included) is
-/// beyond 2.2 σ (path-space MLT) or 2.5 σ (ERPT); a region's σ is typically 0.45% of its
-/// mean for path-space MLT (0.07–1.15%) and 0.23% for ERPT (0.07–0.74%), so a bias of 2%
-/// (1%) in a typical region would show. The worst regions' per-render means have skewness
-/// below 0.5 and their largest exceeds their mean by about a fifth at most: no heavy tail.
-/// Over 32 groups of 16 renders the suite's 16-render statistic exceeds 3 in 7–9 of 1536
-/// comparisons per algorithm and 4 in at most one, as Student's t with 15 to 30 degrees of
-/// freedom predicts (0.5–0.9%, 0.04–0.12%), and never 6: the suite's tolerances hold here.
-/// Longer mirror chains change nothing: at `MLT_FACING_MAX_DEPTH=6` over 256 renders the
-/// ratios are 0.9994–1.0000 ± 0.0006 (path-space MLT) and 0.9998 ± 0.0006 (ERPT), no region
-/// beyond 2.2 σ and 2.7 σ, though path-space MLT's 16-render statistic exceeds 3 a little
-/// more often than Student's t predicts (8 and 12 of 768, 4.2 at most).
-///
-/// The old failure is the variant with the back wall uncoated (`MLT_FACING_BACK_UNCOATED=1`),
-/// and it is a heavy tail, not a bias. At the suite's seeds (the first 16 renders) path-space
-/// MLT perturbing directions is 10% low at −6.4 σ in region (3, 0), the top of the green
-/// wall. Over 256 renders the same region is −0.6 σ (σ 0.84%), the image means' ratios are
-/// 0.9996–1.0009 ± 0.0006 and no region is beyond 2.7 σ in any algorithm. There the region's
-/// per-render means are skewed (0.37, the largest 1.4 times the mean): 16 renders without a
-/// bright one read low with too small a spread. This variant's 16-render statistic exceeds 4
-/// in 5 of 768 comparisons (Student's t: under 1) for that algorithm.
-#[test]
-#[ignore = "minutes: run by hand (see its doc comment)"]
-fn facing_clear_coats_path_space_mlt_and_erpt_agree_with_bdpt() {
-    let variable = |name: &str, default: u64| {
-        std::env::var(name).map_or(default, |v| v.parse().expect("a number"))
-    };
-    let renders = variable("MLT_FACING_RENDERS", 96);
-    let max_depth = variable("MLT_FACING_MAX_DEPTH", MAX_DEPTH as u64) as u32;
-    let scene = facing_coats_box();
-    let camera = canonical_camera("cornell-box");
-    const GRID: usize = 4;
-    let size = SIZE as usize;
-    // Per algorithm: its estimate and, per region and channel, the per-render means.
-    let run = |settings: RenderSettings| {
-        let settings = RenderSettings {
-            width: SIZE,
-            height: SIZE,
-            max_depth,
-            ..settings
-        };
-        let start = std::time::Instant::now();
-        let images: Vec<Vec<f32>> = (0..renders)
-            .map(|seed| {
-                let settings = RenderSettings {
-                    seed: 700 + seed,
-                    ..settings
-                };
-                render_image(&scene, &camera, &settings)
-            })
-            .collect();
-        eprintln!(
-            "{:?} (perturbing in sample space: {}): {renders} renders in {:.1} s",
-            settings.algorithm,
-            settings.perturb_in_sample_space,
-            start.elapsed().as_secs_f64()
-        );
-        let regions: Vec<Vec<[f64; 3]>> = images
-            .iter()
-            .map(|image| common::stats::region_means(image, size, size, GRID))
-            .collect();
-        let per_region: Vec<[Vec<f64>; 3]> = (0..GRID * GRID)
-            .map(|cell| std::array::from_fn(|c| regions.iter().map(|r| r[cell][c]).collect()))
-            .collect();
-        let whole: [Vec<f64>; 3] = std::array::from_fn(|c| {
-            images
-                .iter()
-                .map(|image| common::stats::mean(image)[c])
-                .collect()
-        });
-        (
-            Estimate::from_correlated_renders(size, size, &images),
-            per_region,
-            whole,
-        )
-    };
-    let (bdpt, bdpt_regions, bdpt_whole) = run(RenderSettings {
-        algorithm: Algorithm::Bdpt,
-        samples_per_pixel: 48,
-        ..Default::default()
-    });
-    let mut checked = Vec::new();
-    for (algorithm, perturb_in_sample_space) in [
-        (Algorithm::PathSpaceMlt, false),
-        (Algorithm::PathSpaceMlt, true),
-        (Algorithm::Erpt, false),
-    ] {
-        let (estimate, regions, whole) = run(RenderSettings {
-            algorithm,
-            perturb_in_sample_space,
-            samples_per_pixel: 40,
-            mutations_per_pixel: 64,
-            bootstrap_samples: 1 << 15,
-            chains: 256,
-            ..Default::default()
-        });
-        let label =
-            format!("{algorithm:?} (perturbing in sample space: {perturb_in_sample_space})");
-        for c in 0..3 {
-            let (a, b) = (spread(&whole[c]), spread(&bdpt_whole[c]));
-            let ratio = a.mean / b.mean;
-            let ratio_error = ratio
-                * ((a.standard_error / a.mean).powi(2) + (b.standard_error / b.mean).powi(2))
-                    .sqrt();
-            eprintln!(
-                "{label}: image channel {c}: ratio to BDPT {ratio:.4} ± {ratio_error:.4} ({:+.2} σ); skewness {:.2} (BDPT {:.2}), largest render's share {:.4} (BDPT {:.4})",
-                (ratio - 1.0) / ratio_error,
-                a.skewness,
-                b.skewness,
-                a.largest_share,
-                b.largest_share,
-            );
-        }
-        let mut worst = (0.0f64, 0, 0);
-        for cell in 0..GRID * GRID {
-            let row: Vec<String> = (0..3)
-                .map(|c| {
-                    let (a, b) = (spread(&regions[cell][c]), spread(&bdpt_regions[cell][c]));
-                    let t = (a.mean - b.mean)
-                        / (a.standard_error.powi(2) + b.standard_error.powi(2)).sqrt();
-                    if t.abs() > worst.0.abs() {
-                        worst = (t, cell, c);
-                    }
-                    let sigma = (a.standard_error.powi(2) + b.standard_error.powi(2)).sqrt();
-                    format!("{t:+.2} ({:.2}%)", 100.0 * sigma / b.mean)
-                })
-                .collect();
-            eprintln!(
-                "{label}: region ({}, {}): {} σ (σ of BDPT's mean)",
-                cell % GRID,
-                cell / GRID,
-                row.join(" ")
-            );
-        }
-        let (t, cell, c) = worst;
-        let (a, b) = (&regions[cell][c], &bdpt_regions[cell][c]);
-        let (sa, sb) = (spread(a), spread(b));
-        let (low, high) = bootstrap_interval(a, b, 20_000);
-        eprintln!(
-            "{label}: worst region ({}, {}) channel {c}: {t:+.2} σ; ratio to BDPT {:.4}, bootstrap 99.9% interval of the difference [{:+.4}, {:+.4}] of BDPT's mean; skewness {:.2} (BDPT {:.2}), largest render's share {:.4} (BDPT {:.4})",
-            cell % GRID,
-            cell / GRID,
-            sa.mean / sb.mean,
-            low / sb.mean,
-            high / sb.mean,
-            sa.skewness,
-            sb.skewness,
-            sa.largest_share,
-            sb.largest_share,
-        );
-        // The suite's test compares 16 renders: how its statistic is distributed here.
-        const GROUP: usize = 16;
-        let welch = |a: &[f64], b: &[f64]| {
-            let (a, b) = (spread(a), spread(b));
-            (a.mean - b.mean) / (a.standard_error.powi(2) + b.standard_error.powi(2)).sqrt()
-        };
-        let mut group_worst = Vec::new();
-        let mut beyond = [0usize; 3];
-        for g in 0..renders as usize / GROUP {
-            let group = g * GROUP..(g + 1) * GROUP;
-            let mut worst = 0.0f64;
-            for cell in 0..GRID * GRID {
-                for c in 0..3 {
-                    let (a, b) = (
-                        &regions[cell][c][group.clone()],
-                        &bdpt_regions[cell][c][group.clone()],
-                    );
-                    let t = welch(a, b).abs();
-                    if t > 4.0 {
-                        let (sa, sb) = (spread(a), spread(b));
-                        let (all, all_bdpt) =
-                            (spread(&regions[cell][c]), spread(&bdpt_regions[cell][c]));
-                        eprintln!(
-                            "{label}: group {g}, region ({}, {}) channel {c}: {:+.2} σ; ratio to BDPT {:.4}; skewness {:.2} (BDPT {:.2}), largest render's share {:.3} (BDPT {:.3}); over all renders: skewness {:.2} (BDPT {:.2}), largest render {:.2} (BDPT {:.2}) times the mean",
-                            cell % GRID,
-                            cell / GRID,
-                            welch(a, b),
-                            sa.mean / sb.mean,
-                            sa.skewness,
-                            sb.skewness,
-                            sa.largest_share,
-                            sb.largest_share,
-                            all.skewness,
-                            all_bdpt.skewness,
-                            1.0 + all.largest_share * renders as f64,
-                            1.0 + all_bdpt.largest_share * renders as f64,
-                        );
-                    }
-                    worst = worst.max(t);
-                    for (count, limit) in beyond.iter_mut().zip([3.0, 4.0, 6.0]) {
-                        *count += (t > limit) as usize;
-                    }
-                }
-            }
-            group_worst.push(format!("{worst:.1}"));
-        }
-        eprintln!(
-            "{label}: {} groups of {GROUP} renders, each region channel against BDPT's: of {} comparisons, |t| > 3: {}, > 4: {}, > 6: {}; the largest |t| per group: {}",
-            group_worst.len(),
-            group_worst.len() * GRID * GRID * 3,
-            beyond[0],
-            beyond[1],
-            beyond[2],
-            group_worst.join(" ")
-        );
-        checked.push((label, estimate));
-    }
-    // Asserted after all are printed.
-    for (label, estimate) in checked {
-        assert_estimates_agree(
-            &format!("facing coats {label} against BDPT"),
-            &estimate,
-            &bdpt,
-            GRID,
             5.0,
             6.0,
         );
